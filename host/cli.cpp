@@ -1,0 +1,141 @@
+#include "cli.hpp"
+
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "compare.hpp"
+#include "errors.hpp"
+#include "render.hpp"
+
+namespace dacrt {
+namespace {
+
+glm::dvec3 parseVec3(const std::string& option, const std::string& text) {
+    std::stringstream s(text);
+    std::string part;
+    std::vector<double> values;
+    while (std::getline(s, part, ',')) {
+        try {
+            std::size_t used = 0;
+            values.push_back(std::stod(part, &used));
+            if (used != part.size()) throw std::invalid_argument(part);
+        } catch (const std::exception&) {
+            throw InputError(option + ": '" + text + "' is not three comma-separated numbers");
+        }
+    }
+    if (values.size() != 3) throw InputError(option + ": '" + text + "' is not three comma-separated numbers");
+    for (double v : values)
+        if (!std::isfinite(v)) throw InputError(option + ": '" + text + "' has a non-finite value");
+    return {values[0], values[1], values[2]};
+}
+
+void parseSize(const std::string& text, int& width, int& height) {
+    const std::size_t x = text.find('x');
+    try {
+        std::size_t usedW = 0, usedH = 0;
+        if (x == std::string::npos) throw std::invalid_argument(text);
+        width = std::stoi(text.substr(0, x), &usedW);
+        height = std::stoi(text.substr(x + 1), &usedH);
+        if (usedW != x || usedH != text.size() - x - 1) throw std::invalid_argument(text);
+    } catch (const std::exception&) {
+        throw InputError("--size: '" + text + "' is not WIDTHxHEIGHT");
+    }
+}
+
+template <typename E>
+CLI::CheckedTransformer choices(const std::map<std::string, E>& map) {
+    return CLI::CheckedTransformer(map, CLI::ignore_case);
+}
+
+}  // namespace
+
+int runCli(int argc, char** argv) {
+    CLI::App app{"dacrt: divide-and-conquer ray tracing without an acceleration structure"};
+    app.require_subcommand(1);
+
+    RenderOptions render;
+    std::string size = "640x480", eye, target, up;
+    double fov = 0.0;
+    CLI::App* renderCmd = app.add_subcommand("render", "trace primary rays through a glTF scene");
+    renderCmd->add_option("scene", render.scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
+    renderCmd->add_option("-o,--output", render.outputPath, "shaded image (PNG or any OpenImageIO format)");
+    renderCmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id and hit mask");
+    renderCmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
+    renderCmd->add_option("--backend", render.trace.backend, "brute | cpu-seq | cpu")
+        ->transform(choices<Backend>({{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}}))
+        ->default_str("cpu");
+    renderCmd->add_option("--size", size, "image size WIDTHxHEIGHT")->default_str("640x480");
+    renderCmd->add_option("--regions", render.trace.regions, "sub-scenes of the cpu backend (default: 2 per thread)")
+        ->check(CLI::Range(1u, 4096u));
+    renderCmd->add_option("--threads", render.trace.threads, "worker threads (default: every core)")
+        ->check(CLI::Range(1u, 1024u));
+    renderCmd->add_option("--axis", render.trace.axis, "division axis of the cpu backend: best | x | y | z")
+        ->transform(choices<DivisionAxis>(
+            {{"best", DivisionAxis::Best}, {"x", DivisionAxis::X}, {"y", DivisionAxis::Y}, {"z", DivisionAxis::Z}}))
+        ->default_str("best");
+    renderCmd->add_option("--split", render.trace.dacrt.split, "DACRT split: spatial-median | centroid-mean | sampled-mean")
+        ->transform(choices<SplitMethod>({{"spatial-median", SplitMethod::SpatialMedian},
+                                          {"centroid-mean", SplitMethod::CentroidMean},
+                                          {"sampled-mean", SplitMethod::SampledMean}}))
+        ->default_str(toString(DacrtOptions{}.split));
+    renderCmd->add_option("--ray-limit", render.trace.dacrt.rayLimit, "leaf when fewer live rays")
+        ->check(CLI::Range(1u, 1u << 30))->default_str(std::to_string(DacrtOptions{}.rayLimit));
+    renderCmd->add_option("--tri-limit", render.trace.dacrt.triLimit, "leaf when fewer triangles")
+        ->check(CLI::Range(1u, 1u << 30))->default_str(std::to_string(DacrtOptions{}.triLimit));
+    renderCmd->add_option("--eye", eye, "camera position x,y,z");
+    renderCmd->add_option("--target", target, "point the camera looks at x,y,z");
+    renderCmd->add_option("--up", up, "camera up vector x,y,z");
+    renderCmd->add_option("--fov", fov, "vertical field of view in degrees");
+    renderCmd->add_option("--orbit", render.camera.orbit, "K cameras on a circle about the vertical axis")
+        ->check(CLI::Range(1, 100000));
+    renderCmd->add_flag("--plan", render.planOnly, "print the memory plan and stop before tracing");
+
+    std::string compareA, compareB;
+    bool compareJson = false;
+    double tieBound = kNearTieRelativeDepth;
+    CLI::App* compareCmd = app.add_subcommand("compare", "compare two --aov images pixel by pixel");
+    compareCmd->add_option("a", compareA, "first AOV EXR")->required();
+    compareCmd->add_option("b", compareB, "second AOV EXR")->required();
+    compareCmd->add_flag("--json", compareJson, "write the report as JSON to stdout");
+    compareCmd->add_option("--tie-bound", tieBound, "relative depth bound of a near tie")->check(CLI::PositiveNumber);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    }
+
+    try {
+        if (*renderCmd) {
+            parseSize(size, render.width, render.height);
+            if (!eye.empty()) render.camera.eye = parseVec3("--eye", eye);
+            if (!target.empty()) render.camera.target = parseVec3("--target", target);
+            if (!up.empty()) render.camera.up = parseVec3("--up", up);
+            if (renderCmd->count("--fov")) render.camera.fovDegrees = fov;
+            return runRender(render);
+        }
+        if (*compareCmd) {
+            const Aov a = readAov(compareA);
+            const Aov b = readAov(compareB);
+            const CompareReport report = compareAovs(a, b, tieBound);
+            std::cout << (compareJson ? report.json() + "\n" : report.text());
+            return 0;
+        }
+    } catch (const InputError& e) {
+        std::cerr << "dacrt: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "dacrt: internal error: " << e.what() << "\n";
+        return 1;
+    }
+    return 2;
+}
+
+}  // namespace dacrt

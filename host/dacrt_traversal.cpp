@@ -1,0 +1,131 @@
+#include "dacrt_traversal.hpp"
+
+#include <algorithm>
+#include <utility>
+
+namespace dacrt {
+namespace {
+
+Box widen(const Box& b, float margin) {
+    Box w;
+    w.lo = b.lo - glm::vec3(margin);
+    w.hi = b.hi + glm::vec3(margin);
+    return w;
+}
+
+int longestAxis(const Box& b) {
+    const glm::vec3 e = b.extent();
+    return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+}
+
+}  // namespace
+
+DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& options, Hit* hits,
+                               std::uint32_t* rayIds, std::uint32_t* triIds, Counters& counters)
+    : rays_(g.rays->data()),
+      triangles_(g.triangles->data()),
+      triangleBounds_(g.triangleBounds->data()),
+      origin_(g.rayOrigin),
+      margin_(g.margin),
+      options_(options),
+      hits_(hits),
+      rayIds_(rayIds),
+      triIds_(triIds),
+      counters_(counters) {}
+
+std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
+                                    std::uint32_t triBegin, std::uint32_t triEnd, const RetireRule& retire) {
+    const std::uint32_t crossing = filterRays(widen(box, margin_), terminated, rayEnd);
+    node(box, terminated, crossing, triBegin, triEnd, 0);
+    if (retire.axis < 0) return crossing;
+    const std::uint32_t from = retire.direction == 0 ? terminated : crossing;
+    for (std::uint32_t k = from; k < rayEnd; ++k) {
+        const float d = rays_[rayIds_[k]].dir[retire.axis];
+        const bool done = retire.direction == 0 ? d == 0.0f : (retire.direction > 0 ? d > 0.0f : d < 0.0f);
+        if (done) {
+            std::swap(rayIds_[k], rayIds_[terminated]);
+            ++terminated;
+            ++counters_.raysRetired;
+        }
+    }
+    return crossing;
+}
+
+std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
+    counters_.rayBoxTests += end - begin;
+    std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
+        return shared::rayMayCrossBox(rays_[id], cell.lo, cell.hi, hits_[id].t);
+    });
+    return std::uint32_t(first - rayIds_);
+}
+
+std::uint32_t DacrtTraversal::filterTriangles(const Box& cell, std::uint32_t begin, std::uint32_t end) {
+    std::uint32_t* first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+        const Bounds& b = triangleBounds_[id];
+        return shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
+    });
+    return std::uint32_t(first - triIds_);
+}
+
+float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const {
+    const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
+    if (options_.split == SplitMethod::SpatialMedian) return mid;
+    // Mora's sampled mean: every 50th triangle centre once the set is large, all of them below.
+    const std::uint32_t count = triEnd - triBegin;
+    const std::uint32_t stride = options_.split == SplitMethod::SampledMean && count > 500 ? 50 : 1;
+    double sum = 0.0;
+    std::uint32_t samples = 0;
+    for (std::uint32_t i = triBegin; i < triEnd; i += stride, ++samples) {
+        const Bounds& b = triangleBounds_[triIds_[i]];
+        sum += 0.5 * (double(b.lo[axis]) + double(b.hi[axis]));
+    }
+    const float s = float(sum / double(std::max(samples, 1u)));
+    return s > box.lo[axis] && s < box.hi[axis] ? s : mid;
+}
+
+void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd, std::uint32_t depth) {
+    if (terminated >= rayEnd || triBegin >= triEnd) return;
+    const std::uint32_t rayCount = rayEnd - terminated, triCount = triEnd - triBegin;
+    const int axis = longestAxis(box);
+    const float split = splitPosition(box, axis, triBegin, triEnd);
+    if (rayCount < options_.rayLimit || triCount < options_.triLimit || depth >= options_.maxDepth ||
+        !(split > box.lo[axis] && split < box.hi[axis])) {
+        leaf(box, terminated, rayEnd, triBegin, triEnd);
+        return;
+    }
+    Box low = box, high = box;
+    low.hi[axis] = split;
+    high.lo[axis] = split;
+    // Front to back: every ray shares the origin, so the child on its side is crossed first.
+    const bool lowFirst = origin_[axis] <= split;
+    for (const Box* child : {lowFirst ? &low : &high, lowFirst ? &high : &low}) {
+        const Box cell = widen(*child, margin_);
+        const std::uint32_t childRays = filterRays(cell, terminated, rayEnd);
+        if (childRays == terminated) continue;
+        const std::uint32_t childTris = filterTriangles(cell, triBegin, triEnd);
+        node(*child, terminated, childRays, triBegin, childTris, depth + 1);
+    }
+}
+
+void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd) {
+    ++counters_.leaves;
+    counters_.rayTriangleTests += std::uint64_t(rayEnd - terminated) * (triEnd - triBegin);
+    for (std::uint32_t k = terminated; k < rayEnd; ++k) {
+        const std::uint32_t rayId = rayIds_[k];
+        const Ray& ray = rays_[rayId];
+        Hit best = hits_[rayId];
+        for (std::uint32_t j = triBegin; j < triEnd; ++j) {
+            const std::uint32_t prim = triIds_[j];
+            testTriangle(ray, triangles_[prim], prim, best);
+        }
+        hits_[rayId] = best;
+        if (best.prim != kMissPrim && shared::hitEndsInBox(ray, box.lo, box.hi, best.t)) {
+            std::swap(rayIds_[k], rayIds_[terminated]);
+            ++terminated;
+        }
+    }
+}
+
+}  // namespace dacrt

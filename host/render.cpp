@@ -1,0 +1,167 @@
+#include "render.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cpu_tracers.hpp"
+#include "errors.hpp"
+#include "gltf_loader.hpp"
+#include "image_io.hpp"
+
+namespace dacrt {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::uint64_t physicalMemoryBytes() {
+    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && pageSize > 0 ? std::uint64_t(pages) * std::uint64_t(pageSize) : 0;
+}
+
+nlohmann::ordered_json vec(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+
+nlohmann::ordered_json statsJson(const RenderOptions& o, const Scene& scene, const Camera& camera, int cameraIndex,
+                                 std::size_t rayCount, const TraceResult& r,
+                                 const std::vector<std::pair<std::string, double>>& timings) {
+    nlohmann::ordered_json j;
+    j["backend"] = toString(o.trace.backend);
+    j["scene"] = o.scenePath;
+    j["triangles"] = scene.triangleCount();
+    j["rays"] = rayCount;
+    j["width"] = o.width;
+    j["height"] = o.height;
+    j["regions"] = r.regions;
+    j["threads"] = r.threads;
+    j["division_axis"] = r.axis < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(std::string(1, "xyz"[r.axis]));
+    j["camera"] = {{"index", cameraIndex}, {"eye", vec(camera.eye)}, {"forward", vec(camera.forward)},
+                   {"up", vec(camera.up)}, {"yfov_degrees", glm::degrees(camera.yfovRadians)}};
+    j["options"] = {{"ray_limit", o.trace.dacrt.rayLimit}, {"tri_limit", o.trace.dacrt.triLimit},
+                    {"max_depth", o.trace.dacrt.maxDepth}, {"split", toString(o.trace.dacrt.split)},
+                    {"axis", toString(o.trace.axis)}, {"intersector", "watertight"}};
+    nlohmann::ordered_json t;
+    for (const auto& [name, ms] : timings) t[name] = ms;
+    nlohmann::ordered_json phases;
+    for (const auto& [name, ms] : r.phaseMs) phases[name] = ms;
+    if (!phases.empty()) t["trace_phases"] = phases;
+    j["timings_ms"] = t;
+    nlohmann::ordered_json mem;
+    for (const auto& [name, bytes] : r.memory.buffers) mem[name] = bytes;
+    mem["total"] = r.memory.total();
+    j["memory_plan_bytes"] = mem;
+    const Counters& c = r.counters;
+    nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < c.terminatedPerRound.size(); ++i)
+        rounds.push_back({{"round", c.roundNames[i]}, {"terminated", c.terminatedPerRound[i]}});
+    j["counters"] = {{"ray_box_tests", c.rayBoxTests},
+                     {"ray_triangle_tests", c.rayTriangleTests},
+                     {"leaves", c.leaves},
+                     {"rays_retired_without_hit", c.raysRetired},
+                     {"rays_culled", c.raysCulled},
+                     {"rays_terminated_step1", c.terminatedStep1},
+                     {"rays_terminated_per_round", rounds},
+                     {"transfer_work_items", c.transferWorkItems},
+                     {"transfer_work_items_skipped", c.transferWorkItemsSkipped}};
+    std::uint64_t hits = 0;
+    for (const Hit& h : r.hits) hits += h.prim != kMissPrim;
+    j["hits"] = hits;
+    return j;
+}
+
+}  // namespace
+
+std::string pathForCamera(const std::string& path, int camera, int cameraCount) {
+    if (path.empty() || cameraCount <= 1) return path;
+    const std::filesystem::path p(path);
+    const int digits = int(std::to_string(cameraCount - 1).size());
+    std::string index = std::to_string(camera);
+    index.insert(0, std::size_t(digits) - index.size(), '0');
+    return (p.parent_path() / (p.stem().string() + "_cam" + index + p.extension().string())).string();
+}
+
+int runRender(const RenderOptions& o) {
+    const auto start = Clock::now();
+    if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
+        throw InputError("--size: width and height must lie in 1..16384");
+    Scene scene = loadGltf(o.scenePath);
+    const double loadMs = msSince(start);
+
+    const auto prepareStart = Clock::now();
+    const std::vector<Bounds> triangleBounds = allTriangleBounds(scene.triangles);
+    const Box box = sceneBounds(scene.triangles);
+    const std::vector<Camera> cameras = makeCameras(scene, box, o.camera, double(o.width) / double(o.height));
+    const double sharedPrepareMs = msSince(prepareStart);
+
+    const unsigned threads =
+        o.trace.backend == Backend::CpuSeq ? 1u
+                                           : (o.trace.threads ? o.trace.threads : std::max(1u, std::thread::hardware_concurrency()));
+    ThreadPool pool(threads);
+    const std::uint64_t memoryLimit = physicalMemoryBytes();
+
+    for (int k = 0; k < int(cameras.size()); ++k) {
+        const auto frameStart = Clock::now();
+        const auto raysStart = Clock::now();
+        const std::vector<Ray> rays = primaryRays(cameras[std::size_t(k)], o.width, o.height);
+        FrameGeometry g;
+        g.triangles = &scene.triangles;
+        g.triangleBounds = &triangleBounds;
+        g.rays = &rays;
+        g.sceneBox = box;
+        g.rayOrigin = rays.front().origin;
+        g.margin = filterMargin(box, g.rayOrigin);
+        const double prepareMs = sharedPrepareMs + msSince(raysStart);
+
+        auto onPlan = [&](const MemoryPlan& plan) {
+            if (o.planOnly) {
+                std::cout << "memory plan (" << toString(o.trace.backend) << ", " << scene.triangleCount()
+                          << " triangles, " << rays.size() << " rays"
+                          << (cameras.size() > 1 ? ", camera " + std::to_string(k) : std::string()) << "):\n"
+                          << plan.describe();
+                return false;
+            }
+            if (memoryLimit && plan.total() > memoryLimit)
+                throw InputError("the frame needs " + std::to_string(plan.total()) + " bytes but this machine has " +
+                                 std::to_string(memoryLimit) + " bytes of memory (over by " +
+                                 std::to_string(plan.total() - memoryLimit) + " bytes); lower --size or --regions");
+            return true;
+        };
+        const auto traceStart = Clock::now();
+        const TraceResult result = traceCpu(g, o.trace, pool, onPlan);
+        if (o.planOnly) continue;
+        const double traceMs = msSince(traceStart);
+
+        const auto writeStart = Clock::now();
+        const HitImage image{o.width, o.height, &rays, &result.hits};
+        const std::string out = pathForCamera(o.outputPath, k, int(cameras.size()));
+        const std::string aov = pathForCamera(o.aovPath, k, int(cameras.size()));
+        if (!out.empty()) writeShaded(out, scene, image);
+        if (!aov.empty()) writeAov(aov, scene, image);
+        const double writeMs = msSince(writeStart);
+        const double totalMs = (k == 0 ? loadMs : 0.0) + msSince(frameStart) + (k == 0 ? sharedPrepareMs : 0.0);
+
+        const std::string statsPath = pathForCamera(o.statsPath, k, int(cameras.size()));
+        const std::vector<std::pair<std::string, double>> timings = {
+            {"load", loadMs}, {"prepare", prepareMs}, {"trace", traceMs}, {"write", writeMs}, {"total", totalMs}};
+        if (!statsPath.empty()) {
+            std::ofstream f(statsPath);
+            if (!f) throw InputError(statsPath + ": cannot write the stats file");
+            f << statsJson(o, scene, cameras[std::size_t(k)], k, rays.size(), result, timings).dump(2) << "\n";
+        }
+        std::cerr << "dacrt: " << toString(o.trace.backend) << " camera " << k << ": " << scene.triangleCount()
+                  << " triangles, " << rays.size() << " rays, trace " << traceMs << " ms"
+                  << (out.empty() ? "" : ", wrote " + out) << "\n";
+    }
+    return 0;
+}
+
+}  // namespace dacrt

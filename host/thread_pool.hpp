@@ -1,0 +1,43 @@
+#pragma once
+// A fixed set of worker threads running one parallel loop at a time. The calling thread
+// takes part, so a pool of size 1 runs everything inline.
+#include <atomic>
+#include <condition_variable>
+#include <cstddef>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace dacrt {
+
+class ThreadPool {
+public:
+    explicit ThreadPool(unsigned threads);
+    ~ThreadPool();
+    ThreadPool(const ThreadPool&) = delete;
+    ThreadPool& operator=(const ThreadPool&) = delete;
+
+    unsigned size() const { return unsigned(workers_.size()) + 1; }
+
+    // Calls body(index, worker) for every index in [0, count), handing out indices one at a
+    // time (dynamic balance); worker is in [0, size()). Returns when all calls are done.
+    void parallelFor(std::size_t count, const std::function<void(std::size_t, unsigned)>& body);
+
+private:
+    void workerLoop(unsigned worker);
+    void drain(unsigned worker);
+
+    std::vector<std::thread> workers_;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::condition_variable done_;
+    const std::function<void(std::size_t, unsigned)>* body_ = nullptr;
+    std::size_t count_ = 0;
+    std::atomic<std::size_t> next_{0};
+    unsigned busy_ = 0;
+    unsigned long generation_ = 0;
+    bool stopping_ = false;
+};
+
+}  // namespace dacrt

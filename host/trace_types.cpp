@@ -1,0 +1,54 @@
+#include "trace_types.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace dacrt {
+
+std::string toString(Backend b) {
+    switch (b) {
+        case Backend::Brute: return "brute";
+        case Backend::CpuSeq: return "cpu-seq";
+        case Backend::Cpu: return "cpu";
+    }
+    return "?";
+}
+
+std::string toString(SplitMethod s) {
+    switch (s) {
+        case SplitMethod::SpatialMedian: return "spatial-median";
+        case SplitMethod::CentroidMean: return "centroid-mean";
+        case SplitMethod::SampledMean: return "sampled-mean";
+    }
+    return "?";
+}
+
+std::string toString(DivisionAxis a) {
+    switch (a) {
+        case DivisionAxis::Best: return "best";
+        case DivisionAxis::X: return "x";
+        case DivisionAxis::Y: return "y";
+        case DivisionAxis::Z: return "z";
+    }
+    return "?";
+}
+
+float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin) {
+    float m = 0.0f;
+    for (int a = 0; a < 3; ++a)
+        m = std::max({m, std::abs(sceneBox.lo[a]), std::abs(sceneBox.hi[a]), std::abs(rayOrigin[a])});
+    return std::max(m * 0x1p-18f, 0x1p-100f);
+}
+
+std::string MemoryPlan::describe() const {
+    std::ostringstream s;
+    for (const auto& [name, bytes] : buffers)
+        s << "  " << name << std::string(name.size() < 28 ? 28 - name.size() : 1, ' ') << bytes << " bytes ("
+          << std::fixed << double(bytes) / (1024.0 * 1024.0) << " MiB)\n";
+    s << "  total" << std::string(23, ' ') << total() << " bytes (" << std::fixed
+      << double(total()) / (1024.0 * 1024.0) << " MiB)\n";
+    return s.str();
+}
+
+}  // namespace dacrt

@@ -1,0 +1,94 @@
+#pragma once
+// What every tracer takes and returns.
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene.hpp"
+
+namespace dacrt {
+
+enum class Backend { Brute, CpuSeq, Cpu };
+enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
+enum class DivisionAxis { Best, X, Y, Z };
+
+std::string toString(Backend b);
+std::string toString(SplitMethod s);
+std::string toString(DivisionAxis a);
+
+struct DacrtOptions {
+    std::uint32_t rayLimit = 16;   // a node with fewer live rays is a leaf
+    std::uint32_t triLimit = 16;   // a node with fewer triangles is a leaf
+    std::uint32_t maxDepth = 48;   // guards against coincident triangles that never separate
+    SplitMethod split = SplitMethod::SpatialMedian;
+};
+
+struct TraceOptions {
+    Backend backend = Backend::Cpu;
+    unsigned regions = 0;   // cpu: sub-scenes; 0 means 2 per thread
+    unsigned threads = 0;   // 0 means every core
+    DivisionAxis axis = DivisionAxis::Best;
+    DacrtOptions dacrt;
+};
+
+// Everything a tracer reads, prepared once per frame and shared by every backend.
+struct FrameGeometry {
+    const std::vector<Triangle>* triangles = nullptr;
+    const std::vector<Bounds>* triangleBounds = nullptr;
+    const std::vector<Ray>* rays = nullptr;
+    Box sceneBox;          // exact bounds of the triangles
+    glm::vec3 rayOrigin{};  // every ray starts here (primary rays)
+    float margin = 0.0f;    // filter widening, see filterMargin()
+};
+
+// Widening applied to every box before a ray or triangle filter, so that rounding in the
+// intersection test can never move a hit out of the cells that test it. See
+// docs/correctness.md for the derivation: 64 units in the last place of the largest
+// coordinate magnitude among the scene bounds and the ray origin.
+float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin);
+
+struct Counters {
+    std::uint64_t rayBoxTests = 0;
+    std::uint64_t rayTriangleTests = 0;
+    std::uint64_t leaves = 0;
+    std::uint64_t raysRetired = 0;       // finished by the parallel scheme without a further hit
+    std::uint64_t raysCulled = 0;        // missed the scene box
+    std::uint64_t terminatedStep1 = 0;   // for cpu-seq: every terminated ray
+    std::vector<std::uint64_t> terminatedPerRound;  // transfer rounds in execution order
+    std::vector<std::string> roundNames;
+    std::uint64_t transferWorkItems = 0;
+    std::uint64_t transferWorkItemsSkipped = 0;
+
+    void add(const Counters& o) {
+        rayBoxTests += o.rayBoxTests;
+        rayTriangleTests += o.rayTriangleTests;
+        leaves += o.leaves;
+        raysRetired += o.raysRetired;
+    }
+};
+
+struct MemoryPlan {
+    std::vector<std::pair<std::string, std::uint64_t>> buffers;
+    void add(const std::string& name, std::uint64_t bytes) { buffers.emplace_back(name, bytes); }
+    std::uint64_t total() const {
+        std::uint64_t t = 0;
+        for (const auto& b : buffers) t += b.second;
+        return t;
+    }
+    std::string describe() const;
+};
+
+struct TraceResult {
+    std::vector<Hit> hits;   // one per ray
+    Counters counters;
+    MemoryPlan memory;
+    std::vector<std::pair<std::string, double>> phaseMs;  // backend-specific parts of the trace
+    unsigned threads = 1;
+    unsigned regions = 1;
+    int axis = -1;           // division axis used (cpu), -1 if none
+};
+
+}  // namespace dacrt

@@ -1,0 +1,74 @@
+// Data layouts shared by the C++ host and the GLSL compute shaders (std430).
+// Included verbatim by both: C++ sees glm types through host/shader_compat.hpp,
+// GLSL sees its own. Every size and offset is checked at the end of this file.
+#ifndef DACRT_LAYOUT_H
+#define DACRT_LAYOUT_H
+
+// A primary ray. Everything a backend needs is computed once on the host in float32,
+// so that every backend starts from bit-identical inputs (no division on the device).
+struct Ray {
+    vec3 origin;
+    float tmin;     // hits must have t > tmin
+    vec3 dir;
+    uint axes;      // watertight test permutation: kx | ky << 2 | kz << 4
+    vec3 invDir;    // 1/dir per component, 0 where dir is 0 (the box test branches on dir == 0)
+    float pad0;
+    vec3 shear;     // watertight test: (dir[kx]/dir[kz], dir[ky]/dir[kz], 1/dir[kz])
+    float pad1;
+};
+
+struct Triangle {
+    vec3 v0;
+    float pad0;
+    vec3 v1;
+    float pad1;
+    vec3 v2;
+    float pad2;
+};
+
+// Axis-aligned bounds; also the per-triangle bounds used by the triangle/cell filter.
+struct Bounds {
+    vec3 lo;
+    float pad0;
+    vec3 hi;
+    float pad1;
+};
+
+// Per-ray result. prim == kMissPrim means no hit; t is then kNoHitT.
+struct Hit {
+    float t;
+    uint prim;
+    float u;   // barycentric weight of v1
+    float v;   // barycentric weight of v2
+};
+
+// One sub-scene of the parallel scheme: a slab of the scene box along the division axis.
+struct Region {
+    vec3 lo;
+    uint rayBegin;
+    vec3 hi;
+    uint rayEnd;
+    uint triBegin;
+    uint triEnd;
+    uint terminated;   // rays [rayBegin, terminated) have their final hit
+    uint pad0;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(Ray) == 64);
+static_assert(offsetof(Ray, origin) == 0 && offsetof(Ray, tmin) == 12);
+static_assert(offsetof(Ray, dir) == 16 && offsetof(Ray, axes) == 28);
+static_assert(offsetof(Ray, invDir) == 32 && offsetof(Ray, shear) == 48);
+static_assert(sizeof(Triangle) == 48);
+static_assert(offsetof(Triangle, v0) == 0 && offsetof(Triangle, v1) == 16 && offsetof(Triangle, v2) == 32);
+static_assert(sizeof(Bounds) == 32 && offsetof(Bounds, lo) == 0 && offsetof(Bounds, hi) == 16);
+static_assert(sizeof(Hit) == 16 && offsetof(Hit, t) == 0 && offsetof(Hit, prim) == 4);
+static_assert(offsetof(Hit, u) == 8 && offsetof(Hit, v) == 12);
+static_assert(sizeof(Region) == 48);
+static_assert(offsetof(Region, lo) == 0 && offsetof(Region, rayBegin) == 12);
+static_assert(offsetof(Region, hi) == 16 && offsetof(Region, rayEnd) == 28);
+static_assert(offsetof(Region, triBegin) == 32 && offsetof(Region, triEnd) == 36);
+static_assert(offsetof(Region, terminated) == 40);
+#endif
+
+#endif

@@ -1,0 +1,95 @@
+#!/usr/bin/env python3
+"""Writes the tiny glTF scenes the tests load (run from this folder; outputs are committed).
+
+Each file is small enough to check by hand: positions, indices and transforms are listed
+below with the answers the tests expect.
+"""
+import base64, json, math, struct
+
+def gltf(positions, indices=None, index_format=None, mode=4, nodes=None, extra=None, uri=None):
+    pos = b"".join(struct.pack("<3f", *p) for p in positions)
+    idx = b""
+    if indices is not None:
+        fmt, ctype = {"B": ("<B", 5121), "H": ("<H", 5123), "I": ("<I", 5125)}[index_format]
+        idx = b"".join(struct.pack(fmt, i) for i in indices)
+    pad = (4 - len(pos) % 4) % 4
+    data = pos + b"\0" * pad + idx
+    data += b"\0" * ((4 - len(data) % 4) % 4)
+    finite = [p for p in positions if all(math.isfinite(c) for c in p)] or [(0, 0, 0)]
+    doc = {
+        "asset": {"version": "2.0", "generator": "dacrt tests/scenes/make_fixtures.py"},
+        "buffers": [{"byteLength": len(data),
+                     "uri": uri or "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(pos)}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(positions), "type": "VEC3",
+                       "min": [min(p[k] for p in finite) for k in range(3)],
+                       "max": [max(p[k] for p in finite) for k in range(3)]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1.0, 0.25, 0.125, 1.0]}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "mode": mode, "material": 0}]}],
+        "nodes": nodes or [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0,
+    }
+    if indices is not None:
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": len(pos) + pad, "byteLength": len(idx)})
+        doc["accessors"].append({"bufferView": 1, "componentType": ctype, "count": len(indices), "type": "SCALAR"})
+        doc["meshes"][0]["primitives"][0]["indices"] = 1
+    if extra:
+        extra(doc)
+    return doc
+
+def write(name, doc):
+    with open(name, "w") as f:
+        json.dump(doc, f, indent=1)
+        f.write("\n")
+
+def glb(name, doc):
+    """Moves the data URI of buffer 0 into a GLB BIN chunk."""
+    data = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+    del doc["buffers"][0]["uri"]
+    js = json.dumps(doc).encode()
+    js += b" " * ((4 - len(js) % 4) % 4)
+    body = struct.pack("<II", len(js), 0x4E4F534A) + js + struct.pack("<II", len(data), 0x004E4942) + data
+    with open(name, "wb") as f:
+        f.write(struct.pack("<III", 0x46546C67, 2, 12 + len(body)) + body)
+
+# A unit quad in the plane z = 0 from (-1,-1) to (1,1), two triangles, u8 indices, and a
+# camera at (0, 0, 4) looking down -z (identity rotation), yfov 0.5 rad.
+quad = [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]
+def add_camera(doc):
+    doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}]
+    doc["nodes"].append({"camera": 0, "translation": [0, 0, 4]})
+    doc["scenes"][0]["nodes"].append(1)
+write("quad_u8_camera.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=add_camera))
+
+# The same quad as a triangle strip 0 1 3 2 with u16 indices, under a node whose matrix
+# translates by (10, 0, 0): world x from 9 to 11.
+write("quad_strip_u16_matrix.gltf", gltf(quad, [0, 1, 3, 2], "H", mode=5,
+      nodes=[{"mesh": 0, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 10, 0, 0, 1]}]))
+
+# Non-indexed: one triangle (0,0,0) (1,0,0) (0,1,0) under child node (translation (0,0,1))
+# of a parent with scale 2, rotation 90 degrees about +y, translation (5,0,0). World
+# vertices: child maps to z=1, scale 2 gives (0,0,2) (2,0,2) (0,2,2); rotating +90 about y
+# sends (x,y,z) to (z,y,-x): (2,0,0) (2,0,-2) (2,2,0); translation: (7,0,0) (7,0,-2) (7,2,0).
+s = math.sqrt(0.5)
+write("triangle_trs_hierarchy.gltf", gltf([(0, 0, 0), (1, 0, 0), (0, 1, 0)],
+      nodes=[{"children": [1], "scale": [2, 2, 2], "rotation": [0, s, 0, s], "translation": [5, 0, 0]},
+             {"mesh": 0, "translation": [0, 0, 1]}]))
+
+# A triangle fan of the quad (0 1 2 3) with u32 indices, as a binary .glb.
+glb("quad_fan_u32.glb", gltf(quad, [0, 1, 2, 3], "I", mode=6))
+
+# Bad inputs.
+write("bad_index_out_of_range.gltf", gltf(quad, [0, 1, 2, 0, 2, 7], "B"))
+write("bad_nan_position.gltf", gltf([(0, 0, 0), (1, 0, float("nan")), (0, 1, 0)]))
+write("bad_inf_position.gltf", gltf([(0, 0, 0), (1, float("inf"), 0), (0, 1, 0)]))
+write("bad_points_mode.gltf", gltf(quad, mode=0))
+write("bad_missing_buffer.gltf", gltf(quad, uri="missing.bin"))
+write("bad_no_triangles.gltf", gltf(quad, nodes=[{"name": "empty"}]))
+write("bad_index_count.gltf", gltf(quad, [0, 1, 2, 0], "B"))
+with open("bad_not_gltf.gltf", "w") as f:
+    f.write("this is not a glTF file\n")
+with open("quad_fan_u32.glb", "rb") as f:
+    whole = f.read()
+with open("bad_truncated.glb", "wb") as f:
+    f.write(whole[: len(whole) - 40])

@@ -1,0 +1,126 @@
+// The dacrt command line, run as a user would run it.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.hpp"
+
+namespace {
+
+struct CommandResult {
+    int code = -1;
+    std::string output;  // stdout and stderr together
+};
+
+CommandResult run(const std::string& args) {
+    const std::string command = std::string(DACRT_BINARY) + " " + args + " 2>&1";
+    CommandResult r;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return r;
+    std::array<char, 4096> buffer{};
+    std::size_t n;
+    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
+    const int status = pclose(pipe);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+std::string temp(const std::string& name) { return ::testing::TempDir() + "/cli_" + name; }
+
+}  // namespace
+
+TEST(Cli, RenderWritesImageAovAndStats) {
+    const std::string png = temp("quad.png"), exr = temp("quad.exr"), stats = temp("quad.json");
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 32x24 --backend cpu --regions 3 -o " +
+                      png + " --aov " + exr + " --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_TRUE(std::filesystem::file_size(png) > 0);
+    EXPECT_TRUE(std::filesystem::file_size(exr) > 0);
+    std::ifstream f(stats);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    for (const char* key : {"backend", "triangles", "rays", "regions", "threads", "timings_ms", "memory_plan_bytes", "counters"})
+        EXPECT_TRUE(j.contains(key)) << key;
+    for (const char* key : {"load", "prepare", "trace", "write", "total"}) EXPECT_TRUE(j["timings_ms"].contains(key)) << key;
+    EXPECT_TRUE(j["memory_plan_bytes"].contains("total"));
+    for (const char* key : {"ray_box_tests", "ray_triangle_tests", "rays_terminated_step1", "rays_terminated_per_round"})
+        EXPECT_TRUE(j["counters"].contains(key)) << key;
+    EXPECT_EQ(j["rays"], 32 * 24);
+    EXPECT_EQ(j["regions"], 3);
+    EXPECT_GT(j["hits"].get<int>(), 0);
+
+    const CommandResult same = run("compare " + exr + " " + exr + " --json");
+    ASSERT_EQ(same.code, 0) << same.output;
+    const nlohmann::json c = nlohmann::json::parse(same.output);
+    EXPECT_EQ(c["pixels"], 32 * 24);
+    EXPECT_EQ(c["differing_prim_id"], 0);
+    for (const char* key : {"differing_depth", "near_ties", "max_rel_depth_diff", "rms_rel_depth_diff"})
+        EXPECT_TRUE(c.contains(key)) << key;
+}
+
+TEST(Cli, CompareCountsDifferences) {
+    const std::string a = temp("cmp_a.exr"), b = temp("cmp_b.exr");
+    const std::string scene = dacrt::test::fixture("quad_u8_camera.gltf");
+    ASSERT_EQ(run("render " + scene + " --size 16x16 --aov " + a).code, 0);
+    ASSERT_EQ(run("render " + scene + " --size 16x16 --eye 0.5,0,4 --aov " + b).code, 0);
+    const CommandResult r = run("compare " + a + " " + b + " --json");
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json c = nlohmann::json::parse(r.output);
+    EXPECT_GT(c["differing_depth"].get<int>(), 0);
+}
+
+TEST(Cli, OrbitWritesOneImagePerCamera) {
+    const std::string base = temp("orbit.png");
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_strip_u16_matrix.gltf") + " --size 8x8 --orbit 3 -o " + base);
+    ASSERT_EQ(r.code, 0) << r.output;
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::filesystem::exists(temp("orbit_cam" + std::to_string(k) + ".png"))) << k;
+}
+
+TEST(Cli, PlanPrintsEveryBufferAndTracesNothing) {
+    const std::string png = temp("plan.png");
+    std::filesystem::remove(png);
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 16x8 --regions 2 --plan -o " + png);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("memory plan"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("triangle ids (with straddlers)"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("total"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(png));
+}
+
+struct BadCommand {
+    const char* name;
+    std::string args;
+    const char* expected;
+};
+
+void PrintTo(const BadCommand& c, std::ostream* os) { *os << c.name; }
+
+class CliRejects : public ::testing::TestWithParam<BadCommand> {};
+
+TEST_P(CliRejects, WithExitCode2AndAMessage) {
+    const CommandResult r = run(GetParam().args);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find(GetParam().expected), std::string::npos) << r.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadCommands, CliRejects,
+    ::testing::Values(
+        BadCommand{"UnknownBackend", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend warp", "warp"},
+        BadCommand{"BadSize", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 64by48", "--size"},
+        BadCommand{"ZeroSize", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 0x48", "--size"},
+        BadCommand{"UnknownOption", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --frobnicate", "frobnicate"},
+        BadCommand{"BadEye", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --eye 1,2", "--eye"},
+        BadCommand{"NanEye", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --eye nan,0,1", "--eye"},
+        BadCommand{"EyeOnTarget", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --eye 0,0,0 --target 0,0,0", "coincide"},
+        BadCommand{"BadFov", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --fov 180", "--fov"},
+        BadCommand{"ZeroRegions", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --regions 0", "--regions"},
+        BadCommand{"TruncatedFile", "render " + dacrt::test::fixture("bad_truncated.glb"), "bad_truncated.glb"},
+        BadCommand{"NanVertex", "render " + dacrt::test::fixture("bad_nan_position.gltf"), "non-finite"},
+        BadCommand{"NoSubcommand", "", "subcommand"},
+        BadCommand{"CompareMissingFile", "compare /nonexistent/a.exr /nonexistent/b.exr", "a.exr"},
+        BadCommand{"CompareNotAnAov", "compare " + dacrt::test::fixture("bad_not_gltf.gltf") + " x.exr", "bad_not_gltf.gltf"}),
+    [](const ::testing::TestParamInfo<BadCommand>& info) { return std::string(info.param.name); });
