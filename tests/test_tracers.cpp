@@ -168,3 +168,23 @@ TEST(ParallelScheme, CountersAndPlanAreConsistent) {
         return t;
     }());
 }
+
+TEST(BackendsAgree, NearlyCoincidentWallsAcrossASplitPlane) {
+    // Two walls one float step either side of x = 1, the root split of a scene spanning
+    // x in [0, 2], seen obliquely: the watertight test's rounding of t is larger than the
+    // gap, so the far wall sometimes wins by t. A cell must then still test the far wall,
+    // which is what the filter margin guarantees (docs/correctness.md).
+    const float below = std::nextafter(1.0f, 0.0f), above = std::nextafter(1.0f, 2.0f);
+    std::vector<Mesh> meshes = {grid({below, -4, -4}, {0, 8, 0}, {0, 0, 8}, 9, 7),
+                                grid({above, -4, -4}, {0, 8, 0}, {0, 0, 8}, 7, 9),
+                                grid({0, -4, -4}, {0, 0.1f, 0}, {0, 0, 0.1f}, 1, 1),   // pins the bounds at x = 0
+                                grid({2, 3.9f, 3.9f}, {0, 0.1f, 0}, {0, 0, 0.1f}, 1, 1)};  // and x = 2
+    const Scene s = sceneFromMeshes(meshes);
+    ASSERT_EQ(sceneBounds(s.triangles).center().x, 1.0f);
+    CameraOptions o;
+    o.eye = glm::dvec3(0.3, 0.1, 0.2);
+    o.target = glm::dvec3(1.0, 1.5, -2.0);
+    o.fovDegrees = 100.0;
+    const Frame frame(sceneFromMeshes(meshes), defaultCamera(s, 160, 120, o), 160, 120);
+    expectAllBackendsAgree(frame, {1, 2, 4}, DivisionAxis::X);
+}
