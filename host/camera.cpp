@@ -88,7 +88,7 @@ Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
                          " must be finite and the direction non-zero");
     glm::vec3 d = glm::vec3(glm::normalize(direction));
     for (int a = 0; a < 3; ++a)
-        if (std::abs(d[a]) < 0x1p-100f) d[a] = 0.0f;  // keeps 1/d finite; a sub-2^-100 slope is no slope
+        if (std::abs(d[a]) < 0x1p-64f) d[a] = 0.0f;  // keeps every slab bound finite (predicates.glsl)
 
     Ray r{};
     r.origin = origin;

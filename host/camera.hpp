@@ -33,7 +33,7 @@ constexpr double kDefaultFovDegrees = 45.0;
 std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const CameraOptions& options, double aspect);
 
 // Canonical float32 ray from an origin and a direction of any length: normalized in double,
-// rounded to float, components below 2^-100 flushed to zero (so 1/dir is finite), and the
+// rounded to float, components below 2^-64 flushed to zero (so 1/dir <= 2^64), and the
 // watertight-test permutation and shear precomputed. Throws InputError on a zero or
 // non-finite direction or origin.
 Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin = 0.0f);

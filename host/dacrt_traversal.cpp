@@ -54,7 +54,7 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
 std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
     counters_.rayBoxTests += end - begin;
     std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
-        return shared::rayMayCrossBox(rays_[id], cell.lo, cell.hi, hits_[id].t);
+        return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
     });
     return std::uint32_t(first - rayIds_);
 }

@@ -119,7 +119,7 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
         for (std::size_t i = begin; i < end; ++i) {
             const Ray& ray = rays[i];
             rayRegion[i] = kCulled;
-            if (!shared::rayMayCrossBox(ray, sceneLo, sceneHi, kNoHitT)) continue;
+            if (!shared::rayMayCrossCell(ray, sceneLo, sceneHi, kNoHitT)) continue;
             const float o = ray.origin[axis], dir = ray.dir[axis];
             const int step = dir < 0.0f ? -1 : 1;
             // Start one slab behind the origin's so that rounding in the guess never skips
@@ -129,7 +129,7 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
             if (dir < 0.0f && o > box.hi[axis]) k = int(n) - 1;
             k = std::clamp(k, 0, int(n) - 1);
             for (; k >= 0 && k < int(n); k += step) {
-                if (shared::rayMayCrossBox(ray, wideLo[std::size_t(k)], wideHi[std::size_t(k)], kNoHitT)) {
+                if (shared::rayMayCrossCell(ray, wideLo[std::size_t(k)], wideHi[std::size_t(k)], kNoHitT)) {
                     rayRegion[i] = std::uint32_t(k);
                     ++counts[std::size_t(k)];
                     low[std::size_t(k)] |= dir < 0.0f;

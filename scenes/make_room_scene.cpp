@@ -30,10 +30,10 @@ int main(int argc, char** argv) {
         colored(icosphere({-0.05f, 0.72f, 0.75f}, 0.22f, 3), "small sphere", {0.75f, 0.3f, 0.6f, 1}),
     };
     SceneCamera camera;
-    camera.eye = {0.0, 1.3, 3.9};
-    camera.forward = glm::normalize(glm::dvec3(0.0, -0.25, -1.0));
+    camera.eye = {0.0, 1.35, 1.95};
+    camera.forward = glm::normalize(glm::dvec3(0.0, -0.3, -1.0));
     camera.up = glm::normalize(glm::cross(glm::cross(camera.forward, glm::dvec3(0, 1, 0)), camera.forward));
-    camera.yfovRadians = glm::radians(55.0);
+    camera.yfovRadians = glm::radians(70.0);
     try {
         writeGltf(argv[1], meshes, camera);
     } catch (const InputError& e) {

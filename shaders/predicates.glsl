@@ -17,17 +17,16 @@ struct RayInterval {
     float tFar;
 };
 
-// The interval of one slab lo <= origin + t dir <= hi, widened outward. A zero direction
-// component never divides: the slab then either holds the origin (no constraint) or the
-// interval is empty. With |invDir| >= 1 and finite operands nothing here can become NaN.
+// The interval of one slab lo <= origin + t dir <= hi, each bound within three roundings of
+// the exact one. A zero direction component never divides: the slab then either holds the
+// origin (no constraint) or the interval is empty. makeRay keeps |invDir| <= 2^64 and
+// coordinates are at most 1e9, so every bound is finite: no inf, no NaN.
 RayInterval slabInterval(float origin, float dir, float invDir, float lo, float hi) {
     precise float t0 = (lo - origin) * invDir;
     precise float t1 = (hi - origin) * invDir;
-    precise float enter = min(t0, t1);
-    precise float leave = max(t0, t1);
     RayInterval r;
-    r.tNear = enter - abs(enter) * kSlabSlack;
-    r.tFar = leave + abs(leave) * kSlabSlack;
+    r.tNear = min(t0, t1);
+    r.tFar = max(t0, t1);
     if (dir == 0.0) {
         bool inside = origin >= lo && origin <= hi;
         r.tNear = inside ? -kNoHitT : kNoHitT;
@@ -36,9 +35,8 @@ RayInterval slabInterval(float origin, float dir, float invDir, float lo, float 
     return r;
 }
 
-// Parametric interval of a ray inside [lo, hi], containing the exact interval of the float
-// ray; empty when tNear > tFar.
-RayInterval rayBoxInterval(IN(Ray) ray, vec3 lo, vec3 hi) {
+// The rounded interval of a ray inside [lo, hi]; empty when tNear > tFar.
+RayInterval rayBoxIntervalRounded(IN(Ray) ray, vec3 lo, vec3 hi) {
     RayInterval x = slabInterval(ray.origin.x, ray.dir.x, ray.invDir.x, lo.x, hi.x);
     RayInterval y = slabInterval(ray.origin.y, ray.dir.y, ray.invDir.y, lo.y, hi.y);
     RayInterval z = slabInterval(ray.origin.z, ray.dir.z, ray.invDir.z, lo.z, hi.z);
@@ -48,14 +46,28 @@ RayInterval rayBoxInterval(IN(Ray) ray, vec3 lo, vec3 hi) {
     return r;
 }
 
-// May the ray meet the box at some t in [tmin, tmax]? (tmax inclusive: equal-t ties matter.)
-bool rayMayCrossBox(IN(Ray) ray, vec3 lo, vec3 hi, float tmax) {
-    RayInterval r = rayBoxInterval(ray, lo, hi);
+// The interval widened so that it contains the exact interval of the float ray. Widening
+// after the min/max equals widening each slab: t - |t| k is monotone for k < 1.
+RayInterval rayBoxInterval(IN(Ray) ray, vec3 lo, vec3 hi) {
+    RayInterval r = rayBoxIntervalRounded(ray, lo, hi);
+    precise float nearLow = r.tNear - abs(r.tNear) * kSlabSlack;
+    precise float farHigh = r.tFar + abs(r.tFar) * kSlabSlack;
+    r.tNear = nearLow;
+    r.tFar = farHigh;
+    return r;
+}
+
+// Filter: may the ray meet the cell at some t in [tmin, tmax]? (tmax inclusive: equal-t
+// ties matter.) Called only with cells already widened by the filter margin, which exceeds
+// the rounding of these bounds many times over, so the rounded interval of the widened cell
+// contains the exact interval of the cell itself (docs/correctness.md).
+bool rayMayCrossCell(IN(Ray) ray, vec3 lo, vec3 hi, float tmax) {
+    RayInterval r = rayBoxIntervalRounded(ray, lo, hi);
     return r.tNear <= r.tFar && r.tFar >= ray.tmin && r.tNear <= tmax;
 }
 
-// Acceptance rule: a hit at t may end the ray in this box only if t is no later than the
-// (upper bound of the) exit parameter.
+// Acceptance rule: a hit at t may end the ray in this (unwidened) box only if t is no later
+// than an upper bound of the exact exit parameter.
 bool hitEndsInBox(IN(Ray) ray, vec3 lo, vec3 hi, float t) {
     RayInterval r = rayBoxInterval(ray, lo, hi);
     return t <= r.tFar;
