@@ -51,7 +51,7 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
     return crossing;
 }
 
-std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
+[[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
     counters_.rayBoxTests += end - begin;
     std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
         return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
@@ -108,7 +108,7 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
     }
 }
 
-void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+[[gnu::flatten]] void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
                           std::uint32_t triEnd) {
     ++counters_.leaves;
     counters_.rayTriangleTests += std::uint64_t(rayEnd - terminated) * (triEnd - triBegin);

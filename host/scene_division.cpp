@@ -10,32 +10,14 @@ namespace {
 
 constexpr std::uint32_t kCulled = 0xFFFFFFFFu;
 
-// Slab boundaries along the axis: boundary[0] = lo, boundary[n] = hi exactly.
-std::vector<float> slabBoundaries(const Box& box, int axis, unsigned n) {
-    std::vector<float> b(n + 1);
-    const double lo = box.lo[axis], hi = box.hi[axis];
-    for (unsigned k = 0; k <= n; ++k) b[k] = float(lo + (hi - lo) * double(k) / double(n));
-    b[0] = box.lo[axis];
-    b[n] = box.hi[axis];
-    return b;
-}
-
-unsigned slabGuess(double x, const Box& box, int axis, unsigned n) {
-    const double extent = double(box.hi[axis]) - double(box.lo[axis]);
-    if (!(extent > 0.0)) return 0;
-    const double f = (x - double(box.lo[axis])) / extent * double(n);
-    return unsigned(std::clamp(f, 0.0, double(n - 1)));
-}
-
-}  // namespace
-
-int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
+// Where rays enter the scene box (a sample of them), as (entry point, entry face axis or -1
+// for rays that start inside).
+std::vector<std::pair<glm::vec3, int>> sampleEntries(const FrameGeometry& g, std::size_t maxSamples) {
     const std::vector<Ray>& rays = *g.rays;
     const Box& box = g.sceneBox;
-    const std::size_t rayStride = std::max<std::size_t>(1, rays.size() / 8192);
-    std::array<std::uint64_t, 3> entryFace{};
-    std::vector<std::pair<glm::vec3, int>> entries;  // entry point, entry face axis
-    for (std::size_t i = 0; i < rays.size(); i += rayStride) {
+    const std::size_t stride = std::max<std::size_t>(1, rays.size() / maxSamples);
+    std::vector<std::pair<glm::vec3, int>> entries;
+    for (std::size_t i = 0; i < rays.size(); i += stride) {
         const Ray& ray = rays[i];
         const shared::RayInterval iv = shared::rayBoxInterval(ray, box.lo, box.hi);
         if (!(iv.tNear <= iv.tFar && iv.tFar >= ray.tmin)) continue;
@@ -46,9 +28,37 @@ int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
             const float t = std::min((box.lo[a] - ray.origin[a]) * ray.invDir[a], (box.hi[a] - ray.origin[a]) * ray.invDir[a]);
             if (t > best) best = t, face = a;
         }
-        if (face >= 0) ++entryFace[std::size_t(face)];
         entries.emplace_back(ray.origin + std::max(iv.tNear, ray.tmin) * ray.dir, face);
     }
+    return entries;
+}
+
+// Slab boundaries along the axis: equal widths (the source's midpoint subdivision,
+// generalised to any n), boundary[0] = lo and boundary[n] = hi exactly.
+std::vector<float> slabBoundaries(const Box& box, int axis, unsigned n) {
+    std::vector<float> b(n + 1);
+    const double lo = box.lo[axis], hi = box.hi[axis];
+    for (unsigned k = 0; k <= n; ++k) b[k] = float(lo + (hi - lo) * double(k) / double(n));
+    b[0] = box.lo[axis];
+    b[n] = box.hi[axis];
+    return b;
+}
+
+// The slab holding x (clamped to the ends); callers correct by walking.
+int slabOf(float x, const std::vector<float>& boundary) {
+    const int n = int(boundary.size()) - 1;
+    const int k = int(std::upper_bound(boundary.begin() + 1, boundary.end() - 1, x) - (boundary.begin() + 1));
+    return std::clamp(k, 0, n - 1);
+}
+
+}  // namespace
+
+int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
+    const Box& box = g.sceneBox;
+    const auto entries = sampleEntries(g, 8192);
+    std::array<std::uint64_t, 3> entryFace{};
+    for (const auto& e : entries)
+        if (e.second >= 0) ++entryFace[std::size_t(e.second)];
     const glm::vec3 extent = box.extent();
     std::vector<int> candidates;
     const bool outside = entryFace[0] + entryFace[1] + entryFace[2] > 0;
@@ -65,11 +75,12 @@ int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
     int bestAxis = candidates.front();
     double bestCost = 1e300;
     for (int a : candidates) {
+        const std::vector<float> boundary = slabBoundaries(box, a, regionCount);
         std::vector<double> rayShare(regionCount, 0.0), triShare(regionCount, 0.0);
-        for (const auto& e : entries) rayShare[slabGuess(e.first[a], box, a, regionCount)] += 1.0;
+        for (const auto& e : entries) rayShare[std::size_t(slabOf(e.first[a], boundary))] += 1.0;
         std::size_t triSamples = 0;
         for (std::size_t i = 0; i < tb.size(); i += triStride, ++triSamples)
-            triShare[slabGuess(0.5 * (double(tb[i].lo[a]) + double(tb[i].hi[a])), box, a, regionCount)] += 1.0;
+            triShare[std::size_t(slabOf(0.5f * (tb[i].lo[a] + tb[i].hi[a]), boundary))] += 1.0;
         double cost = 0.0;
         for (unsigned k = 0; k < regionCount; ++k)
             cost = std::max(cost, rayShare[k] / double(entries.size()) + triShare[k] / double(triSamples));
@@ -124,7 +135,7 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
             const int step = dir < 0.0f ? -1 : 1;
             // Start one slab behind the origin's so that rounding in the guess never skips
             // the true first region; walk in the travel direction to the first one crossed.
-            int k = int(slabGuess(o, box, axis, n)) - step;
+            int k = slabOf(o, boundary) - step;
             if (dir > 0.0f && o < box.lo[axis]) k = 0;
             if (dir < 0.0f && o > box.hi[axis]) k = int(n) - 1;
             k = std::clamp(k, 0, int(n) - 1);
@@ -156,10 +167,10 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
         std::vector<std::uint32_t> counts(n, 0);
         for (std::size_t i = begin; i < end; ++i) {
             const float lo = tb[i].lo[axis], hi = tb[i].hi[axis];
-            int first = std::clamp(int(slabGuess(lo, box, axis, n)) - 1, 0, int(n) - 1);
+            int first = std::clamp(slabOf(lo, boundary) - 1, 0, int(n) - 1);
             while (first + 1 < int(n) && lo > wideHi[std::size_t(first)][axis]) ++first;
             while (first > 0 && lo <= wideHi[std::size_t(first - 1)][axis]) --first;
-            int last = std::clamp(int(slabGuess(hi, box, axis, n)) + 1, first, int(n) - 1);
+            int last = std::clamp(slabOf(hi, boundary) + 1, first, int(n) - 1);
             while (last > first && hi < wideLo[std::size_t(last)][axis]) --last;
             while (last + 1 < int(n) && hi >= wideLo[std::size_t(last + 1)][axis]) ++last;
             triFirst[i] = std::uint32_t(first);

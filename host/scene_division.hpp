@@ -38,8 +38,8 @@ struct TransferRound {
 // evenly is chosen.
 int chooseDivisionAxis(const FrameGeometry& geometry, unsigned regionCount);
 
-// Splits the scene box into regionCount equal slabs (the midpoint subdivision, generalised
-// to any count), bins each ray into the first region it meets and each triangle into every
+// Splits the scene box into regionCount equal slabs (the source's midpoint subdivision,
+// generalised to any count), bins each ray into the first region it meets and each triangle into every
 // region whose widened box it overlaps. Counts first, then appends the id arrays to plan
 // and fills them, so the memory is known before anything is traced. onPlan returning
 // false stops before the fill.
