@@ -69,7 +69,7 @@ int runCli(int argc, char** argv) {
         ->transform(choices<Backend>({{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}}))
         ->default_str("cpu");
     renderCmd->add_option("--size", size, "image size WIDTHxHEIGHT")->default_str("640x480");
-    renderCmd->add_option("--regions", render.trace.regions, "sub-scenes of the cpu backend (default: 2 per thread)")
+    renderCmd->add_option("--regions", render.trace.regions, "sub-scenes of the cpu backend (default: one per thread)")
         ->check(CLI::Range(1u, 4096u));
     renderCmd->add_option("--threads", render.trace.threads, "worker threads (default: every core)")
         ->check(CLI::Range(1u, 1024u));

@@ -78,7 +78,7 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
                           const PlanHook& onPlan) {
     TraceResult result;
     result.threads = pool.size();
-    const unsigned regions = options.regions ? options.regions : 2 * pool.size();
+    const unsigned regions = options.regions ? options.regions : pool.size();
     result.regions = regions;
     planFrameInputs(g, result.memory);
 

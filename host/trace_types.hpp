@@ -28,7 +28,7 @@ struct DacrtOptions {
 
 struct TraceOptions {
     Backend backend = Backend::Cpu;
-    unsigned regions = 0;   // cpu: sub-scenes; 0 means 2 per thread
+    unsigned regions = 0;   // cpu: sub-scenes; 0 means one per thread (docs/cpu-reference.md)
     unsigned threads = 0;   // 0 means every core
     DivisionAxis axis = DivisionAxis::Best;
     DacrtOptions dacrt;
