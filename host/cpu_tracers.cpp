@@ -118,7 +118,12 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
         return std::uint64_t(table[a].rayEnd - table[a].rayBegin) * (table[a].triEnd - table[a].triBegin) >
                std::uint64_t(table[b].rayEnd - table[b].rayBegin) * (table[b].triEnd - table[b].triBegin);
     });
-    pool.parallelFor(regions, [&](std::size_t i, unsigned worker) { traceItem(order[i], order[i], worker); });
+    result.step1RegionMs.assign(regions, 0.0);
+    pool.parallelFor(regions, [&](std::size_t i, unsigned worker) {
+        const auto itemStart = Clock::now();
+        traceItem(order[i], order[i], worker);
+        result.step1RegionMs[order[i]] = msSince(itemStart);
+    });
     result.counters.terminatedStep1 = terminatedTotal();
     result.phaseMs.emplace_back("step1", msSince(start));
 

@@ -54,6 +54,7 @@ nlohmann::ordered_json statsJson(const RenderOptions& o, const Scene& scene, con
     nlohmann::ordered_json phases;
     for (const auto& [name, ms] : r.phaseMs) phases[name] = ms;
     if (!phases.empty()) t["trace_phases"] = phases;
+    if (!r.step1RegionMs.empty()) t["step1_region"] = r.step1RegionMs;
     j["timings_ms"] = t;
     nlohmann::ordered_json mem;
     for (const auto& [name, bytes] : r.memory.buffers) mem[name] = bytes;

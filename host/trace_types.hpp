@@ -86,6 +86,7 @@ struct TraceResult {
     Counters counters;
     MemoryPlan memory;
     std::vector<std::pair<std::string, double>> phaseMs;  // backend-specific parts of the trace
+    std::vector<double> step1RegionMs;   // cpu: each region's Step 1 work item, for load balance
     unsigned threads = 1;
     unsigned regions = 1;
     int axis = -1;           // division axis used (cpu), -1 if none

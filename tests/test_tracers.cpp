@@ -188,3 +188,20 @@ TEST(BackendsAgree, NearlyCoincidentWallsAcrossASplitPlane) {
     const Frame frame(sceneFromMeshes(meshes), defaultCamera(s, 160, 120, o), 160, 120);
     expectAllBackendsAgree(frame, {1, 2, 4}, DivisionAxis::X);
 }
+
+TEST(BackendsAgree, StanfordModelsAt640x480) {
+    // The acceptance check: cpu with 1, 2, 4, 8 and 16 regions bit-identical to
+    // cpu-seq at full size (brute force at this size would take minutes; the small test
+    // above ties both to it).
+    for (const char* name : {"bunny.glb", "dragon.glb"}) {
+        DACRT_REQUIRE_SHARED_SCENE(path, name);
+        Scene s = loadGltf(path);
+        const Camera cam = defaultCamera(s, 640, 480);
+        const Frame frame(std::move(s), cam, 640, 480);
+        const TraceResult reference = frame.trace(Backend::CpuSeq);
+        ASSERT_GT(hitCount(reference.hits), 10000u);
+        for (unsigned regions : {1u, 2u, 4u, 8u, 16u})
+            EXPECT_TRUE(identicalHits(reference.hits, frame.trace(Backend::Cpu, regions, 2).hits))
+                << name << ", " << regions << " regions";
+    }
+}
