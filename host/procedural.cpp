@@ -134,49 +134,42 @@ void writeGltf(const std::string& path, const std::vector<Mesh>& meshes, const s
     model.asset.generator = "dacrt";
     tinygltf::Buffer buffer;
     tinygltf::Scene scene;
-    auto append = [&](const void* data, std::size_t bytes) {
-        const std::size_t offset = buffer.data.size();
-        buffer.data.resize(offset + bytes);
-        std::memcpy(buffer.data.data() + offset, data, bytes);
-        return offset;
+    // One buffer view and one accessor over `count` elements appended to the buffer.
+    auto addAccessor = [&](const void* data, std::size_t count, std::size_t elementBytes, int target,
+                           int componentType, int type) {
+        tinygltf::BufferView view;
+        view.buffer = 0;
+        view.byteOffset = buffer.data.size();
+        view.byteLength = count * elementBytes;
+        view.target = target;
+        buffer.data.resize(view.byteOffset + view.byteLength);
+        std::memcpy(buffer.data.data() + view.byteOffset, data, view.byteLength);
+        model.bufferViews.push_back(view);
+        tinygltf::Accessor accessor;
+        accessor.bufferView = int(model.bufferViews.size() - 1);
+        accessor.componentType = componentType;
+        accessor.type = type;
+        accessor.count = count;
+        model.accessors.push_back(accessor);
+        return int(model.accessors.size() - 1);
     };
     for (const Mesh& m : meshes) {
         glm::vec3 lo(kNoHitT), hi(-kNoHitT);
         for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-        tinygltf::BufferView pv;
-        pv.buffer = 0;
-        pv.byteOffset = append(m.positions.data(), m.positions.size() * sizeof(glm::vec3));
-        pv.byteLength = m.positions.size() * sizeof(glm::vec3);
-        pv.target = TINYGLTF_TARGET_ARRAY_BUFFER;
-        model.bufferViews.push_back(pv);
-        tinygltf::Accessor pa;
-        pa.bufferView = int(model.bufferViews.size() - 1);
-        pa.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-        pa.type = TINYGLTF_TYPE_VEC3;
-        pa.count = m.positions.size();
-        pa.minValues = {lo.x, lo.y, lo.z};
-        pa.maxValues = {hi.x, hi.y, hi.z};
-        model.accessors.push_back(pa);
-        tinygltf::BufferView iv;
-        iv.buffer = 0;
-        iv.byteOffset = append(m.indices.data(), m.indices.size() * 4);
-        iv.byteLength = m.indices.size() * 4;
-        iv.target = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
-        model.bufferViews.push_back(iv);
-        tinygltf::Accessor ia;
-        ia.bufferView = int(model.bufferViews.size() - 1);
-        ia.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
-        ia.type = TINYGLTF_TYPE_SCALAR;
-        ia.count = m.indices.size();
-        model.accessors.push_back(ia);
+        const int positions = addAccessor(m.positions.data(), m.positions.size(), sizeof(glm::vec3),
+                                          TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3);
+        model.accessors[std::size_t(positions)].minValues = {lo.x, lo.y, lo.z};
+        model.accessors[std::size_t(positions)].maxValues = {hi.x, hi.y, hi.z};
+        const int indices = addAccessor(m.indices.data(), m.indices.size(), 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR);
 
         tinygltf::Material mat;
         mat.name = m.name;
         mat.pbrMetallicRoughness.baseColorFactor = {m.color.r, m.color.g, m.color.b, m.color.a};
         model.materials.push_back(mat);
         tinygltf::Primitive prim;
-        prim.attributes["POSITION"] = int(model.accessors.size() - 2);
-        prim.indices = int(model.accessors.size() - 1);
+        prim.attributes["POSITION"] = positions;
+        prim.indices = indices;
         prim.material = int(model.materials.size() - 1);
         prim.mode = TINYGLTF_MODE_TRIANGLES;
         tinygltf::Mesh mesh;
