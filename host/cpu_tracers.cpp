@@ -154,8 +154,9 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
         case Backend::Brute: return traceBrute(g, pool, onPlan);
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);
         case Backend::Cpu: return traceParallel(g, options, pool, onPlan);
+        case Backend::Gpu: break;
     }
-    return {};
+    throw std::logic_error("traceCpu called for the gpu backend");
 }
 
 }  // namespace dacrt

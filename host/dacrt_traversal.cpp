@@ -38,10 +38,14 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
     const std::uint32_t crossing = filterRays(widen(box, margin_), terminated, rayEnd);
     node(box, terminated, crossing, triBegin, triEnd, 0);
     if (retire.axis < 0) return crossing;
-    const std::uint32_t from = retire.direction == 0 ? terminated : crossing;
-    for (std::uint32_t k = from; k < rayEnd; ++k) {
-        const float d = rays_[rayIds_[k]].dir[retire.axis];
-        const bool done = retire.direction == 0 ? d == 0.0f : (retire.direction > 0 ? d > 0.0f : d < 0.0f);
+    const Box cell = widen(box, margin_);
+    for (std::uint32_t k = terminated; k < rayEnd; ++k) {
+        const std::uint32_t id = rayIds_[k];
+        const float d = rays_[id].dir[retire.axis];
+        const bool done = retire.direction == 0
+                              ? d == 0.0f
+                              : (retire.direction > 0 ? d > 0.0f : d < 0.0f) &&
+                                    !shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
         if (done) {
             std::swap(rayIds_[k], rayIds_[terminated]);
             ++terminated;

@@ -7,10 +7,11 @@
 
 namespace dacrt {
 
-// Which live rays a work item of the parallel scheme may finish without a hit, because no
-// later work item can change their result: along `axis`, rays that do not move (direction
-// 0, after Step 1), or rays moving `direction` that cannot reach the region traced now
-// (regions are consecutive slabs, so they cannot reach any further one either).
+// Which live rays a work item of the parallel scheme may finish, because no later work item
+// can change their result: along `axis`, rays that do not move (direction 0, after Step 1),
+// or rays moving `direction` that cannot reach the region traced now before their best hit
+// (regions are consecutive slabs, so they cannot reach any further one either). The gpu
+// kernel applies the same rule (kKeepStill, kKeepStuckHigh, kKeepStuckLow).
 struct RetireRule {
     int axis = -1;      // -1: retire nothing
     int direction = 0;  // 0: rays with dir[axis] == 0; +1 / -1: non-crossing rays moving that way

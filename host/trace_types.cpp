@@ -11,6 +11,7 @@ std::string toString(Backend b) {
         case Backend::Brute: return "brute";
         case Backend::CpuSeq: return "cpu-seq";
         case Backend::Cpu: return "cpu";
+        case Backend::Gpu: return "gpu";
     }
     return "?";
 }

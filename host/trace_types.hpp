@@ -1,6 +1,7 @@
 #pragma once
 // What every tracer takes and returns.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,7 +12,7 @@
 
 namespace dacrt {
 
-enum class Backend { Brute, CpuSeq, Cpu };
+enum class Backend { Brute, CpuSeq, Cpu, Gpu };
 enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
 enum class DivisionAxis { Best, X, Y, Z };
 
@@ -81,6 +82,19 @@ struct MemoryPlan {
     std::string describe() const;
 };
 
+// What only the gpu backend reports.
+struct GpuReport {
+    std::string device;
+    std::string driver;
+    std::uint32_t workgroupSize = 0;
+    std::uint32_t subgroupSize = 0;
+    std::vector<std::pair<std::string, double>> dispatchMs;  // GPU timestamps, per dispatch
+    std::uint32_t dispatches = 0;
+    std::uint32_t workItemsRun = 0;
+    std::uint32_t workItemsEmpty = 0;
+    std::uint32_t validationErrors = 0;
+};
+
 struct TraceResult {
     std::vector<Hit> hits;   // one per ray
     Counters counters;
@@ -89,7 +103,8 @@ struct TraceResult {
     std::vector<double> step1RegionMs;   // cpu: each region's Step 1 work item, for load balance
     unsigned threads = 1;
     unsigned regions = 1;
-    int axis = -1;           // division axis used (cpu), -1 if none
+    int axis = -1;           // division axis used (cpu, gpu), -1 if none
+    std::optional<GpuReport> gpu;
 };
 
 }  // namespace dacrt

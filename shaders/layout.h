@@ -54,7 +54,66 @@ struct Region {
     uint pad0;
 };
 
+// One work item of a dispatch: the live rays of one region against the triangles of another
+// (the same region in Step 1). retire: 0 = rays that do not move along the division axis,
+// 1 / 2 = rays moving toward higher / lower regions that cannot reach triRegion.
+struct WorkItem {
+    uint rayRegion;
+    uint triRegion;
+    uint retire;
+    uint pad0;
+};
+
+// Push constants of the DACRT kernel.
+struct DacrtPush {
+    vec3 rayOrigin;        // every ray starts here: the near child is the one on its side
+    float margin;          // filter widening (filterMargin)
+    uint firstWorkItem;    // this dispatch's work items are [firstWorkItem, + group count)
+    uint axis;             // division axis
+    uint rayScratchHalf;   // ray id count: the second half of the ray scratch starts here
+    uint triScratchHalf;   // triangle id count: likewise for the triangle scratch
+};
+
+// Counters the kernel adds to with atomics (32-bit: a frame stays far below 2^32 tests).
+struct GpuCounters {
+    uint workItemsRun;
+    uint workItemsEmpty;
+    uint rayBoxTests;
+    uint rayTriangleTests;
+    uint leaves;
+    uint raysRetired;
+    uint pad0;
+    uint pad1;
+};
+
+// Storage buffer bindings of the DACRT kernel (set 0).
+#define DACRT_BINDING_RAYS 0
+#define DACRT_BINDING_TRIANGLES 1
+#define DACRT_BINDING_TRIANGLE_BOUNDS 2
+#define DACRT_BINDING_HITS 3
+#define DACRT_BINDING_RAY_IDS 4
+#define DACRT_BINDING_TRI_IDS 5
+#define DACRT_BINDING_RAY_SCRATCH 6
+#define DACRT_BINDING_TRI_SCRATCH 7
+#define DACRT_BINDING_REGIONS 8
+#define DACRT_BINDING_WORK_ITEMS 9
+#define DACRT_BINDING_COUNTERS 10
+#define DACRT_BINDING_COUNT 11
+
+// Specialization constants of the DACRT kernel (constant_id).
+#define DACRT_SPEC_WORKGROUP_SIZE 0
+#define DACRT_SPEC_RAY_LIMIT 1
+#define DACRT_SPEC_TRI_LIMIT 2
+#define DACRT_SPEC_MAX_DEPTH 3
+
 #ifdef __cplusplus
+static_assert(sizeof(WorkItem) == 16);
+static_assert(offsetof(WorkItem, triRegion) == 4 && offsetof(WorkItem, retire) == 8);
+static_assert(sizeof(DacrtPush) == 32);
+static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
+static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
+static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
+static_assert(sizeof(GpuCounters) == 32 && offsetof(GpuCounters, raysRetired) == 20);
 static_assert(sizeof(Ray) == 64);
 static_assert(offsetof(Ray, origin) == 0 && offsetof(Ray, tmin) == 12);
 static_assert(offsetof(Ray, dir) == 16 && offsetof(Ray, axes) == 28);

@@ -121,10 +121,13 @@ TriangleHit intersectWatertight(IN(Ray) ray, vec3 p0, vec3 p1, vec3 p2) {
     precise float cz = ray.shear.z * c[kz];
     precise float tScaled = eu * az + ev * bz + ew * cz;
     if (det > 0.0 ? tScaled <= 0.0 : tScaled >= 0.0) return h;
+    precise float t = tScaled / det;
+    precise float u = ev / det;
+    precise float v = ew / det;
     h.hit = true;
-    h.t = tScaled / det;
-    h.u = ev / det;
-    h.v = ew / det;
+    h.t = t;
+    h.u = u;
+    h.v = v;
     return h;
 }
 

@@ -1,0 +1,43 @@
+// Buffers, specialization constants and shared memory of the DACRT kernels.
+#ifndef DACRT_BINDINGS_GLSL
+#define DACRT_BINDINGS_GLSL
+
+layout(local_size_x_id = DACRT_SPEC_WORKGROUP_SIZE) in;
+layout(constant_id = DACRT_SPEC_RAY_LIMIT) const uint kRayLimit = 16;
+layout(constant_id = DACRT_SPEC_TRI_LIMIT) const uint kTriLimit = 16;
+layout(constant_id = DACRT_SPEC_MAX_DEPTH) const uint kMaxDepth = 48;
+
+layout(std430, binding = DACRT_BINDING_RAYS) readonly buffer RayBuffer { Ray rays[]; };
+layout(std430, binding = DACRT_BINDING_TRIANGLES) readonly buffer TriangleBuffer { Triangle triangles[]; };
+layout(std430, binding = DACRT_BINDING_TRIANGLE_BOUNDS) readonly buffer BoundsBuffer { Bounds triangleBounds[]; };
+layout(std430, binding = DACRT_BINDING_HITS) coherent buffer HitBuffer { Hit hits[]; };
+layout(std430, binding = DACRT_BINDING_RAY_IDS) coherent buffer RayIdBuffer { uint rayIds[]; };
+layout(std430, binding = DACRT_BINDING_TRI_IDS) coherent buffer TriIdBuffer { uint triIds[]; };
+layout(std430, binding = DACRT_BINDING_RAY_SCRATCH) coherent buffer RayScratchBuffer { uint rayScratch[]; };
+layout(std430, binding = DACRT_BINDING_TRI_SCRATCH) coherent buffer TriScratchBuffer { uint triScratch[]; };
+layout(std430, binding = DACRT_BINDING_REGIONS) coherent buffer RegionBuffer { Region regions[]; };
+layout(std430, binding = DACRT_BINDING_WORK_ITEMS) readonly buffer WorkItemBuffer { WorkItem workItems[]; };
+layout(std430, binding = DACRT_BINDING_COUNTERS) coherent buffer CounterBuffer { GpuCounters counters; };
+
+// Frame parameters, set from push constants at the start of main.
+float gMargin;
+vec3 gRayOrigin;
+uint gAxis;
+uint gRayScratchHalf;
+uint gTriScratchHalf;
+
+const uint kWorkgroupSize = gl_WorkGroupSize.x;
+
+shared uint sSubgroupTotals[kWorkgroupSize];
+shared Triangle sTriangles[kWorkgroupSize];   // leaf staging
+shared uint sPrims[kWorkgroupSize];
+shared float sBestT[kWorkgroupSize];          // leaf reduction across the lanes of one ray
+shared uint sBestPrim[kWorkgroupSize];
+shared float sBestU[kWorkgroupSize];
+shared float sBestV[kWorkgroupSize];
+// The DACRT stack: far children waiting, with their parent's ranges.
+shared vec3 sStackLo[kMaxDepth + 1];
+shared vec3 sStackHi[kMaxDepth + 1];
+shared uvec4 sStackRanges[kMaxDepth + 1];     // rayEnd, triBegin, triEnd, depth
+
+#endif

@@ -1,0 +1,184 @@
+// Workgroup-wide building blocks of the DACRT kernel: synchronisation, prefix sums, stable
+// partitions of the id arrays, and leaves. Every function here is called in uniform control
+// flow by the whole workgroup and returns the same value to every invocation.
+#ifndef DACRT_WORKGROUP_GLSL
+#define DACRT_WORKGROUP_GLSL
+
+// Makes buffer and shared writes of every invocation visible to the whole workgroup. A
+// workgroup of one subgroup needs only a subgroup barrier.
+void workgroupSync() {
+    if (gl_NumSubgroups == 1) {
+        subgroupMemoryBarrierBuffer();
+        subgroupMemoryBarrierShared();
+        subgroupBarrier();
+    } else {
+        memoryBarrierBuffer();
+        memoryBarrierShared();
+        barrier();
+    }
+}
+
+// Exclusive prefix sum of value over the workgroup, in invocation order; total gets the sum.
+// Subgroup scans, then the subgroup totals through shared memory; no subgroup size assumed.
+uint workgroupExclusiveSum(uint value, out uint total) {
+    uint inclusive = subgroupInclusiveAdd(value);
+    if (gl_NumSubgroups == 1) {
+        total = subgroupAdd(value);
+        return inclusive - value;
+    }
+    if (subgroupElect()) sSubgroupTotals[gl_SubgroupID] = subgroupAdd(value);
+    memoryBarrierShared();
+    barrier();
+    uint before = 0;
+    total = 0;
+    for (uint s = 0; s < gl_NumSubgroups; ++s) {
+        uint t = sSubgroupTotals[s];
+        before += s < gl_SubgroupID ? t : 0u;
+        total += t;
+    }
+    barrier();  // sSubgroupTotals is reused by the next call
+    return before + inclusive - value;
+}
+
+// What a ray partition keeps in front.
+const uint kKeepCrossing = 0u;     // rays that may cross the (widened) cell
+const uint kKeepFinished = 1u;     // rays whose best hit ends them in the (unwidened) box
+const uint kKeepStill = 2u;        // rays with no motion along gAxis
+const uint kKeepStuckHigh = 3u;    // rays moving up gAxis that cannot reach the cell
+const uint kKeepStuckLow = 4u;     // rays moving down gAxis that cannot reach the cell
+
+bool keepRay(uint id, uint rule, vec3 lo, vec3 hi) {
+    Ray ray = rays[id];
+    float bestT = hits[id].t;
+    if (rule == kKeepCrossing) return rayMayCrossCell(ray, lo, hi, bestT);
+    if (rule == kKeepFinished) return hits[id].prim != kMissPrim && hitEndsInBox(ray, lo, hi, bestT);
+    float d = ray.dir[gAxis];
+    if (rule == kKeepStill) return d == 0.0;
+    bool moving = rule == kKeepStuckHigh ? d > 0.0 : d < 0.0;
+    return moving && !rayMayCrossCell(ray, lo, hi, bestT);
+}
+
+// Stable partition of rayIds[begin, end): the rays `rule` keeps first, in their order, then
+// the others in theirs. Out of place through the two halves of rayScratch, then copied back.
+// Returns the end of the kept rays.
+uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
+    uint kept = 0, dropped = 0;
+    uint lane = gl_LocalInvocationIndex;
+    for (uint base = begin; base < end; base += kWorkgroupSize) {
+        uint index = base + lane;
+        bool inRange = index < end;
+        uint id = inRange ? rayIds[index] : 0u;
+        bool keep = inRange && keepRay(id, rule, lo, hi);
+        uint total;
+        uint position = workgroupExclusiveSum(keep ? 1u : 0u, total);
+        if (inRange) {
+            if (keep) rayScratch[begin + kept + position] = id;
+            else rayScratch[gRayScratchHalf + begin + dropped + (lane - position)] = id;
+        }
+        kept += total;
+        dropped += min(kWorkgroupSize, end - base) - total;
+    }
+    workgroupSync();
+    for (uint index = begin + lane; index < end; index += kWorkgroupSize) {
+        uint offset = index - begin;
+        rayIds[index] = offset < kept ? rayScratch[index] : rayScratch[gRayScratchHalf + begin + offset - kept];
+    }
+    workgroupSync();
+    if (rule == kKeepCrossing && lane == 0) atomicAdd(counters.rayBoxTests, end - begin);
+    return begin + kept;
+}
+
+// Stable partition of triIds[begin, end): triangles whose bounds overlap [lo, hi] first.
+uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
+    uint kept = 0, dropped = 0;
+    uint lane = gl_LocalInvocationIndex;
+    for (uint base = begin; base < end; base += kWorkgroupSize) {
+        uint index = base + lane;
+        bool inRange = index < end;
+        uint id = inRange ? triIds[index] : 0u;
+        bool keep = inRange && boundsOverlap(triangleBounds[id].lo, triangleBounds[id].hi, lo, hi);
+        uint total;
+        uint position = workgroupExclusiveSum(keep ? 1u : 0u, total);
+        if (inRange) {
+            if (keep) triScratch[begin + kept + position] = id;
+            else triScratch[gTriScratchHalf + begin + dropped + (lane - position)] = id;
+        }
+        kept += total;
+        dropped += min(kWorkgroupSize, end - base) - total;
+    }
+    workgroupSync();
+    for (uint index = begin + lane; index < end; index += kWorkgroupSize) {
+        uint offset = index - begin;
+        triIds[index] = offset < kept ? triScratch[index] : triScratch[gTriScratchHalf + begin + offset - kept];
+    }
+    workgroupSync();
+    return begin + kept;
+}
+
+// Every live ray of the leaf against every triangle of it; then the rays whose best hit
+// ends them inside the leaf box move to the front and `terminated` advances past them.
+// Every invocation stays busy: with fewer rays than invocations each ray gets `lanes`
+// invocations that split the triangles and reduce their bests; triangles are staged in
+// shared memory one workgroup-sized tile at a time.
+uint leaf(vec3 lo, vec3 hi, uint terminated, uint rayEnd, uint triBegin, uint triEnd) {
+    uint lane = gl_LocalInvocationIndex;
+    uint rayCount = rayEnd - terminated;
+    uint lanes = max(1u, kWorkgroupSize / rayCount);
+    uint raysPerPass = kWorkgroupSize / lanes;
+    uint myRay = lane / lanes;
+    uint mySlot = lane % lanes;
+    if (lane == 0) {
+        atomicAdd(counters.leaves, 1u);
+        atomicAdd(counters.rayTriangleTests, rayCount * (triEnd - triBegin));
+    }
+    for (uint first = terminated; first < rayEnd; first += raysPerPass) {
+        uint index = first + myRay;
+        bool rayActive = myRay < raysPerPass && index < rayEnd;
+        uint id = rayActive ? rayIds[index] : 0u;
+        Ray ray = rays[id];
+        Hit best = hits[id];
+        for (uint tile = triBegin; tile < triEnd; tile += kWorkgroupSize) {
+            workgroupSync();
+            if (tile + lane < triEnd) {
+                uint prim = triIds[tile + lane];
+                sPrims[lane] = prim;
+                sTriangles[lane] = triangles[prim];
+            }
+            workgroupSync();
+            uint tileSize = min(kWorkgroupSize, triEnd - tile);
+            if (rayActive) {
+                for (uint k = mySlot; k < tileSize; k += lanes) {
+                    TriangleHit h = intersectWatertight(ray, sTriangles[k].v0, sTriangles[k].v1, sTriangles[k].v2);
+                    if (h.hit && h.t > ray.tmin && hitPrecedes(h.t, sPrims[k], best.t, best.prim)) {
+                        best.t = h.t;
+                        best.prim = sPrims[k];
+                        best.u = h.u;
+                        best.v = h.v;
+                    }
+                }
+            }
+        }
+        if (lanes > 1) {
+            sBestT[lane] = best.t;
+            sBestPrim[lane] = best.prim;
+            sBestU[lane] = best.u;
+            sBestV[lane] = best.v;
+            workgroupSync();
+            if (rayActive && mySlot == 0) {
+                for (uint k = lane + 1; k < lane + lanes; ++k) {
+                    if (hitPrecedes(sBestT[k], sBestPrim[k], best.t, best.prim)) {
+                        best.t = sBestT[k];
+                        best.prim = sBestPrim[k];
+                        best.u = sBestU[k];
+                        best.v = sBestV[k];
+                    }
+                }
+            }
+        }
+        if (rayActive && mySlot == 0) hits[id] = best;
+        workgroupSync();
+    }
+    return partitionRays(terminated, rayEnd, kKeepFinished, lo, hi);
+}
+
+#endif
