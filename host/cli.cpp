@@ -10,6 +10,8 @@
 #include "compare.hpp"
 #include "errors.hpp"
 #include "render.hpp"
+#include "vk_check.hpp"
+#include "vk_context.hpp"
 
 namespace dacrt {
 namespace {
@@ -65,8 +67,9 @@ int runCli(int argc, char** argv) {
     renderCmd->add_option("-o,--output", render.outputPath, "shaded image (PNG or any OpenImageIO format)");
     renderCmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id and hit mask");
     renderCmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
-    renderCmd->add_option("--backend", render.trace.backend, "brute | cpu-seq | cpu")
-        ->transform(choices<Backend>({{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}}))
+    renderCmd->add_option("--backend", render.trace.backend, "brute | cpu-seq | cpu | gpu")
+        ->transform(choices<Backend>(
+            {{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}, {"gpu", Backend::Gpu}}))
         ->default_str("cpu");
     renderCmd->add_option("--size", size, "image size WIDTHxHEIGHT")->default_str("640x480");
     renderCmd->add_option("--regions", render.trace.regions, "sub-scenes of the cpu backend (default: one per thread)")
@@ -93,6 +96,12 @@ int runCli(int argc, char** argv) {
     renderCmd->add_option("--orbit", render.camera.orbit, "K cameras on a circle about the vertical axis")
         ->check(CLI::Range(1, 100000));
     renderCmd->add_flag("--plan", render.planOnly, "print the memory plan and stop before tracing");
+    renderCmd->add_option("--device", render.device, "gpu: Vulkan device index or part of its name (see 'dacrt devices')");
+    renderCmd->add_flag("--validate", render.validate, "gpu: run under the Vulkan validation layers; errors fail the run");
+    renderCmd->add_option("--workgroup-size", render.workgroupSize, "gpu: invocations per workgroup (default: per device)")
+        ->check(CLI::Range(1u, 1024u));
+
+    CLI::App* devicesCmd = app.add_subcommand("devices", "list the Vulkan devices and the limits that matter here");
 
     std::string compareA, compareB;
     bool compareJson = false;
@@ -121,6 +130,12 @@ int runCli(int argc, char** argv) {
             if (renderCmd->count("--fov")) render.camera.fovDegrees = fov;
             return runRender(render);
         }
+        if (*devicesCmd) {
+            const std::vector<vk::DeviceInfo> devices = vk::listDevices();
+            if (devices.empty()) std::cout << "no Vulkan devices\n";
+            for (const vk::DeviceInfo& d : devices) std::cout << d.describe();
+            return 0;
+        }
         if (*compareCmd) {
             const Aov a = readAov(compareA);
             const Aov b = readAov(compareB);
@@ -131,6 +146,9 @@ int runCli(int argc, char** argv) {
     } catch (const InputError& e) {
         std::cerr << "dacrt: error: " << e.what() << "\n";
         return 2;
+    } catch (const vk::VulkanError& e) {
+        std::cerr << "dacrt: Vulkan error: " << e.what() << "\n";
+        return 1;
     } catch (const std::exception& e) {
         std::cerr << "dacrt: internal error: " << e.what() << "\n";
         return 1;

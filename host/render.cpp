@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <thread>
 
 #include <unistd.h>
@@ -13,6 +14,7 @@
 #include "cpu_tracers.hpp"
 #include "errors.hpp"
 #include "gltf_loader.hpp"
+#include "gpu_tracer.hpp"
 #include "image_io.hpp"
 
 namespace dacrt {
@@ -76,6 +78,20 @@ nlohmann::ordered_json statsJson(const RenderOptions& o, const Scene& scene, con
     std::uint64_t hits = 0;
     for (const Hit& h : r.hits) hits += h.prim != kMissPrim;
     j["hits"] = hits;
+    if (r.gpu) {
+        const GpuReport& g = *r.gpu;
+        nlohmann::ordered_json dispatches = nlohmann::ordered_json::array();
+        for (const auto& [name, ms] : g.dispatchMs) dispatches.push_back({{"name", name}, {"gpu_ms", ms}});
+        j["gpu"] = {{"device", g.device},
+                    {"driver", g.driver},
+                    {"workgroup_size", g.workgroupSize},
+                    {"subgroup_size", g.subgroupSize},
+                    {"dispatches", g.dispatches},
+                    {"dispatch_times", dispatches},
+                    {"work_items_run", g.workItemsRun},
+                    {"work_items_empty", g.workItemsEmpty},
+                    {"validation_errors", g.validationErrors}};
+    }
     return j;
 }
 
@@ -107,6 +123,8 @@ int runRender(const RenderOptions& o) {
         o.trace.backend == Backend::CpuSeq ? 1u
                                            : (o.trace.threads ? o.trace.threads : std::max(1u, std::thread::hardware_concurrency()));
     ThreadPool pool(threads);
+    std::unique_ptr<vk::Context> gpu;
+    if (o.trace.backend == Backend::Gpu) gpu = std::make_unique<vk::Context>(vk::ContextOptions{o.device, o.validate});
     const std::uint64_t memoryLimit = physicalMemoryBytes();
 
     for (int k = 0; k < int(cameras.size()); ++k) {
@@ -137,7 +155,8 @@ int runRender(const RenderOptions& o) {
             return true;
         };
         const auto traceStart = Clock::now();
-        const TraceResult result = traceCpu(g, o.trace, pool, onPlan);
+        const TraceResult result = gpu ? traceGpu(g, o.trace, GpuTuning{o.workgroupSize}, *gpu, pool, onPlan)
+                                       : traceCpu(g, o.trace, pool, onPlan);
         if (o.planOnly) continue;
         const double traceMs = msSince(traceStart);
 
@@ -161,6 +180,11 @@ int runRender(const RenderOptions& o) {
         std::cerr << "dacrt: " << toString(o.trace.backend) << " camera " << k << ": " << scene.triangleCount()
                   << " triangles, " << rays.size() << " rays, trace " << traceMs << " ms"
                   << (out.empty() ? "" : ", wrote " + out) << "\n";
+    }
+    if (gpu && o.validate && gpu->validationErrors() > 0) {
+        for (const std::string& m : gpu->validationMessages()) std::cerr << "dacrt: validation " << m << "\n";
+        std::cerr << "dacrt: error: " << gpu->validationErrors() << " Vulkan validation errors\n";
+        return 3;
     }
     return 0;
 }

@@ -1,5 +1,6 @@
 #pragma once
 // The render command: scene in, one traced frame per camera, images and stats out.
+#include <cstdint>
 #include <string>
 
 #include "camera.hpp"
@@ -15,6 +16,9 @@ struct RenderOptions {
     int width = 640;
     int height = 480;
     bool planOnly = false;    // print the memory plan and stop before tracing
+    std::string device;       // gpu: index or part of the name
+    bool validate = false;    // gpu: Vulkan validation layers; errors make the run fail
+    std::uint32_t workgroupSize = 0;  // gpu: 0 = the device's default
     TraceOptions trace;
     CameraOptions camera;
 };

@@ -28,6 +28,10 @@ namespace {  // GLSL has no `inline`: internal linkage keeps one copy per transl
 
 namespace dacrt {
 using shared::Bounds;
+using shared::DacrtPush;
+using shared::GpuCounters;
+using shared::WorkgroupTestPush;
+using shared::WorkItem;
 using shared::Hit;
 using shared::Ray;
 using shared::Region;

@@ -254,12 +254,14 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
         vkGetPhysicalDeviceProperties(physical_, &p);
         timestampPeriodNs_ = p.limits.timestampPeriod;
     } catch (...) {
-        this->~Context();
+        destroy();
         throw;
     }
 }
 
-Context::~Context() {
+Context::~Context() { destroy(); }
+
+void Context::destroy() {
     if (commandPool_) vkDestroyCommandPool(device_, commandPool_, nullptr);
     if (device_) vkDestroyDevice(device_, nullptr);
     if (messenger_) {

@@ -56,6 +56,7 @@ public:
     const std::vector<std::string>& validationMessages() const;
 
 private:
+    void destroy();  // releases the Vulkan handles; safe on a partly built context
     struct Messages;
     VkInstance instance_ = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;

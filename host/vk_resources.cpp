@@ -42,8 +42,14 @@ Buffer::Buffer(const Context& context, std::uint64_t bytes, std::string name)
                              resultName(r) + ")");
         VK_CHECK(r);
     }
-    VK_CHECK(vkBindBufferMemory(device_, buffer_, memory_, 0));
-    VK_CHECK(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
+    try {
+        VK_CHECK(vkBindBufferMemory(device_, buffer_, memory_, 0));
+        VK_CHECK(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
+    } catch (...) {
+        vkFreeMemory(device_, memory_, nullptr);
+        vkDestroyBuffer(device_, buffer_, nullptr);
+        throw;
+    }
 }
 
 Buffer::Buffer(Buffer&& o) noexcept
@@ -121,12 +127,14 @@ ComputePipeline::ComputePipeline(const Context& context, std::span<const std::ui
         allocInfo.pSetLayouts = &setLayout_;
         VK_CHECK(vkAllocateDescriptorSets(device_, &allocInfo, &set_));
     } catch (...) {
-        this->~ComputePipeline();
+        destroy();
         throw;
     }
 }
 
-ComputePipeline::~ComputePipeline() {
+ComputePipeline::~ComputePipeline() { destroy(); }
+
+void ComputePipeline::destroy() {
     if (pool_) vkDestroyDescriptorPool(device_, pool_, nullptr);
     if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
     if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);

@@ -55,6 +55,7 @@ public:
     std::uint32_t pushConstantBytes() const { return pushBytes_; }
 
 private:
+    void destroy();  // releases the Vulkan handles; safe on a partly built pipeline
     VkDevice device_ = VK_NULL_HANDLE;
     VkShaderModule module_ = VK_NULL_HANDLE;
     VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;

@@ -97,8 +97,10 @@ void main() {
     uint rule = item.retire == 0u ? kKeepStill : (item.retire == 1u ? kKeepStuckHigh : kKeepStuckLow);
     uint before = terminated;
     terminated = partitionRays(terminated, rayEnd, rule, rootLo - margin, rootHi + margin);
+    bool cutShort = loopLimiterFired(push.loopProbe);
     if (lane == 0) {
         atomicAdd(counters.raysRetired, terminated - before);
         regions[item.rayRegion].terminated = terminated;
+        if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
     }
 }

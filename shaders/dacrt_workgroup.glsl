@@ -22,11 +22,12 @@ void workgroupSync() {
 // Subgroup scans, then the subgroup totals through shared memory; no subgroup size assumed.
 uint workgroupExclusiveSum(uint value, out uint total) {
     uint inclusive = subgroupInclusiveAdd(value);
+    uint subgroupTotal = subgroupAdd(value);  // in uniform control flow: every lane takes part
     if (gl_NumSubgroups == 1) {
-        total = subgroupAdd(value);
+        total = subgroupTotal;
         return inclusive - value;
     }
-    if (subgroupElect()) sSubgroupTotals[gl_SubgroupID] = subgroupAdd(value);
+    if (subgroupElect()) sSubgroupTotals[gl_SubgroupID] = subgroupTotal;
     memoryBarrierShared();
     barrier();
     uint before = 0;
@@ -38,6 +39,15 @@ uint workgroupExclusiveSum(uint value, out uint total) {
     }
     barrier();  // sSubgroupTotals is reused by the next call
     return before + inclusive - value;
+}
+
+// llvmpipe (Mesa's CPU driver, under lavapipe) ends every loop of a shader invocation once
+// all its loops together have iterated 65535 times, silently. A loop run after the real work
+// tells: if it cannot complete `iterations` (uniform, > 0) passes, the limiter has fired.
+bool loopLimiterFired(uint iterations) {
+    uint done = 0;
+    for (uint i = 0; i < iterations; ++i) ++done;
+    return done != iterations;
 }
 
 // What a ray partition keeps in front.

@@ -72,6 +72,10 @@ struct DacrtPush {
     uint axis;             // division axis
     uint rayScratchHalf;   // ray id count: the second half of the ray scratch starts here
     uint triScratchHalf;   // triangle id count: likewise for the triangle scratch
+    uint loopProbe;        // 2; a loop of this many iterations at the end detects a loop limiter
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 // Counters the kernel adds to with atomics (32-bit: a frame stays far below 2^32 tests).
@@ -82,8 +86,25 @@ struct GpuCounters {
     uint rayTriangleTests;
     uint leaves;
     uint raysRetired;
+    uint testResult;   // workgroup_test.comp's answer
+    uint loopLimitHits;  // work items cut short by a driver's loop limiter (llvmpipe: 65535)
+};
+
+// Push constants of workgroup_test.comp, which runs one building block of the DACRT kernel
+// in a single workgroup so that tests can compare it with the CPU.
+struct WorkgroupTestPush {
+    vec3 lo;
+    uint mode;             // 0: partitionRays, 1: partitionTriangles, 2: leaf
+    vec3 hi;
+    uint rule;             // partitionRays: kKeep* rule
+    uint begin;            // ray range (modes 0 and 2) or triangle range (mode 1)
+    uint end;
+    uint triBegin;         // leaf triangles
+    uint triEnd;
+    uint rayScratchHalf;
+    uint triScratchHalf;
+    uint axis;
     uint pad0;
-    uint pad1;
 };
 
 // Storage buffer bindings of the DACRT kernel (set 0).
@@ -109,11 +130,15 @@ struct GpuCounters {
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 16);
 static_assert(offsetof(WorkItem, triRegion) == 4 && offsetof(WorkItem, retire) == 8);
-static_assert(sizeof(DacrtPush) == 32);
+static_assert(sizeof(DacrtPush) == 48 && offsetof(DacrtPush, loopProbe) == 32);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
 static_assert(sizeof(GpuCounters) == 32 && offsetof(GpuCounters, raysRetired) == 20);
+static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, loopLimitHits) == 28);
+static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);
+static_assert(offsetof(WorkgroupTestPush, rule) == 28 && offsetof(WorkgroupTestPush, begin) == 32);
+static_assert(offsetof(WorkgroupTestPush, triEnd) == 44 && offsetof(WorkgroupTestPush, axis) == 56);
 static_assert(sizeof(Ray) == 64);
 static_assert(offsetof(Ray, origin) == 0 && offsetof(Ray, tmin) == 12);
 static_assert(offsetof(Ray, dir) == 16 && offsetof(Ray, axes) == 28);

@@ -124,3 +124,39 @@ INSTANTIATE_TEST_SUITE_P(
         BadCommand{"CompareMissingFile", "compare /nonexistent/a.exr /nonexistent/b.exr", "a.exr"},
         BadCommand{"CompareNotAnAov", "compare " + dacrt::test::fixture("bad_not_gltf.gltf") + " x.exr", "bad_not_gltf.gltf"}),
     [](const ::testing::TestParamInfo<BadCommand>& info) { return std::string(info.param.name); });
+
+TEST(Cli, DevicesListsTheLimitsThatMatter) {
+    const CommandResult r = run("devices");
+    if (r.code == 2 && r.output.find("no Vulkan") != std::string::npos) GTEST_SKIP() << r.output;
+    ASSERT_EQ(r.code, 0) << r.output;
+    for (const char* key : {"0: ", "driver:", "Vulkan:", "memory heaps:", "max storage buffer range:", "max allocation size:",
+                            "compute shared memory:", "workgroup:", "subgroup size:"})
+        EXPECT_NE(r.output.find(key), std::string::npos) << key << "\n" << r.output;
+}
+
+TEST(Cli, GpuRenderUnderValidationMatchesCpuSeq) {
+    if (run("devices").code != 0) GTEST_SKIP() << "no Vulkan device";
+    const std::string scene = dacrt::test::fixture("quad_u8_camera.gltf");
+    const std::string gpu = temp("gpu.exr"), cpu = temp("gpu_ref.exr"), stats = temp("gpu.json");
+    const CommandResult r = run("render " + scene + " --size 24x16 --backend gpu --regions 2 --validate --aov " + gpu +
+                                " --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_EQ(run("render " + scene + " --size 24x16 --backend cpu-seq --aov " + cpu).code, 0);
+    const nlohmann::json c = nlohmann::json::parse(run("compare " + cpu + " " + gpu + " --json").output);
+    EXPECT_EQ(c["differing_prim_id"], 0);
+    EXPECT_EQ(c["differing_depth"], 0);
+    std::ifstream f(stats);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    ASSERT_TRUE(j.contains("gpu"));
+    for (const char* key : {"device", "driver", "dispatches", "dispatch_times", "work_items_run", "work_items_empty"})
+        EXPECT_TRUE(j["gpu"].contains(key)) << key;
+    EXPECT_EQ(j["gpu"]["validation_errors"], 0);
+}
+
+TEST(Cli, UnknownDeviceIsAnErrorListingTheChoices) {
+    if (run("devices").code != 0) GTEST_SKIP() << "no Vulkan device";
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") +
+                                " --size 8x8 --backend gpu --device warp-drive-9000");
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("matches no Vulkan device; the choices are"), std::string::npos) << r.output;
+}

@@ -1,0 +1,22 @@
+#pragma once
+// The gpu backend: the parallel scheme's division on the host, Step 1 and the transfer
+// rounds as compute dispatches (one workgroup per work item) recorded in one command buffer.
+#include "cpu_tracers.hpp"
+#include "trace_types.hpp"
+#include "vk_context.hpp"
+
+namespace dacrt {
+
+struct GpuTuning {
+    std::uint32_t workgroupSize = 0;  // 0: the device's default (gpuDefaults)
+};
+
+// Per-device defaults, chosen by measurement (docs/gpu.md): a CPU device such as lavapipe
+// runs a workgroup on one thread, SIMD across invocations, so one subgroup per workgroup
+// (no shared-memory barrier at all); a GPU wants wider workgroups.
+std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device);
+
+TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
+                     vk::Context& context, ThreadPool& pool, const PlanHook& onPlan = {});
+
+}  // namespace dacrt

@@ -1,0 +1,212 @@
+// The kernel's building blocks (workgroup_test.comp runs them in one workgroup) against the
+// CPU on random inputs: stable partitions must match std::stable_partition exactly, and a
+// leaf must produce exactly the hits of the CPU leaf.
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "camera.hpp"
+#include "dacrt_traversal.hpp"
+#include "gpu_support.hpp"
+#include "gpu_tracer.hpp"
+#include "vk_resources.hpp"
+
+#include "workgroup_test.spv.h"
+
+using namespace dacrt;
+using namespace dacrt::test;
+
+namespace {
+
+constexpr std::uint32_t kKeepCrossing = 0, kKeepFinished = 1, kKeepStill = 2, kKeepStuckHigh = 3;
+
+struct BlockInputs {
+    std::vector<Ray> rays;
+    std::vector<Triangle> triangles;
+    std::vector<Bounds> bounds;
+    std::vector<Hit> hits;
+    std::vector<std::uint32_t> rayIds, triIds;
+};
+
+BlockInputs randomInputs(std::mt19937& rng, std::size_t rays, std::size_t tris) {
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), small(-0.3f, 0.3f);
+    BlockInputs in;
+    for (std::size_t i = 0; i < rays; ++i) {
+        glm::dvec3 d(u(rng), u(rng), -1.0);
+        if (i % 9 == 0) d.x = 0.0;  // some rays with no motion along x
+        in.rays.push_back(makeRay({u(rng) * 0.1f, u(rng) * 0.1f, 3.0f}, d));
+        Hit h = missHit();
+        if (i % 3 == 0) h = Hit{3.0f + u(rng), std::uint32_t(i % 7), 0.1f, 0.2f};
+        in.hits.push_back(h);
+    }
+    for (std::size_t i = 0; i < tris; ++i) {
+        const glm::vec3 c(u(rng), u(rng), u(rng) * 0.5f);
+        Triangle t{};
+        t.v0 = c + glm::vec3(small(rng), small(rng), small(rng));
+        t.v1 = c + glm::vec3(small(rng), small(rng), small(rng));
+        t.v2 = c + glm::vec3(small(rng), small(rng), small(rng));
+        if (i % 11 == 0) t.v2 = t.v1;  // degenerate
+        in.triangles.push_back(t);
+        in.bounds.push_back(triangleBounds(t));
+    }
+    in.rayIds.resize(rays);
+    in.triIds.resize(tris);
+    std::iota(in.rayIds.begin(), in.rayIds.end(), 0u);
+    std::iota(in.triIds.begin(), in.triIds.end(), 0u);
+    std::shuffle(in.rayIds.begin(), in.rayIds.end(), rng);
+    std::shuffle(in.triIds.begin(), in.triIds.end(), rng);
+    return in;
+}
+
+// Runs workgroup_test.comp once over `in` and reads everything back into `in`.
+std::uint32_t runBlock(vk::Context& context, BlockInputs& in, const WorkgroupTestPush& push, std::uint32_t workgroupSize) {
+    std::vector<vk::Buffer> buffers;
+    const std::uint64_t sizes[DACRT_BINDING_COUNT] = {
+        in.rays.size() * sizeof(Ray), in.triangles.size() * sizeof(Triangle), in.bounds.size() * sizeof(Bounds),
+        in.hits.size() * sizeof(Hit), in.rayIds.size() * 4, in.triIds.size() * 4, in.rayIds.size() * 8,
+        in.triIds.size() * 8, sizeof(Region), sizeof(WorkItem), sizeof(GpuCounters)};
+    for (std::uint32_t b = 0; b < DACRT_BINDING_COUNT; ++b) buffers.emplace_back(context, sizes[b], "test " + std::to_string(b));
+    buffers[DACRT_BINDING_RAYS].upload(in.rays.data(), sizes[DACRT_BINDING_RAYS]);
+    buffers[DACRT_BINDING_TRIANGLES].upload(in.triangles.data(), sizes[DACRT_BINDING_TRIANGLES]);
+    buffers[DACRT_BINDING_TRIANGLE_BOUNDS].upload(in.bounds.data(), sizes[DACRT_BINDING_TRIANGLE_BOUNDS]);
+    buffers[DACRT_BINDING_HITS].upload(in.hits.data(), sizes[DACRT_BINDING_HITS]);
+    buffers[DACRT_BINDING_RAY_IDS].upload(in.rayIds.data(), sizes[DACRT_BINDING_RAY_IDS]);
+    buffers[DACRT_BINDING_TRI_IDS].upload(in.triIds.data(), sizes[DACRT_BINDING_TRI_IDS]);
+    const GpuCounters zero{};
+    buffers[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
+    vk::ComputePipeline pipeline(context, std::span<const std::uint32_t>(workgroup_test_spv, sizeof(workgroup_test_spv) / 4),
+                                 DACRT_BINDING_COUNT, sizeof(WorkgroupTestPush), {workgroupSize, 16, 16, 48}, "workgroup_test");
+    std::vector<const vk::Buffer*> bound;
+    for (const vk::Buffer& b : buffers) bound.push_back(&b);
+    pipeline.bind(bound);
+    vk::DispatchRecorder recorder(context, 1);
+    recorder.dispatch("block", pipeline, 1, &push);
+    recorder.submitAndWait();
+    buffers[DACRT_BINDING_HITS].download(in.hits.data(), sizes[DACRT_BINDING_HITS]);
+    buffers[DACRT_BINDING_RAY_IDS].download(in.rayIds.data(), sizes[DACRT_BINDING_RAY_IDS]);
+    buffers[DACRT_BINDING_TRI_IDS].download(in.triIds.data(), sizes[DACRT_BINDING_TRI_IDS]);
+    GpuCounters counters{};
+    buffers[DACRT_BINDING_COUNTERS].download(&counters, sizeof(counters));
+    EXPECT_EQ(counters.loopLimitHits, 0u) << "the driver's loop limiter cut the block short";
+    return counters.testResult;
+}
+
+class GpuBlocks : public ::testing::TestWithParam<std::uint32_t> {};  // workgroup size
+
+}  // namespace
+
+TEST_P(GpuBlocks, RayPartitionsAreStableAndExact) {
+    DACRT_REQUIRE_GPU(context);
+    const std::uint32_t wg = GetParam();
+    std::mt19937 rng(wg);
+    for (const auto& [count, begin, end] : {std::tuple{1000u, 0u, 1000u}, std::tuple{777u, 13u, 700u},
+                                           std::tuple{5u, 1u, 4u}, std::tuple{300u, 150u, 150u}}) {
+        for (std::uint32_t rule : {kKeepCrossing, kKeepFinished, kKeepStill, kKeepStuckHigh}) {
+            BlockInputs in = randomInputs(rng, count, 4);
+            const glm::vec3 lo(-0.2f, -0.5f, -0.1f), hi(0.4f, 0.3f, 0.2f);
+            std::vector<std::uint32_t> expected = in.rayIds;
+            auto keep = [&](std::uint32_t id) {
+                const Ray& r = in.rays[id];
+                const float bestT = in.hits[id].t;
+                switch (rule) {
+                    case kKeepCrossing: return shared::rayMayCrossCell(r, lo, hi, bestT);
+                    case kKeepFinished: return in.hits[id].prim != kMissPrim && shared::hitEndsInBox(r, lo, hi, bestT);
+                    case kKeepStill: return r.dir.x == 0.0f;
+                    default: return r.dir.x > 0.0f && !shared::rayMayCrossCell(r, lo, hi, bestT);
+                }
+            };
+            const auto pivot = std::stable_partition(expected.begin() + begin, expected.begin() + end, keep);
+            WorkgroupTestPush push{};
+            push.mode = 0;
+            push.rule = rule;
+            push.lo = lo;
+            push.hi = hi;
+            push.begin = begin;
+            push.end = end;
+            push.rayScratchHalf = count;
+            push.triScratchHalf = std::uint32_t(in.triIds.size());
+            push.axis = 0;
+            const std::uint32_t result = runBlock(*context, in, push, wg);
+            EXPECT_EQ(result, std::uint32_t(pivot - expected.begin())) << "rule " << rule << " range " << begin << ".." << end;
+            EXPECT_EQ(in.rayIds, expected) << "rule " << rule << " range " << begin << ".." << end;
+        }
+    }
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
+TEST_P(GpuBlocks, TrianglePartitionsAreStableAndExact) {
+    DACRT_REQUIRE_GPU(context);
+    const std::uint32_t wg = GetParam();
+    std::mt19937 rng(100 + wg);
+    for (const auto& [count, begin, end] : {std::tuple{2000u, 0u, 2000u}, std::tuple{501u, 7u, 499u}, std::tuple{3u, 0u, 3u}}) {
+        BlockInputs in = randomInputs(rng, 4, count);
+        const glm::vec3 lo(-0.3f, -0.2f, -1.0f), hi(0.1f, 0.6f, 1.0f);
+        std::vector<std::uint32_t> expected = in.triIds;
+        const auto pivot = std::stable_partition(expected.begin() + begin, expected.begin() + end, [&](std::uint32_t id) {
+            return shared::boundsOverlap(in.bounds[id].lo, in.bounds[id].hi, lo, hi);
+        });
+        WorkgroupTestPush push{};
+        push.mode = 1;
+        push.lo = lo;
+        push.hi = hi;
+        push.begin = begin;
+        push.end = end;
+        push.rayScratchHalf = 4;
+        push.triScratchHalf = count;
+        const std::uint32_t result = runBlock(*context, in, push, wg);
+        EXPECT_EQ(result, std::uint32_t(pivot - expected.begin()));
+        EXPECT_EQ(in.triIds, expected);
+    }
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
+TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
+    DACRT_REQUIRE_GPU(context);
+    const std::uint32_t wg = GetParam();
+    std::mt19937 rng(200 + wg);
+    // Few rays and many triangles (lanes share a ray), many rays and few triangles, and both.
+    for (const auto& [rays, tris] : {std::pair{3u, 500u}, std::pair{200u, 5u}, std::pair{50u, 70u}, std::pair{1u, 1u}}) {
+        BlockInputs in = randomInputs(rng, rays + 4, tris + 3);
+        const glm::vec3 lo(-1.5f, -1.5f, -1.0f), hi(1.5f, 1.5f, 0.1f);
+        const std::uint32_t begin = 2, end = 2 + rays, triBegin = 1, triEnd = 1 + tris;
+        std::vector<Hit> expectedHits = in.hits;
+        std::vector<std::uint32_t> expectedIds = in.rayIds;
+        for (std::uint32_t k = begin; k < end; ++k) {
+            const std::uint32_t id = in.rayIds[k];
+            for (std::uint32_t j = triBegin; j < triEnd; ++j)
+                testTriangle(in.rays[id], in.triangles[in.triIds[j]], in.triIds[j], expectedHits[id]);
+        }
+        const auto pivot = std::stable_partition(expectedIds.begin() + begin, expectedIds.begin() + end, [&](std::uint32_t id) {
+            return expectedHits[id].prim != kMissPrim && shared::hitEndsInBox(in.rays[id], lo, hi, expectedHits[id].t);
+        });
+        WorkgroupTestPush push{};
+        push.mode = 2;
+        push.lo = lo;
+        push.hi = hi;
+        push.begin = begin;
+        push.end = end;
+        push.triBegin = triBegin;
+        push.triEnd = triEnd;
+        push.rayScratchHalf = std::uint32_t(in.rayIds.size());
+        push.triScratchHalf = std::uint32_t(in.triIds.size());
+        const std::uint32_t result = runBlock(*context, in, push, wg);
+        std::size_t differing = 0;
+        for (std::size_t i = 0; i < in.hits.size(); ++i)
+            differing += in.hits[i].prim != expectedHits[i].prim || in.hits[i].t != expectedHits[i].t ||
+                         in.hits[i].u != expectedHits[i].u || in.hits[i].v != expectedHits[i].v;
+        EXPECT_EQ(differing, 0u) << rays << " rays x " << tris << " triangles";
+        EXPECT_EQ(result, std::uint32_t(pivot - expectedIds.begin()));
+        EXPECT_EQ(in.rayIds, expectedIds);
+        std::size_t hitsFound = 0;
+        for (std::uint32_t k = begin; k < end; ++k) hitsFound += expectedHits[in.rayIds[k]].prim != kMissPrim;
+        if (rays >= 50) EXPECT_GT(hitsFound, 0u) << "the random leaf should hit something";
+    }
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
+INSTANTIATE_TEST_SUITE_P(WorkgroupSizes, GpuBlocks, ::testing::Values(8u, 32u, 64u),
+                         [](const ::testing::TestParamInfo<std::uint32_t>& info) {
+                             return "wg" + std::to_string(info.param);
+                         });

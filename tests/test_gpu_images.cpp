@@ -1,0 +1,108 @@
+// Whole images: the gpu backend against cpu-seq, bit for bit, under the validation layers.
+#include <gtest/gtest.h>
+
+#include "errors.hpp"
+#include "gltf_loader.hpp"
+#include "gpu_support.hpp"
+#include "gpu_tracer.hpp"
+#include "procedural.hpp"
+#include "test_support.hpp"
+
+using namespace dacrt;
+using namespace dacrt::test;
+
+namespace {
+
+Scene shapes() {
+    return sceneFromMeshes({icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 3), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 40, 16),
+                            box({-0.3f, -1.0f, -1.2f}, {0.4f, 0.6f, -0.6f}), grid({-2, -1, 2}, {4, 0, 0}, {0, 0, -4}, 12, 12)},
+                           "shapes");
+}
+
+// gpu == cpu-seq for every region count; on llvmpipe a work item too large for its loop
+// limiter must be reported as such (never a silent wrong image). Returns how many ran.
+int expectGpuMatchesCpu(vk::Context& context, const Frame& frame, std::initializer_list<unsigned> regionCounts,
+                        std::uint32_t workgroupSize = 0) {
+    const TraceResult reference = frame.trace(Backend::CpuSeq);
+    int ran = 0;
+    for (unsigned regions : regionCounts) {
+        TraceOptions o;
+        o.backend = Backend::Gpu;
+        o.regions = regions;
+        ThreadPool pool(2);
+        try {
+            const TraceResult r = traceGpu(frame.geometry, o, GpuTuning{workgroupSize}, context, pool);
+            EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << regions << " regions";
+            EXPECT_EQ(r.gpu->dispatches, r.gpu->dispatchMs.size());
+            EXPECT_EQ(r.gpu->workItemsRun + r.gpu->workItemsEmpty, regions + r.counters.transferWorkItems);
+            ++ran;
+        } catch (const InputError& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find("loop limit"), std::string::npos) << what;
+            EXPECT_NE(context.info().driver.find("llvmpipe"), std::string::npos)
+                << "only llvmpipe has a loop limiter: " << what;
+        }
+    }
+    EXPECT_TRUE(noValidationErrors(context));
+    return ran;
+}
+
+}  // namespace
+
+TEST(GpuImages, ProceduralShapes) {
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 96, 72), 96, 72);
+    EXPECT_GE(expectGpuMatchesCpu(*context, frame, {1, 2, 3, 4, 8, 16}), 4);
+    EXPECT_GE(expectGpuMatchesCpu(*context, frame, {1, 4}, 32), 1);
+}
+
+TEST(GpuImages, CameraInsideTheSceneAndOnSplitPlanes) {
+    DACRT_REQUIRE_GPU(context);
+    std::vector<Mesh> meshes = {box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2),
+                                torus({-1.0f, -0.5f, 1.5f}, 0.6f, 0.2f, 24, 12)};
+    CameraOptions o;
+    o.eye = glm::dvec3(0.0, 0.0, 0.2);  // inside, and on the x = 0 and y = 0 planes
+    o.target = glm::dvec3(0.3, 0.0, -1.0);
+    o.fovDegrees = 100.0;
+    const Scene s = sceneFromMeshes(meshes);
+    const Frame frame(sceneFromMeshes(meshes), defaultCamera(s, 64, 48, o), 64, 48);
+    EXPECT_GE(expectGpuMatchesCpu(*context, frame, {1, 2, 4, 8}), 3);
+}
+
+TEST(GpuImages, NearlyCoincidentWallsAcrossASplitPlane) {
+    DACRT_REQUIRE_GPU(context);
+    const float below = std::nextafter(1.0f, 0.0f), above = std::nextafter(1.0f, 2.0f);
+    std::vector<Mesh> meshes = {grid({below, -4, -4}, {0, 8, 0}, {0, 0, 8}, 9, 7),
+                                grid({above, -4, -4}, {0, 8, 0}, {0, 0, 8}, 7, 9),
+                                grid({0, -4, -4}, {0, 0.1f, 0}, {0, 0, 0.1f}, 1, 1),
+                                grid({2, 3.9f, 3.9f}, {0, 0.1f, 0}, {0, 0, 0.1f}, 1, 1)};
+    CameraOptions o;
+    o.eye = glm::dvec3(0.3, 0.1, 0.2);
+    o.target = glm::dvec3(1.0, 1.5, -2.0);
+    o.fovDegrees = 100.0;
+    const Scene s = sceneFromMeshes(meshes);
+    const Frame frame(sceneFromMeshes(meshes), defaultCamera(s, 96, 72, o), 96, 72);
+    EXPECT_GE(expectGpuMatchesCpu(*context, frame, {1, 2, 4, 8, 16}), 2);
+}
+
+TEST(GpuImages, StanfordBunny) {
+    DACRT_REQUIRE_GPU(context);
+    DACRT_REQUIRE_SHARED_SCENE(path, "bunny.glb");
+    Scene s = loadGltf(path);
+    const Camera cam = defaultCamera(s, 160, 120);
+    const Frame frame(std::move(s), cam, 160, 120);
+    EXPECT_GE(expectGpuMatchesCpu(*context, frame, {1, 2, 4, 8, 16, 64}), 2);
+}
+
+TEST(GpuImages, UnknownDeviceListsTheChoices) {
+    DACRT_REQUIRE_GPU(context);
+    try {
+        vk::Context other(vk::ContextOptions{"no such device 42", false});
+        FAIL() << "accepted an unknown device";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("matches no Vulkan device"), std::string::npos) << what;
+        EXPECT_NE(what.find(context->info().name), std::string::npos) << what;
+    }
+}
