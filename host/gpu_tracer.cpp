@@ -1,6 +1,8 @@
 #include "gpu_tracer.hpp"
 
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 
 #include "dacrt_traversal.hpp"
 #include "errors.hpp"
@@ -20,10 +22,24 @@ double msSince(Clock::time_point start) {
 
 }  // namespace
 
-std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device) {
+std::uint32_t loopBudgetOf(const vk::DeviceInfo& device) {
+    // llvmpipe stops all loops of an invocation after 65535 iterations in all; keep a margin
+    // for the few loops the kernel's cost estimates round down.
+    return device.driver.find("llvmpipe") != std::string::npos ? 40000u : 0u;
+}
+
+std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t largestRegionRays,
+                                   std::uint32_t largestRegionTriangles) {
     const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
-    const std::uint32_t wanted = device.type == "cpu" ? subgroup : std::max(64u, subgroup);
-    return std::min(wanted, device.maxComputeWorkGroupInvocations);
+    const std::uint32_t widest = std::min({device.maxComputeWorkGroupInvocations, device.maxComputeWorkGroupSizeX, subgroup * subgroup});
+    std::uint32_t size = device.type == "cpu" ? subgroup : std::max(64u, subgroup);
+    if (const std::uint32_t budget = loopBudgetOf(device)) {
+        // The largest single step (a split of the biggest region, then its final partition)
+        // must fit one slice: about 2 (rays + triangles) / size + 2 rays / size iterations.
+        const double needed = (4.0 * largestRegionRays + 2.0 * largestRegionTriangles) / (0.8 * budget);
+        while (size < widest && double(size) < needed) size *= 2;
+    }
+    return std::min(size, widest);
 }
 
 TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const GpuTuning& tuning,
@@ -33,17 +49,13 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
         throw InputError("--split " + toString(options.dacrt.split) + " is not available on the gpu backend (spatial-median only)");
     if (!device.subgroupArithmetic)
         throw InputError("device '" + device.name + "' lacks subgroup arithmetic in compute shaders, which the gpu backend needs");
-    const std::uint32_t workgroupSize = tuning.workgroupSize ? tuning.workgroupSize : defaultWorkgroupSize(device);
-    if (workgroupSize > device.maxComputeWorkGroupInvocations || workgroupSize > device.maxComputeWorkGroupSizeX)
-        throw InputError("--workgroup-size " + std::to_string(workgroupSize) + " exceeds the device limit of " +
-                         std::to_string(std::min(device.maxComputeWorkGroupInvocations, device.maxComputeWorkGroupSizeX)));
+    const std::uint32_t loopBudget = loopBudgetOf(device);
 
     TraceResult result;
     result.gpu = GpuReport{};
     GpuReport& report = *result.gpu;
     report.device = device.name;
     report.driver = device.driver;
-    report.workgroupSize = workgroupSize;
     report.subgroupSize = device.subgroupSize;
     const unsigned regions = options.regions ? options.regions : 64;
     result.regions = regions;
@@ -58,12 +70,30 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     const std::vector<TransferRound> schedule = transferSchedule(division);
     result.counters.raysCulled = division.culledRays;
 
+    // Work items in schedule order; raySeq and triSeq count the earlier users of each range.
     std::vector<WorkItem> items;
-    for (std::uint32_t k = 0; k < regions; ++k) items.push_back(WorkItem{k, k, 0, 0});
+    std::vector<std::uint32_t> rayUses(regions, 0), triUses(regions, 0);
+    auto addItem = [&](std::uint32_t rayRegion, std::uint32_t triRegion, std::uint32_t retire) {
+        items.push_back(WorkItem{rayRegion, triRegion, retire, rayUses[rayRegion]++, triUses[triRegion]++, 0, 0, 0});
+    };
+    for (std::uint32_t k = 0; k < regions; ++k) addItem(k, k, 0);
     for (const TransferRound& round : schedule)
-        for (const TransferPair& p : round.pairs)
-            items.push_back(WorkItem{p.rayRegion, p.triRegion, p.triRegion > p.rayRegion ? 1u : 2u, 0});
+        for (const TransferPair& p : round.pairs) addItem(p.rayRegion, p.triRegion, p.triRegion > p.rayRegion ? 1u : 2u);
+    std::uint32_t largestRays = 0, largestTris = 0;
+    for (const Region& r : division.regions) {
+        largestRays = std::max(largestRays, r.rayEnd - r.rayBegin);
+        largestTris = std::max(largestTris, r.triEnd - r.triBegin);
+    }
     result.phaseMs.emplace_back("divide", msSince(start));
+
+    const std::uint32_t workgroupSize =
+        tuning.workgroupSize ? tuning.workgroupSize : defaultWorkgroupSize(device, largestRays, largestTris);
+    const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
+    const std::uint32_t widest = std::min({device.maxComputeWorkGroupInvocations, device.maxComputeWorkGroupSizeX, subgroup * subgroup});
+    if (workgroupSize % subgroup != 0 || workgroupSize > widest)
+        throw InputError("--workgroup-size " + std::to_string(workgroupSize) + " must be a multiple of the subgroup size " +
+                         std::to_string(subgroup) + " and at most " + std::to_string(widest) + " on this device");
+    report.workgroupSize = workgroupSize;
 
     // Every device buffer, sized from the counts before anything is allocated on the device.
     const std::uint64_t rayCount = g.rays->size(), triCount = g.triangles->size();
@@ -84,6 +114,8 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
         {"device: regions", std::uint64_t(regions) * sizeof(Region)},
         {"device: work items", items.size() * sizeof(WorkItem)},
         {"device: counters", sizeof(GpuCounters)},
+        {"device: traversal states", items.size() * sizeof(TraversalState)},
+        {"device: traversal stacks", items.size() * (options.dacrt.maxDepth + 1) * sizeof(StackEntry)},
     };
     for (const auto& [name, bytes] : hostPlan.buffers) result.memory.add("host: " + name, bytes);
     for (const Planned& b : deviceBuffers) {
@@ -112,42 +144,70 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     buffers[DACRT_BINDING_WORK_ITEMS].upload(items.data(), items.size() * sizeof(WorkItem));
     const GpuCounters zero{};
     buffers[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
+    const std::vector<TraversalState> fresh(items.size(), TraversalState{});
+    buffers[DACRT_BINDING_STATES].upload(fresh.data(), fresh.size() * sizeof(TraversalState));
     result.phaseMs.emplace_back("upload", msSince(start));
 
     start = Clock::now();
-    vk::ComputePipeline pipeline(context, std::span<const std::uint32_t>(dacrt_spv, sizeof(dacrt_spv) / 4),
-                                 DACRT_BINDING_COUNT, sizeof(DacrtPush),
-                                 {workgroupSize, options.dacrt.rayLimit, options.dacrt.triLimit, options.dacrt.maxDepth},
-                                 "dacrt");
+    vk::ComputePipeline pipeline(
+        context, std::span<const std::uint32_t>(dacrt_spv, sizeof(dacrt_spv) / 4), DACRT_BINDING_COUNT, sizeof(DacrtPush),
+        {workgroupSize, options.dacrt.rayLimit, options.dacrt.triLimit, options.dacrt.maxDepth, loopBudget}, "dacrt");
     std::vector<const vk::Buffer*> bound;
     for (const vk::Buffer& b : buffers) bound.push_back(&b);
     pipeline.bind(bound);
     result.phaseMs.emplace_back("pipeline", msSince(start));
 
+    // One command buffer: Step 1, then each transfer round, one dispatch each. A work item
+    // that runs out of loop budget (llvmpipe) is finished by continuation dispatches over all
+    // work items, submitted until every one is done.
     start = Clock::now();
-    vk::DispatchRecorder recorder(context, std::uint32_t(1 + schedule.size()));
     DacrtPush push{};
     push.rayOrigin = g.rayOrigin;
     push.margin = g.margin;
     push.axis = std::uint32_t(axis);
     push.rayScratchHalf = std::uint32_t(rayIdCount);
     push.triScratchHalf = std::uint32_t(triIdCount);
-    push.firstWorkItem = 0;
     push.loopProbe = 2;
-    recorder.dispatch("step1", pipeline, regions, &push);
-    push.firstWorkItem = regions;
-    for (const TransferRound& round : schedule) {
-        recorder.dispatch(round.name, pipeline, std::uint32_t(round.pairs.size()), &push);
-        push.firstWorkItem += std::uint32_t(round.pairs.size());
+    GpuCounters counters{};
+    {
+        vk::DispatchRecorder recorder(context, std::uint32_t(1 + schedule.size()));
+        push.firstWorkItem = 0;
+        recorder.dispatch("step1", pipeline, regions, &push);
+        push.firstWorkItem = regions;
+        for (const TransferRound& round : schedule) {
+            recorder.dispatch(round.name, pipeline, std::uint32_t(round.pairs.size()), &push);
+            push.firstWorkItem += std::uint32_t(round.pairs.size());
+        }
+        recorder.submitAndWait();
+        for (const auto& t : recorder.timingsMs()) report.dispatchMs.push_back(t);
+        buffers[DACRT_BINDING_COUNTERS].download(&counters, sizeof(counters));
     }
-    recorder.submitAndWait();
+    constexpr std::uint32_t kContinuationsPerSubmit = 8;
+    while (counters.itemsFinished < items.size()) {
+        if (counters.tooLarge > 0)
+            throw InputError(std::to_string(counters.tooLarge) + " work items have a single step larger than the loop "
+                             "budget of " + std::to_string(loopBudget) + " iterations (" + device.driver +
+                             "); use a larger --workgroup-size or more --regions (docs/gpu.md)");
+        const std::uint32_t slicesBefore = counters.slices;
+        vk::DispatchRecorder recorder(context, kContinuationsPerSubmit);
+        push.firstWorkItem = 0;
+        for (std::uint32_t c = 0; c < kContinuationsPerSubmit; ++c)
+            recorder.dispatch("continuation", pipeline, std::uint32_t(items.size()), &push);
+        recorder.submitAndWait();
+        for (const auto& t : recorder.timingsMs()) report.dispatchMs.push_back(t);
+        buffers[DACRT_BINDING_COUNTERS].download(&counters, sizeof(counters));
+        if (std::getenv("DACRT_DEBUG_SLICES"))
+            std::fprintf(stderr, "continuation: finished %u/%zu slices %u notReady %u tooLarge %u\n", counters.itemsFinished,
+                         items.size(), counters.slices, counters.notReady, counters.tooLarge);
+        if (counters.slices == slicesBefore)
+            throw std::logic_error("gpu work items stopped making progress (" + std::to_string(counters.itemsFinished) +
+                                   " of " + std::to_string(items.size()) + " finished)");
+    }
     result.phaseMs.emplace_back("dispatch", msSince(start));
 
     start = Clock::now();
     result.hits.resize(rayCount);
     buffers[DACRT_BINDING_HITS].download(result.hits.data(), rayCount * sizeof(Hit));
-    GpuCounters counters{};
-    buffers[DACRT_BINDING_COUNTERS].download(&counters, sizeof(counters));
     std::vector<Region> after(regions);
     buffers[DACRT_BINDING_REGIONS].download(after.data(), regions * sizeof(Region));
     result.phaseMs.emplace_back("readback", msSince(start));
@@ -166,8 +226,8 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     for (const Region& r : after) finished += r.terminated - r.rayBegin;
     result.counters.terminatedStep1 = finished;  // the gpu reports all rays finished, not per round
     result.counters.transferWorkItems = items.size() - regions;
-    report.dispatchMs = recorder.timingsMs();
-    report.dispatches = recorder.dispatchCount();
+    report.dispatches = std::uint32_t(report.dispatchMs.size());
+    report.slices = counters.slices;
     report.workItemsRun = counters.workItemsRun;
     report.workItemsEmpty = counters.workItemsEmpty;
     report.validationErrors = context.validationErrors();

@@ -11,10 +11,15 @@ struct GpuTuning {
     std::uint32_t workgroupSize = 0;  // 0: the device's default (gpuDefaults)
 };
 
+// Loop iterations one slice of a work item may spend: llvmpipe's loop limiter, 0 elsewhere.
+std::uint32_t loopBudgetOf(const vk::DeviceInfo& device);
+
 // Per-device defaults, chosen by measurement (docs/gpu.md): a CPU device such as lavapipe
-// runs a workgroup on one thread, SIMD across invocations, so one subgroup per workgroup
-// (no shared-memory barrier at all); a GPU wants wider workgroups.
-std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device);
+// runs a workgroup on one thread, SIMD across invocations, so one subgroup per workgroup (no
+// shared-memory barrier at all), widened only as far as the loop budget needs for the
+// largest region; a GPU wants wider workgroups.
+std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t largestRegionRays,
+                                   std::uint32_t largestRegionTriangles);
 
 TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
                      vk::Context& context, ThreadPool& pool, const PlanHook& onPlan = {});

@@ -90,6 +90,7 @@ nlohmann::ordered_json statsJson(const RenderOptions& o, const Scene& scene, con
                     {"dispatch_times", dispatches},
                     {"work_items_run", g.workItemsRun},
                     {"work_items_empty", g.workItemsEmpty},
+                    {"work_item_slices", g.slices},
                     {"validation_errors", g.validationErrors}};
     }
     return j;

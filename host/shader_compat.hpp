@@ -34,6 +34,8 @@ using shared::WorkgroupTestPush;
 using shared::WorkItem;
 using shared::Hit;
 using shared::Ray;
+using shared::StackEntry;
+using shared::TraversalState;
 using shared::Region;
 using shared::Triangle;
 using shared::kMissPrim;

@@ -92,6 +92,7 @@ struct GpuReport {
     std::uint32_t dispatches = 0;
     std::uint32_t workItemsRun = 0;
     std::uint32_t workItemsEmpty = 0;
+    std::uint32_t slices = 0;          // work item slices (more than work items: continuations)
     std::uint32_t validationErrors = 0;
 };
 

@@ -1,6 +1,12 @@
 #version 450
 // One DACRT work item per workgroup: the live rays of one region against the triangles of
 // one region (Step 1: its own), depth first on an explicit stack in shared memory.
+//
+// A work item may take several dispatches (slices): with a loop budget (llvmpipe's loop
+// limiter), a slice stops before a step that would overrun it and saves its node and stack;
+// the next dispatch over the same work item resumes there. A work item also waits (exits at
+// once) until every earlier work item on its rays and on its triangles has finished, so a
+// dispatch may hold work items of several rounds without two of them sharing a range.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
@@ -13,9 +19,17 @@
 
 layout(push_constant) uniform Push { DacrtPush push; };
 
+const uint kPhaseNew = 0u;
+const uint kPhaseRunning = 1u;
+const uint kPhaseFinished = 2u;
+
 int longestAxis(vec3 lo, vec3 hi) {
     vec3 e = hi - lo;
     return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+}
+
+bool overBudget(uint spent, uint cost) {
+    return kLoopBudget != 0u && spent + cost > kLoopBudget;
 }
 
 void main() {
@@ -25,34 +39,78 @@ void main() {
     gRayScratchHalf = push.rayScratchHalf;
     gTriScratchHalf = push.triScratchHalf;
     uint lane = gl_LocalInvocationIndex;
-    WorkItem item = workItems[push.firstWorkItem + gl_WorkGroupID.x];
-    uint terminated = regions[item.rayRegion].terminated;
-    uint rayEnd = regions[item.rayRegion].rayEnd;
-    if (terminated >= rayEnd) {  // nothing left to trace: the cheapest possible work item
-        if (lane == 0) atomicAdd(counters.workItemsEmpty, 1u);
+    uint itemIndex = push.firstWorkItem + gl_WorkGroupID.x;
+    WorkItem item = workItems[itemIndex];
+    TraversalState state = states[itemIndex];
+    if (state.phase == kPhaseFinished) return;
+    if (atomicAdd(regions[item.rayRegion].rayItemsDone, 0u) != item.raySeq ||
+        atomicAdd(regions[item.triRegion].triItemsDone, 0u) != item.triSeq) {
+        if (lane == 0) atomicAdd(counters.notReady, 1u);
         return;
     }
-    if (lane == 0) atomicAdd(counters.workItemsRun, 1u);
+    if (lane == 0) atomicAdd(counters.slices, 1u);
+    uint terminated = regions[item.rayRegion].terminated;
+    uint rayEnd = regions[item.rayRegion].rayEnd;
     vec3 rootLo = regions[item.triRegion].lo;
     vec3 rootHi = regions[item.triRegion].hi;
     vec3 margin = vec3(gMargin);
+    uint retireCost = partitionCost(rayEnd - terminated) + 4u;  // the final partition and the probe
+    uint spent = 0;
 
-    // Root: the rays that may cross this region go first.
-    uint crossing = partitionRays(terminated, rayEnd, kKeepCrossing, rootLo - margin, rootHi + margin);
-    vec3 lo = rootLo, hi = rootHi;
-    uint nodeRayEnd = crossing;
-    uint triBegin = regions[item.triRegion].triBegin, triEnd = regions[item.triRegion].triEnd;
-    uint depth = 0;
-    uint stackSize = 0;
+    vec3 lo = state.lo, hi = state.hi;
+    uint nodeRayEnd = state.nodeRayEnd, triBegin = state.triBegin, triEnd = state.triEnd, depth = state.depth;
+    uint stackSize = state.stackSize;
+    if (state.phase == kPhaseNew && terminated >= rayEnd) {  // nothing to trace: finish at once
+        if (lane == 0) {
+            atomicAdd(counters.workItemsEmpty, 1u);
+            states[itemIndex].phase = kPhaseFinished;
+            atomicAdd(counters.itemsFinished, 1u);
+            memoryBarrierBuffer();
+            atomicAdd(regions[item.rayRegion].rayItemsDone, 1u);
+            atomicAdd(regions[item.triRegion].triItemsDone, 1u);
+        }
+        return;
+    }
+    if (state.phase == kPhaseNew) {
+        if (lane == 0) atomicAdd(counters.workItemsRun, 1u);
+        // Root: the rays that may cross this region go first.
+        spent = partitionCost(rayEnd - terminated);
+        if (overBudget(spent, retireCost)) {
+            if (lane == 0) atomicAdd(counters.tooLarge, 1u);
+            return;
+        }
+        nodeRayEnd = partitionRays(terminated, rayEnd, kKeepCrossing, rootLo - margin, rootHi + margin);
+        lo = rootLo;
+        hi = rootHi;
+        triBegin = regions[item.triRegion].triBegin;
+        triEnd = regions[item.triRegion].triEnd;
+        depth = 0;
+        stackSize = 0;
+    } else {
+        for (uint i = lane; i < stackSize; i += kWorkgroupSize) sStack[i] = stacks[itemIndex * (kMaxDepth + 1u) + i];
+        spent = stackSize / kWorkgroupSize + 1u;
+        workgroupSync();
+    }
+
+    bool finished = false;
+    bool progressed = state.phase == kPhaseNew;  // the root partition ran
     for (;;) {
-        bool pop = true;
         if (terminated < nodeRayEnd && triBegin < triEnd) {
             uint rayCount = nodeRayEnd - terminated, triCount = triEnd - triBegin;
             int axis = longestAxis(lo, hi);
             float split = 0.5 * (lo[axis] + hi[axis]);
-            if (rayCount < kRayLimit || triCount < kTriLimit || depth >= kMaxDepth ||
-                !(split > lo[axis] && split < hi[axis])) {
+            bool canSplit = depth < kMaxDepth && split > lo[axis] && split < hi[axis];
+            bool isLeaf = rayCount < kRayLimit || triCount < kTriLimit || !canSplit;
+            // Under a loop budget a leaf too large for half a slice splits further instead:
+            // another tree, the same hits (every tree gives brute force's answer).
+            if (isLeaf && canSplit && kLoopBudget != 0u && leafCost(rayCount, triCount) > kLoopBudget / 2u) isLeaf = false;
+            uint cost = isLeaf ? leafCost(rayCount, triCount) : partitionCost(rayCount) + partitionCost(triCount) + 1u;
+            if (overBudget(spent, cost + retireCost)) break;
+            spent += cost;
+            progressed = true;
+            if (isLeaf) {
                 terminated = leaf(lo, hi, terminated, nodeRayEnd, triBegin, triEnd);
+                nodeRayEnd = terminated;
             } else {
                 // Front to back: the child on the rays' origin side first; the other waits on
                 // the stack with this node's ranges, which it filters again later.
@@ -60,37 +118,70 @@ void main() {
                 lowHi[axis] = split;
                 highLo[axis] = split;
                 bool lowFirst = gRayOrigin[axis] <= split;
-                vec3 nearLo = lo, nearHi = lowFirst ? lowHi : hi;
-                if (!lowFirst) nearLo = highLo;
+                vec3 nearLo = lowFirst ? lo : highLo, nearHi = lowFirst ? lowHi : hi;
                 if (lane == 0) {
-                    sStackLo[stackSize] = lowFirst ? highLo : lo;
-                    sStackHi[stackSize] = lowFirst ? hi : lowHi;
-                    sStackRanges[stackSize] = uvec4(nodeRayEnd, triBegin, triEnd, depth + 1);
+                    StackEntry far;
+                    far.lo = lowFirst ? highLo : lo;
+                    far.hi = lowFirst ? hi : lowHi;
+                    far.rayEnd = nodeRayEnd;
+                    far.triBegin = triBegin;
+                    far.triEnd = triEnd;
+                    far.depth = depth + 1u;
+                    sStack[stackSize] = far;
                 }
                 ++stackSize;
                 uint childRayEnd = partitionRays(terminated, nodeRayEnd, kKeepCrossing, nearLo - margin, nearHi + margin);
-                if (childRayEnd > terminated) {
+                if (childRayEnd > terminated)
                     triEnd = partitionTriangles(triBegin, triEnd, nearLo - margin, nearHi + margin);
-                    lo = nearLo;
-                    hi = nearHi;
-                    nodeRayEnd = childRayEnd;
-                    ++depth;
-                    pop = false;
-                }
+                lo = nearLo;
+                hi = nearHi;
+                nodeRayEnd = childRayEnd;
+                ++depth;
             }
+            continue;
         }
-        if (!pop) continue;
-        if (stackSize == 0) break;
-        --stackSize;
+        if (stackSize == 0) {
+            finished = true;
+            break;
+        }
         workgroupSync();
-        lo = sStackLo[stackSize];
-        hi = sStackHi[stackSize];
-        uvec4 ranges = sStackRanges[stackSize];
+        StackEntry far = sStack[stackSize - 1u];
+        uint cost = partitionCost(far.rayEnd - terminated) + partitionCost(far.triEnd - far.triBegin) + 1u;
+        if (overBudget(spent, cost + retireCost)) break;
+        spent += cost;
+        progressed = true;
+        --stackSize;
         workgroupSync();  // the slot may be written again before everyone has read it
-        nodeRayEnd = partitionRays(terminated, ranges.x, kKeepCrossing, lo - margin, hi + margin);
-        triBegin = ranges.y;
-        triEnd = nodeRayEnd > terminated ? partitionTriangles(ranges.y, ranges.z, lo - margin, hi + margin) : ranges.y;
-        depth = ranges.w;
+        lo = far.lo;
+        hi = far.hi;
+        nodeRayEnd = partitionRays(terminated, far.rayEnd, kKeepCrossing, lo - margin, hi + margin);
+        triBegin = far.triBegin;
+        triEnd = nodeRayEnd > terminated ? partitionTriangles(far.triBegin, far.triEnd, lo - margin, hi + margin)
+                                         : far.triBegin;
+        depth = far.depth;
+    }
+
+    if (!finished) {
+        // Out of budget: save the node and the stack; a later dispatch resumes here.
+        if (!progressed && lane == 0) atomicAdd(counters.tooLarge, 1u);
+        workgroupSync();
+        for (uint i = lane; i < stackSize; i += kWorkgroupSize) stacks[itemIndex * (kMaxDepth + 1u) + i] = sStack[i];
+        bool cutShort = loopLimiterFired(push.loopProbe);
+        if (lane == 0) {
+            TraversalState saved;
+            saved.lo = lo;
+            saved.hi = hi;
+            saved.phase = kPhaseRunning;
+            saved.nodeRayEnd = nodeRayEnd;
+            saved.triBegin = triBegin;
+            saved.triEnd = triEnd;
+            saved.depth = depth;
+            saved.stackSize = stackSize;
+            states[itemIndex] = saved;
+            regions[item.rayRegion].terminated = terminated;
+            if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
+        }
+        return;
     }
 
     // Rays no later work item can change are finished here (see RetireRule on the CPU side).
@@ -101,6 +192,11 @@ void main() {
     if (lane == 0) {
         atomicAdd(counters.raysRetired, terminated - before);
         regions[item.rayRegion].terminated = terminated;
+        states[itemIndex].phase = kPhaseFinished;
         if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
+        atomicAdd(counters.itemsFinished, 1u);
+        memoryBarrierBuffer();
+        atomicAdd(regions[item.rayRegion].rayItemsDone, 1u);
+        atomicAdd(regions[item.triRegion].triItemsDone, 1u);
     }
 }

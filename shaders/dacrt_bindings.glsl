@@ -6,6 +6,8 @@ layout(local_size_x_id = DACRT_SPEC_WORKGROUP_SIZE) in;
 layout(constant_id = DACRT_SPEC_RAY_LIMIT) const uint kRayLimit = 16;
 layout(constant_id = DACRT_SPEC_TRI_LIMIT) const uint kTriLimit = 16;
 layout(constant_id = DACRT_SPEC_MAX_DEPTH) const uint kMaxDepth = 48;
+// Loop iterations one slice of a work item may spend (0: no limit, one slice per work item).
+layout(constant_id = DACRT_SPEC_LOOP_BUDGET) const uint kLoopBudget = 0;
 
 layout(std430, binding = DACRT_BINDING_RAYS) readonly buffer RayBuffer { Ray rays[]; };
 layout(std430, binding = DACRT_BINDING_TRIANGLES) readonly buffer TriangleBuffer { Triangle triangles[]; };
@@ -18,6 +20,8 @@ layout(std430, binding = DACRT_BINDING_TRI_SCRATCH) coherent buffer TriScratchBu
 layout(std430, binding = DACRT_BINDING_REGIONS) coherent buffer RegionBuffer { Region regions[]; };
 layout(std430, binding = DACRT_BINDING_WORK_ITEMS) readonly buffer WorkItemBuffer { WorkItem workItems[]; };
 layout(std430, binding = DACRT_BINDING_COUNTERS) coherent buffer CounterBuffer { GpuCounters counters; };
+layout(std430, binding = DACRT_BINDING_STATES) coherent buffer StateBuffer { TraversalState states[]; };
+layout(std430, binding = DACRT_BINDING_STACKS) coherent buffer StackBuffer { StackEntry stacks[]; };
 
 // Frame parameters, set from push constants at the start of main.
 float gMargin;
@@ -35,9 +39,7 @@ shared float sBestT[kWorkgroupSize];          // leaf reduction across the lanes
 shared uint sBestPrim[kWorkgroupSize];
 shared float sBestU[kWorkgroupSize];
 shared float sBestV[kWorkgroupSize];
-// The DACRT stack: far children waiting, with their parent's ranges.
-shared vec3 sStackLo[kMaxDepth + 1];
-shared vec3 sStackHi[kMaxDepth + 1];
-shared uvec4 sStackRanges[kMaxDepth + 1];     // rayEnd, triBegin, triEnd, depth
+// The DACRT stack of the running slice (saved to `stacks` between slices).
+shared StackEntry sStack[kMaxDepth + 1];
 
 #endif

@@ -30,13 +30,12 @@ uint workgroupExclusiveSum(uint value, out uint total) {
     if (subgroupElect()) sSubgroupTotals[gl_SubgroupID] = subgroupTotal;
     memoryBarrierShared();
     barrier();
-    uint before = 0;
-    total = 0;
-    for (uint s = 0; s < gl_NumSubgroups; ++s) {
-        uint t = sSubgroupTotals[s];
-        before += s < gl_SubgroupID ? t : 0u;
-        total += t;
-    }
+    // Lane k of every subgroup holds subgroup k's total (the host keeps the number of
+    // subgroups within one subgroup's size): two subgroup sums, no loop.
+    uint k = gl_SubgroupInvocationID;
+    uint t = k < gl_NumSubgroups ? sSubgroupTotals[k] : 0u;
+    uint before = subgroupAdd(k < gl_SubgroupID ? t : 0u);
+    total = subgroupAdd(t);
     barrier();  // sSubgroupTotals is reused by the next call
     return before + inclusive - value;
 }
@@ -66,6 +65,21 @@ bool keepRay(uint id, uint rule, vec3 lo, vec3 hi) {
     if (rule == kKeepStill) return d == 0.0;
     bool moving = rule == kKeepStuckHigh ? d > 0.0 : d < 0.0;
     return moving && !rayMayCrossCell(ray, lo, hi, bestT);
+}
+
+// Loop iterations (llvmpipe's unit of account) a partition of n ids costs, at most.
+uint partitionCost(uint n) {
+    return 2u * ((n + kWorkgroupSize - 1u) / kWorkgroupSize) + 2u;
+}
+
+// ... and a leaf of rayCount rays and triCount triangles, its final partition included.
+uint leafCost(uint rayCount, uint triCount) {
+    uint lanes = max(1u, kWorkgroupSize / rayCount);
+    uint raysPerPass = kWorkgroupSize / lanes;
+    uint passes = (rayCount + raysPerPass - 1u) / raysPerPass;
+    uint tiles = (triCount + kWorkgroupSize - 1u) / kWorkgroupSize;
+    uint perTile = 2u + (kWorkgroupSize + lanes - 1u) / lanes;
+    return passes * (2u + tiles * perTile + lanes) + partitionCost(rayCount);
 }
 
 // Stable partition of rayIds[begin, end): the rays `rule` keeps first, in their order, then

@@ -50,18 +50,53 @@ struct Region {
     uint rayEnd;
     uint triBegin;
     uint triEnd;
-    uint terminated;   // rays [rayBegin, terminated) have their final hit
+    uint terminated;     // rays [rayBegin, terminated) have their final hit
+    uint rayItemsDone;   // gpu: finished work items that traced this region's rays
+    uint triItemsDone;   // gpu: finished work items that used this region's triangles
     uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 // One work item of a dispatch: the live rays of one region against the triangles of another
 // (the same region in Step 1). retire: 0 = rays that do not move along the division axis,
 // 1 / 2 = rays moving toward higher / lower regions that cannot reach triRegion.
+// raySeq / triSeq: how many earlier work items use the same rays / triangles. A work item
+// runs only when exactly that many have finished, so work items that share ranges never run
+// at once and always run in schedule order, however many dispatches they take.
 struct WorkItem {
     uint rayRegion;
     uint triRegion;
     uint retire;
+    uint raySeq;
+    uint triSeq;
     uint pad0;
+    uint pad1;
+    uint pad2;
+};
+
+// A work item's traversal between dispatches: llvmpipe ends a shader invocation after 65535
+// loop iterations, so a large work item runs in slices, each resuming where the last stopped.
+struct TraversalState {
+    vec3 lo;           // the current node (empty when nodeRayEnd <= terminated)
+    uint phase;        // 0 not started, 1 running, 2 finished
+    vec3 hi;
+    uint nodeRayEnd;
+    uint triBegin;
+    uint triEnd;
+    uint depth;
+    uint stackSize;
+};
+
+struct StackEntry {   // a far child waiting, with its parent's ranges
+    vec3 lo;
+    uint rayEnd;
+    vec3 hi;
+    uint triBegin;
+    uint triEnd;
+    uint depth;
+    uint pad0;
+    uint pad1;
 };
 
 // Push constants of the DACRT kernel.
@@ -88,6 +123,10 @@ struct GpuCounters {
     uint raysRetired;
     uint testResult;   // workgroup_test.comp's answer
     uint loopLimitHits;  // work items cut short by a driver's loop limiter (llvmpipe: 65535)
+    uint itemsFinished;
+    uint slices;         // work item slices run (a work item that fits runs in one)
+    uint notReady;       // work item launches that found an earlier one still running
+    uint tooLarge;       // work items with a single step beyond the loop budget
 };
 
 // Push constants of workgroup_test.comp, which runs one building block of the DACRT kernel
@@ -119,22 +158,30 @@ struct WorkgroupTestPush {
 #define DACRT_BINDING_REGIONS 8
 #define DACRT_BINDING_WORK_ITEMS 9
 #define DACRT_BINDING_COUNTERS 10
-#define DACRT_BINDING_COUNT 11
+#define DACRT_BINDING_STATES 11
+#define DACRT_BINDING_STACKS 12
+#define DACRT_BINDING_COUNT 13
 
 // Specialization constants of the DACRT kernel (constant_id).
 #define DACRT_SPEC_WORKGROUP_SIZE 0
 #define DACRT_SPEC_RAY_LIMIT 1
 #define DACRT_SPEC_TRI_LIMIT 2
 #define DACRT_SPEC_MAX_DEPTH 3
+#define DACRT_SPEC_LOOP_BUDGET 4
 
 #ifdef __cplusplus
-static_assert(sizeof(WorkItem) == 16);
+static_assert(sizeof(WorkItem) == 32);
 static_assert(offsetof(WorkItem, triRegion) == 4 && offsetof(WorkItem, retire) == 8);
+static_assert(offsetof(WorkItem, raySeq) == 12 && offsetof(WorkItem, triSeq) == 16);
+static_assert(sizeof(TraversalState) == 48 && offsetof(TraversalState, phase) == 12);
+static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalState, stackSize) == 44);
+static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depth) == 36);
 static_assert(sizeof(DacrtPush) == 48 && offsetof(DacrtPush, loopProbe) == 32);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
-static_assert(sizeof(GpuCounters) == 32 && offsetof(GpuCounters, raysRetired) == 20);
+static_assert(sizeof(GpuCounters) == 48 && offsetof(GpuCounters, raysRetired) == 20);
+static_assert(offsetof(GpuCounters, itemsFinished) == 32 && offsetof(GpuCounters, tooLarge) == 44);
 static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, loopLimitHits) == 28);
 static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);
 static_assert(offsetof(WorkgroupTestPush, rule) == 28 && offsetof(WorkgroupTestPush, begin) == 32);
@@ -148,7 +195,8 @@ static_assert(offsetof(Triangle, v0) == 0 && offsetof(Triangle, v1) == 16 && off
 static_assert(sizeof(Bounds) == 32 && offsetof(Bounds, lo) == 0 && offsetof(Bounds, hi) == 16);
 static_assert(sizeof(Hit) == 16 && offsetof(Hit, t) == 0 && offsetof(Hit, prim) == 4);
 static_assert(offsetof(Hit, u) == 8 && offsetof(Hit, v) == 12);
-static_assert(sizeof(Region) == 48);
+static_assert(sizeof(Region) == 64);
+static_assert(offsetof(Region, rayItemsDone) == 44 && offsetof(Region, triItemsDone) == 48);
 static_assert(offsetof(Region, lo) == 0 && offsetof(Region, rayBegin) == 12);
 static_assert(offsetof(Region, hi) == 16 && offsetof(Region, rayEnd) == 28);
 static_assert(offsetof(Region, triBegin) == 32 && offsetof(Region, triEnd) == 36);

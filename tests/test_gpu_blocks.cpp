@@ -66,7 +66,8 @@ std::uint32_t runBlock(vk::Context& context, BlockInputs& in, const WorkgroupTes
     const std::uint64_t sizes[DACRT_BINDING_COUNT] = {
         in.rays.size() * sizeof(Ray), in.triangles.size() * sizeof(Triangle), in.bounds.size() * sizeof(Bounds),
         in.hits.size() * sizeof(Hit), in.rayIds.size() * 4, in.triIds.size() * 4, in.rayIds.size() * 8,
-        in.triIds.size() * 8, sizeof(Region), sizeof(WorkItem), sizeof(GpuCounters)};
+        in.triIds.size() * 8, sizeof(Region), sizeof(WorkItem), sizeof(GpuCounters), sizeof(TraversalState),
+        sizeof(StackEntry)};
     for (std::uint32_t b = 0; b < DACRT_BINDING_COUNT; ++b) buffers.emplace_back(context, sizes[b], "test " + std::to_string(b));
     buffers[DACRT_BINDING_RAYS].upload(in.rays.data(), sizes[DACRT_BINDING_RAYS]);
     buffers[DACRT_BINDING_TRIANGLES].upload(in.triangles.data(), sizes[DACRT_BINDING_TRIANGLES]);
