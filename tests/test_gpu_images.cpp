@@ -116,3 +116,25 @@ TEST(GpuImages, UnknownDeviceListsTheChoices) {
         EXPECT_NE(what.find(context->info().name), std::string::npos) << what;
     }
 }
+
+TEST(GpuImages, ABufferOverTheDeviceLimitIsAClearError) {
+    DACRT_REQUIRE_GPU(context);
+    const std::uint64_t limit = context->info().maxStorageBufferRange;
+    if (limit > (256ull << 20)) GTEST_SKIP() << "the device's storage buffer range is too large to exceed cheaply";
+    const int width = 2048, height = int(limit / sizeof(Ray) / width) + 1;  // one row more than the ray buffer allows
+    const Scene s = sceneFromMeshes({grid({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 1, 1)});
+    const Frame frame(sceneFromMeshes({grid({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 1, 1)}), defaultCamera(s, width, height),
+                      width, height);
+    TraceOptions o;
+    o.backend = Backend::Gpu;
+    o.regions = 2;
+    ThreadPool pool(2);
+    try {
+        traceGpu(frame.geometry, o, GpuTuning{}, *context, pool);
+        FAIL() << "a " << frame.rays.size() * sizeof(Ray) << "-byte ray buffer was accepted";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("maxStorageBufferRange of " + std::to_string(limit)), std::string::npos) << what;
+        EXPECT_NE(what.find("over by"), std::string::npos) << what;
+    }
+}
