@@ -82,22 +82,32 @@ uint leafCost(uint rayCount, uint triCount) {
     return passes * (2u + tiles * perTile + lanes) + partitionCost(rayCount);
 }
 
-// Stable partition of rayIds[begin, end): the rays `rule` keeps first, in their order, then
-// the others in theirs. Out of place through the two halves of rayScratch, then copied back.
-// Returns the end of the kept rays.
-uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
+const uint kKeepOverlapping = 5u;  // triangles whose bounds overlap the (widened) cell
+
+bool keepId(uint id, uint rule, vec3 lo, vec3 hi) {
+    if (rule == kKeepOverlapping) return boundsOverlap(triangleBounds[id].lo, triangleBounds[id].hi, lo, hi);
+    return keepRay(id, rule, lo, hi);
+}
+
+// Stable partition of rayIds[begin, end) (or triIds, for kKeepOverlapping): the ids `rule`
+// keeps first, in their order, then the others in theirs. Out of place through the two
+// halves of the matching scratch buffer, then copied back. Returns the end of the kept ids.
+uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
+    bool triangleIds = rule == kKeepOverlapping;
+    uint secondHalf = triangleIds ? gTriScratchHalf : gRayScratchHalf;
     uint kept = 0, dropped = 0;
     uint lane = gl_LocalInvocationIndex;
     for (uint base = begin; base < end; base += kWorkgroupSize) {
         uint index = base + lane;
         bool inRange = index < end;
-        uint id = inRange ? rayIds[index] : 0u;
-        bool keep = inRange && keepRay(id, rule, lo, hi);
+        uint id = inRange ? (triangleIds ? triIds[index] : rayIds[index]) : 0u;
+        bool keep = inRange && keepId(id, rule, lo, hi);
         uint total;
         uint position = workgroupExclusiveSum(keep ? 1u : 0u, total);
+        uint slot = keep ? begin + kept + position : secondHalf + begin + dropped + (lane - position);
         if (inRange) {
-            if (keep) rayScratch[begin + kept + position] = id;
-            else rayScratch[gRayScratchHalf + begin + dropped + (lane - position)] = id;
+            if (triangleIds) triScratch[slot] = id;
+            else rayScratch[slot] = id;
         }
         kept += total;
         dropped += min(kWorkgroupSize, end - base) - total;
@@ -105,38 +115,21 @@ uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
     workgroupSync();
     for (uint index = begin + lane; index < end; index += kWorkgroupSize) {
         uint offset = index - begin;
-        rayIds[index] = offset < kept ? rayScratch[index] : rayScratch[gRayScratchHalf + begin + offset - kept];
+        uint from = offset < kept ? index : secondHalf + begin + offset - kept;
+        if (triangleIds) triIds[index] = triScratch[from];
+        else rayIds[index] = rayScratch[from];
     }
     workgroupSync();
     if (rule == kKeepCrossing && lane == 0) atomicAdd(counters.rayBoxTests, end - begin);
     return begin + kept;
 }
 
-// Stable partition of triIds[begin, end): triangles whose bounds overlap [lo, hi] first.
+uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
+    return partitionIds(begin, end, rule, lo, hi);
+}
+
 uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
-    uint kept = 0, dropped = 0;
-    uint lane = gl_LocalInvocationIndex;
-    for (uint base = begin; base < end; base += kWorkgroupSize) {
-        uint index = base + lane;
-        bool inRange = index < end;
-        uint id = inRange ? triIds[index] : 0u;
-        bool keep = inRange && boundsOverlap(triangleBounds[id].lo, triangleBounds[id].hi, lo, hi);
-        uint total;
-        uint position = workgroupExclusiveSum(keep ? 1u : 0u, total);
-        if (inRange) {
-            if (keep) triScratch[begin + kept + position] = id;
-            else triScratch[gTriScratchHalf + begin + dropped + (lane - position)] = id;
-        }
-        kept += total;
-        dropped += min(kWorkgroupSize, end - base) - total;
-    }
-    workgroupSync();
-    for (uint index = begin + lane; index < end; index += kWorkgroupSize) {
-        uint offset = index - begin;
-        triIds[index] = offset < kept ? triScratch[index] : triScratch[gTriScratchHalf + begin + offset - kept];
-    }
-    workgroupSync();
-    return begin + kept;
+    return partitionIds(begin, end, kKeepOverlapping, lo, hi);
 }
 
 // Every live ray of the leaf against every triangle of it; then the rays whose best hit
