@@ -42,8 +42,16 @@ std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t l
     return std::min(size, widest);
 }
 
+vk::ComputePipeline& PipelineCache::get(const std::vector<std::uint32_t>& specialization) {
+    std::unique_ptr<vk::ComputePipeline>& slot = pipelines_[specialization];
+    if (!slot)
+        slot = std::make_unique<vk::ComputePipeline>(context_, std::span<const std::uint32_t>(dacrt_spv, sizeof(dacrt_spv) / 4),
+                                                     DACRT_BINDING_COUNT, sizeof(DacrtPush), specialization, "dacrt");
+    return *slot;
+}
+
 TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const GpuTuning& tuning,
-                     vk::Context& context, ThreadPool& pool, const PlanHook& onPlan) {
+                     vk::Context& context, ThreadPool& pool, const PlanHook& onPlan, PipelineCache* pipelines) {
     const vk::DeviceInfo& device = context.info();
     if (options.dacrt.split != SplitMethod::SpatialMedian)
         throw InputError("--split " + toString(options.dacrt.split) + " is not available on the gpu backend (spatial-median only)");
@@ -149,9 +157,10 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     result.phaseMs.emplace_back("upload", msSince(start));
 
     start = Clock::now();
-    vk::ComputePipeline pipeline(
-        context, std::span<const std::uint32_t>(dacrt_spv, sizeof(dacrt_spv) / 4), DACRT_BINDING_COUNT, sizeof(DacrtPush),
-        {workgroupSize, options.dacrt.rayLimit, options.dacrt.triLimit, options.dacrt.maxDepth, loopBudget}, "dacrt");
+    PipelineCache frameOnly(context);
+    vk::ComputePipeline& pipeline = (pipelines ? *pipelines : frameOnly)
+                                        .get({workgroupSize, options.dacrt.rayLimit, options.dacrt.triLimit,
+                                              options.dacrt.maxDepth, loopBudget});
     std::vector<const vk::Buffer*> bound;
     for (const vk::Buffer& b : buffers) bound.push_back(&b);
     pipeline.bind(bound);

@@ -125,7 +125,11 @@ int runRender(const RenderOptions& o) {
                                            : (o.trace.threads ? o.trace.threads : std::max(1u, std::thread::hardware_concurrency()));
     ThreadPool pool(threads);
     std::unique_ptr<vk::Context> gpu;
-    if (o.trace.backend == Backend::Gpu) gpu = std::make_unique<vk::Context>(vk::ContextOptions{o.device, o.validate});
+    std::unique_ptr<PipelineCache> pipelines;
+    if (o.trace.backend == Backend::Gpu) {
+        gpu = std::make_unique<vk::Context>(vk::ContextOptions{o.device, o.validate});
+        pipelines = std::make_unique<PipelineCache>(*gpu);
+    }
     const std::uint64_t memoryLimit = physicalMemoryBytes();
 
     for (int k = 0; k < int(cameras.size()); ++k) {
@@ -156,7 +160,7 @@ int runRender(const RenderOptions& o) {
             return true;
         };
         const auto traceStart = Clock::now();
-        const TraceResult result = gpu ? traceGpu(g, o.trace, GpuTuning{o.workgroupSize}, *gpu, pool, onPlan)
+        const TraceResult result = gpu ? traceGpu(g, o.trace, GpuTuning{o.workgroupSize}, *gpu, pool, onPlan, pipelines.get())
                                        : traceCpu(g, o.trace, pool, onPlan);
         if (o.planOnly) continue;
         const double traceMs = msSince(traceStart);
