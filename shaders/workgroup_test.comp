@@ -20,7 +20,13 @@ void main() {
     gRayScratchHalf = push.rayScratchHalf;
     gTriScratchHalf = push.triScratchHalf;
     uint result;
-    if (push.mode == 0u) result = partitionRays(push.begin, push.end, push.rule, push.lo, push.hi);
+    // One call site per rule, each with a constant rule, as in dacrt.comp (a rule known only at
+    // run time would make every branch of the predicate run under a mask).
+    if (push.mode == 0u && push.rule == kKeepCrossing) result = partitionRays(push.begin, push.end, kKeepCrossing, push.lo, push.hi);
+    else if (push.mode == 0u && push.rule == kKeepFinished) result = partitionRays(push.begin, push.end, kKeepFinished, push.lo, push.hi);
+    else if (push.mode == 0u && push.rule == kKeepStill) result = partitionRays(push.begin, push.end, kKeepStill, push.lo, push.hi);
+    else if (push.mode == 0u && push.rule == kKeepStuckHigh) result = partitionRays(push.begin, push.end, kKeepStuckHigh, push.lo, push.hi);
+    else if (push.mode == 0u) result = partitionRays(push.begin, push.end, kKeepStuckLow, push.lo, push.hi);
     else if (push.mode == 1u) result = partitionTriangles(push.begin, push.end, push.lo, push.hi);
     else result = leaf(push.lo, push.hi, push.begin, push.end, push.triBegin, push.triEnd);
     bool cutShort = loopLimiterFired(2u + push.pad0);
