@@ -198,10 +198,15 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
                              "budget of " + std::to_string(loopBudget) + " iterations (" + device.driver +
                              "); use a larger --workgroup-size or more --regions (docs/gpu.md)");
         const std::uint32_t slicesBefore = counters.slices;
-        vk::DispatchRecorder recorder(context, kContinuationsPerSubmit);
-        push.firstWorkItem = 0;
+        const std::uint32_t perDispatch = device.maxComputeWorkGroupCountX;
+        const std::uint32_t dispatchesPerPass = std::uint32_t((items.size() + perDispatch - 1) / perDispatch);
+        vk::DispatchRecorder recorder(context, kContinuationsPerSubmit * dispatchesPerPass);
         for (std::uint32_t c = 0; c < kContinuationsPerSubmit; ++c)
-            recorder.dispatch("continuation", pipeline, std::uint32_t(items.size()), &push);
+            for (std::uint32_t first = 0; first < items.size(); first += perDispatch) {
+                push.firstWorkItem = first;
+                recorder.dispatch("continuation", pipeline, std::min<std::uint32_t>(perDispatch, std::uint32_t(items.size()) - first),
+                                  &push);
+            }
         recorder.submitAndWait();
         for (const auto& t : recorder.timingsMs()) report.dispatchMs.push_back(t);
         buffers[DACRT_BINDING_COUNTERS].download(&counters, sizeof(counters));
