@@ -1,20 +1,14 @@
 #include "cpu_tracers.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <numeric>
 
 #include "dacrt_traversal.hpp"
 #include "scene_division.hpp"
+#include "timing.hpp"
 
 namespace dacrt {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
     plan.add("rays", std::uint64_t(g.rays->size()) * sizeof(Ray));

@@ -1,26 +1,14 @@
 #include "gpu_tracer.hpp"
 
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
-
 #include "dacrt_traversal.hpp"
 #include "errors.hpp"
 #include "scene_division.hpp"
+#include "timing.hpp"
 #include "vk_resources.hpp"
 
 #include "dacrt.spv.h"
 
 namespace dacrt {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-}  // namespace
 
 std::uint32_t loopBudgetOf(const vk::DeviceInfo& device) {
     // llvmpipe stops all loops of an invocation after 65535 iterations in all; keep a margin
@@ -210,9 +198,6 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
         recorder.submitAndWait();
         for (const auto& t : recorder.timingsMs()) report.dispatchMs.push_back(t);
         buffers[DACRT_BINDING_COUNTERS].download(&counters, sizeof(counters));
-        if (std::getenv("DACRT_DEBUG_SLICES"))
-            std::fprintf(stderr, "continuation: finished %u/%zu slices %u notReady %u tooLarge %u\n", counters.itemsFinished,
-                         items.size(), counters.slices, counters.notReady, counters.tooLarge);
         if (counters.slices == slicesBefore)
             throw std::logic_error("gpu work items stopped making progress (" + std::to_string(counters.itemsFinished) +
                                    " of " + std::to_string(items.size()) + " finished)");

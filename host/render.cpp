@@ -1,6 +1,5 @@
 #include "render.hpp"
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -16,15 +15,10 @@
 #include "gltf_loader.hpp"
 #include "gpu_tracer.hpp"
 #include "image_io.hpp"
+#include "timing.hpp"
 
 namespace dacrt {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 std::uint64_t physicalMemoryBytes() {
     const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
