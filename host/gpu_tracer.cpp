@@ -223,7 +223,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     result.counters.raysRetired = counters.raysRetired;
     std::uint64_t finished = 0;
     for (const Region& r : after) finished += r.terminated - r.rayBegin;
-    result.counters.terminatedStep1 = finished;  // the gpu reports all rays finished, not per round
+    report.raysFinished = finished;  // one command buffer: no per-round readback
     result.counters.transferWorkItems = items.size() - regions;
     report.dispatches = std::uint32_t(report.dispatchMs.size());
     report.slices = counters.slices;

@@ -65,7 +65,7 @@ nlohmann::ordered_json statsJson(const RenderOptions& o, const Scene& scene, con
                      {"leaves", c.leaves},
                      {"rays_retired_without_hit", c.raysRetired},
                      {"rays_culled", c.raysCulled},
-                     {"rays_terminated_step1", c.terminatedStep1},
+                     {"rays_terminated_step1", r.gpu ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(c.terminatedStep1)},
                      {"rays_terminated_per_round", rounds},
                      {"transfer_work_items", c.transferWorkItems},
                      {"transfer_work_items_skipped", c.transferWorkItemsSkipped}};
@@ -85,6 +85,7 @@ nlohmann::ordered_json statsJson(const RenderOptions& o, const Scene& scene, con
                     {"work_items_run", g.workItemsRun},
                     {"work_items_empty", g.workItemsEmpty},
                     {"work_item_slices", g.slices},
+                    {"rays_finished", g.raysFinished},
                     {"validation_errors", g.validationErrors}};
     }
     return j;

@@ -93,6 +93,7 @@ struct GpuReport {
     std::uint32_t workItemsRun = 0;
     std::uint32_t workItemsEmpty = 0;
     std::uint32_t slices = 0;          // work item slices (more than work items: continuations)
+    std::uint64_t raysFinished = 0;    // rays ended by a hit or retired, over all steps
     std::uint32_t validationErrors = 0;
 };
 
