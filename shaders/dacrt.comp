@@ -43,11 +43,18 @@ void main() {
     WorkItem item = workItems[itemIndex];
     TraversalState state = states[itemIndex];
     if (state.phase == kPhaseFinished) return;
-    if (atomicAdd(regions[item.rayRegion].rayItemsDone, 0u) != item.raySeq ||
-        atomicAdd(regions[item.triRegion].triItemsDone, 0u) != item.triSeq) {
+    // Earlier work items may finish during this very dispatch: one invocation reads the
+    // counters and the whole workgroup follows its answer, so control flow stays uniform.
+    if (lane == 0)
+        sReady = atomicAdd(regions[item.rayRegion].rayItemsDone, 0u) == item.raySeq &&
+                 atomicAdd(regions[item.triRegion].triItemsDone, 0u) == item.triSeq;
+    memoryBarrierShared();
+    barrier();
+    if (!sReady) {
         if (lane == 0) atomicAdd(counters.notReady, 1u);
         return;
     }
+    memoryBarrierBuffer();  // see the finished work items' writes (they barrier before counting)
     if (lane == 0) atomicAdd(counters.slices, 1u);
     uint terminated = regions[item.rayRegion].terminated;
     uint rayEnd = regions[item.rayRegion].rayEnd;

@@ -39,6 +39,7 @@ shared float sBestT[kWorkgroupSize];          // leaf reduction across the lanes
 shared uint sBestPrim[kWorkgroupSize];
 shared float sBestU[kWorkgroupSize];
 shared float sBestV[kWorkgroupSize];
+shared bool sReady;                           // this work item may run now
 // The DACRT stack of the running slice (saved to `stacks` between slices).
 shared StackEntry sStack[kMaxDepth + 1];
 
