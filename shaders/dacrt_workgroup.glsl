@@ -67,9 +67,14 @@ bool keepRay(uint id, uint rule, vec3 lo, vec3 hi) {
     return moving && !rayMayCrossCell(ray, lo, hi, bestT);
 }
 
+// Ids one invocation takes per step of a partition: a run of consecutive ids, so that a scan
+// and a loop iteration serve four ids.
+const uint kIdsPerInvocation = 4u;
+const uint kPartitionChunk = kWorkgroupSize * kIdsPerInvocation;
+
 // Loop iterations (llvmpipe's unit of account) a partition of n ids costs, at most.
 uint partitionCost(uint n) {
-    return 2u * ((n + kWorkgroupSize - 1u) / kWorkgroupSize) + 2u;
+    return 2u * ((n + kPartitionChunk - 1u) / kPartitionChunk) + 2u;
 }
 
 // ... and a leaf of rayCount rays and triCount triangles, its final partition included.
@@ -97,27 +102,42 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
     uint secondHalf = triangleIds ? gTriScratchHalf : gRayScratchHalf;
     uint kept = 0, dropped = 0;
     uint lane = gl_LocalInvocationIndex;
-    for (uint base = begin; base < end; base += kWorkgroupSize) {
-        uint index = base + lane;
-        bool inRange = index < end;
-        uint id = inRange ? (triangleIds ? triIds[index] : rayIds[index]) : 0u;
-        bool keep = inRange && keepId(id, rule, lo, hi);
+    for (uint base = begin; base < end; base += kPartitionChunk) {
+        uint first = base + lane * kIdsPerInvocation;
+        uint ids[kIdsPerInvocation];
+        bool keeps[kIdsPerInvocation];
+        uint myKept = 0;
+        for (uint e = 0; e < kIdsPerInvocation; ++e) {
+            uint index = first + e;
+            bool inRange = index < end;
+            ids[e] = inRange ? (triangleIds ? triIds[index] : rayIds[index]) : 0u;
+            keeps[e] = inRange && keepId(ids[e], rule, lo, hi);
+            myKept += keeps[e] ? 1u : 0u;
+        }
         uint total;
-        uint position = workgroupExclusiveSum(keep ? 1u : 0u, total);
-        uint slot = keep ? begin + kept + position : secondHalf + begin + dropped + (lane - position);
-        if (inRange) {
-            if (triangleIds) triScratch[slot] = id;
-            else rayScratch[slot] = id;
+        uint keptBefore = workgroupExclusiveSum(myKept, total);
+        // Every invocation before this one had a full run of ids (runs fill in order).
+        uint droppedBefore = min(lane * kIdsPerInvocation, end - base) - keptBefore;
+        uint k = begin + kept + keptBefore, d = secondHalf + begin + dropped + droppedBefore;
+        for (uint e = 0; e < kIdsPerInvocation; ++e) {
+            if (first + e >= end) continue;
+            uint slot = keeps[e] ? k++ : d++;
+            if (triangleIds) triScratch[slot] = ids[e];
+            else rayScratch[slot] = ids[e];
         }
         kept += total;
-        dropped += min(kWorkgroupSize, end - base) - total;
+        dropped += min(kPartitionChunk, end - base) - total;
     }
     workgroupSync();
-    for (uint index = begin + lane; index < end; index += kWorkgroupSize) {
-        uint offset = index - begin;
-        uint from = offset < kept ? index : secondHalf + begin + offset - kept;
-        if (triangleIds) triIds[index] = triScratch[from];
-        else rayIds[index] = rayScratch[from];
+    for (uint base = begin; base < end; base += kPartitionChunk) {
+        for (uint e = 0; e < kIdsPerInvocation; ++e) {
+            uint index = base + lane * kIdsPerInvocation + e;
+            if (index >= end) continue;
+            uint offset = index - begin;
+            uint from = offset < kept ? index : secondHalf + begin + offset - kept;
+            if (triangleIds) triIds[index] = triScratch[from];
+            else rayIds[index] = rayScratch[from];
+        }
     }
     workgroupSync();
     if (rule == kKeepCrossing && lane == 0) atomicAdd(counters.rayBoxTests, end - begin);
