@@ -23,8 +23,9 @@ std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t l
     std::uint32_t size = device.type == "cpu" ? subgroup : std::max(64u, subgroup);
     if (const std::uint32_t budget = loopBudgetOf(device)) {
         // The largest single step (a split of the biggest region, then its final partition)
-        // must fit one slice: about 2 (rays + triangles) / size + 2 rays / size iterations.
-        const double needed = (4.0 * largestRegionRays + 2.0 * largestRegionTriangles) / (0.8 * budget);
+        // must fit one slice: about (2 (rays + triangles) + 2 rays) / (4 size) iterations, a
+        // partition step taking four ids per invocation (kIdsPerInvocation).
+        const double needed = (4.0 * largestRegionRays + 2.0 * largestRegionTriangles) / (4.0 * 0.8 * budget);
         while (size < widest && double(size) < needed) size *= 2;
     }
     return std::min(size, widest);
