@@ -143,7 +143,7 @@ struct WorkgroupTestPush {
     uint rayScratchHalf;
     uint triScratchHalf;
     uint axis;
-    uint pad0;
+    uint loopProbe;        // 2, as DacrtPush::loopProbe
 };
 
 // Storage buffer bindings of the DACRT kernel (set 0).
@@ -186,6 +186,7 @@ static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, l
 static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);
 static_assert(offsetof(WorkgroupTestPush, rule) == 28 && offsetof(WorkgroupTestPush, begin) == 32);
 static_assert(offsetof(WorkgroupTestPush, triEnd) == 44 && offsetof(WorkgroupTestPush, axis) == 56);
+static_assert(offsetof(WorkgroupTestPush, loopProbe) == 60);
 static_assert(sizeof(Ray) == 64);
 static_assert(offsetof(Ray, origin) == 0 && offsetof(Ray, tmin) == 12);
 static_assert(offsetof(Ray, dir) == 16 && offsetof(Ray, axes) == 28);

@@ -29,7 +29,7 @@ void main() {
     else if (push.mode == 0u) result = partitionRays(push.begin, push.end, kKeepStuckLow, push.lo, push.hi);
     else if (push.mode == 1u) result = partitionTriangles(push.begin, push.end, push.lo, push.hi);
     else result = leaf(push.lo, push.hi, push.begin, push.end, push.triBegin, push.triEnd);
-    bool cutShort = loopLimiterFired(2u + push.pad0);
+    bool cutShort = loopLimiterFired(push.loopProbe);
     if (gl_LocalInvocationIndex == 0) {
         counters.testResult = result;
         if (cutShort) counters.loopLimitHits = 1u;

@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
         WorkgroupTestPush push{};
         push.rayScratchHalf = rayCount;
         push.triScratchHalf = triCount;
+        push.loopProbe = 2;
         push.lo = glm::vec3(-0.05f);
         push.hi = glm::vec3(0.05f, 0.05f, 3.5f);
         push.mode = 0;

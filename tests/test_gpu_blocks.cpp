@@ -60,8 +60,24 @@ BlockInputs randomInputs(std::mt19937& rng, std::size_t rays, std::size_t tris) 
     return in;
 }
 
-// Runs workgroup_test.comp once over `in` and reads everything back into `in`.
-std::uint32_t runBlock(vk::Context& context, BlockInputs& in, const WorkgroupTestPush& push, std::uint32_t workgroupSize) {
+// The push constants of one block over [begin, end) in the box [lo, hi].
+WorkgroupTestPush blockPush(std::uint32_t mode, const glm::vec3& lo, const glm::vec3& hi, std::uint32_t begin,
+                            std::uint32_t end) {
+    WorkgroupTestPush push{};
+    push.mode = mode;
+    push.lo = lo;
+    push.hi = hi;
+    push.begin = begin;
+    push.end = end;
+    return push;
+}
+
+// Runs workgroup_test.comp once over `in` and reads everything back into `in`; the scratch
+// halves and the loop probe follow from the inputs.
+std::uint32_t runBlock(vk::Context& context, BlockInputs& in, WorkgroupTestPush push, std::uint32_t workgroupSize) {
+    push.rayScratchHalf = std::uint32_t(in.rayIds.size());
+    push.triScratchHalf = std::uint32_t(in.triIds.size());
+    push.loopProbe = 2;
     std::vector<vk::Buffer> buffers;
     const std::uint64_t sizes[DACRT_BINDING_COUNT] = {
         in.rays.size() * sizeof(Ray), in.triangles.size() * sizeof(Triangle), in.bounds.size() * sizeof(Bounds),
@@ -119,15 +135,8 @@ TEST_P(GpuBlocks, RayPartitionsAreStableAndExact) {
                 }
             };
             const auto pivot = std::stable_partition(expected.begin() + begin, expected.begin() + end, keep);
-            WorkgroupTestPush push{};
-            push.mode = 0;
+            WorkgroupTestPush push = blockPush(0, lo, hi, begin, end);
             push.rule = rule;
-            push.lo = lo;
-            push.hi = hi;
-            push.begin = begin;
-            push.end = end;
-            push.rayScratchHalf = count;
-            push.triScratchHalf = std::uint32_t(in.triIds.size());
             push.axis = 0;
             const std::uint32_t result = runBlock(*context, in, push, wg);
             EXPECT_EQ(result, std::uint32_t(pivot - expected.begin())) << "rule " << rule << " range " << begin << ".." << end;
@@ -148,15 +157,7 @@ TEST_P(GpuBlocks, TrianglePartitionsAreStableAndExact) {
         const auto pivot = std::stable_partition(expected.begin() + begin, expected.begin() + end, [&](std::uint32_t id) {
             return shared::boundsOverlap(in.bounds[id].lo, in.bounds[id].hi, lo, hi);
         });
-        WorkgroupTestPush push{};
-        push.mode = 1;
-        push.lo = lo;
-        push.hi = hi;
-        push.begin = begin;
-        push.end = end;
-        push.rayScratchHalf = 4;
-        push.triScratchHalf = count;
-        const std::uint32_t result = runBlock(*context, in, push, wg);
+        const std::uint32_t result = runBlock(*context, in, blockPush(1, lo, hi, begin, end), wg);
         EXPECT_EQ(result, std::uint32_t(pivot - expected.begin()));
         EXPECT_EQ(in.triIds, expected);
     }
@@ -182,16 +183,9 @@ TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
         const auto pivot = std::stable_partition(expectedIds.begin() + begin, expectedIds.begin() + end, [&](std::uint32_t id) {
             return expectedHits[id].prim != kMissPrim && shared::hitEndsInBox(in.rays[id], lo, hi, expectedHits[id].t);
         });
-        WorkgroupTestPush push{};
-        push.mode = 2;
-        push.lo = lo;
-        push.hi = hi;
-        push.begin = begin;
-        push.end = end;
+        WorkgroupTestPush push = blockPush(2, lo, hi, begin, end);
         push.triBegin = triBegin;
         push.triEnd = triEnd;
-        push.rayScratchHalf = std::uint32_t(in.rayIds.size());
-        push.triScratchHalf = std::uint32_t(in.triIds.size());
         const std::uint32_t result = runBlock(*context, in, push, wg);
         std::size_t differing = 0;
         for (std::size_t i = 0; i < in.hits.size(); ++i)
