@@ -10,6 +10,7 @@
 #include "compare.hpp"
 #include "errors.hpp"
 #include "render.hpp"
+#include "stress.hpp"
 #include "vk_check.hpp"
 #include "vk_context.hpp"
 
@@ -112,6 +113,28 @@ int runCli(int argc, char** argv) {
     compareCmd->add_flag("--json", compareJson, "write the report as JSON to stdout");
     compareCmd->add_option("--tie-bound", tieBound, "relative depth bound of a near tie")->check(CLI::PositiveNumber);
 
+    StressCommand stress;
+    std::string stressSize = "large";
+    std::vector<Backend> stressBackends;
+    std::vector<std::string> stressFamilyNames;
+    bool stressDefaultsOnly = false, stressNoDeterminism = false;
+    CLI::App* stressCmd = app.add_subcommand("stress", "try to break every backend numerically (docs/stability.md)");
+    stressCmd->add_option("--backends", stressBackends, "backends to run (default: brute cpu-seq cpu gpu)")
+        ->transform(choices<Backend>(
+            {{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}, {"gpu", Backend::Gpu}}))
+        ->delimiter(',');
+    stressCmd->add_option("--families", stressFamilyNames, "case families (default: watertight split-plane degenerate)")
+        ->check(CLI::IsMember({"watertight", "split-plane", "degenerate"}))
+        ->delimiter(',');
+    stressCmd->add_option("--size", stressSize, "small (the test suite's cases) or large")
+        ->check(CLI::IsMember({"small", "large"}))->default_str("large");
+    stressCmd->add_option("--seed", stress.seed, "seed of the random parts of the cases")->default_str("1");
+    stressCmd->add_flag("--defaults-only", stressDefaultsOnly, "run only each backend's default configuration");
+    stressCmd->add_flag("--no-determinism", stressNoDeterminism, "skip the determinism checks");
+    stressCmd->add_option("--json", stress.jsonPath, "write the table and checks as JSON");
+    stressCmd->add_option("--device", stress.device, "gpu: Vulkan device index or part of its name");
+    stressCmd->add_flag("--validate", stress.validate, "gpu: run under the Vulkan validation layers; errors fail the run");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -129,6 +152,14 @@ int runCli(int argc, char** argv) {
             if (!up.empty()) render.camera.up = parseVec3("--up", up);
             if (renderCmd->count("--fov")) render.camera.fovDegrees = fov;
             return runRender(render);
+        }
+        if (*stressCmd) {
+            stress.size = stressSize == "small" ? StressSize::Small : StressSize::Large;
+            stress.backends = stressBackends;
+            stress.families = stressFamilyNames;
+            stress.withOptions = !stressDefaultsOnly;
+            stress.determinism = !stressNoDeterminism;
+            return runStressCommand(stress);
         }
         if (*devicesCmd) {
             const std::vector<vk::DeviceInfo> devices = vk::listDevices();

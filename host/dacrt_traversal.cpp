@@ -36,7 +36,7 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
 std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
                                     std::uint32_t triBegin, std::uint32_t triEnd, const RetireRule& retire) {
     const std::uint32_t crossing = filterRays(widen(box, margin_), terminated, rayEnd);
-    node(box, terminated, crossing, triBegin, triEnd, 0);
+    node(box, terminated, crossing, triBegin, triEnd, 0, 0);
     if (retire.axis < 0) return crossing;
     const Box cell = widen(box, margin_);
     for (std::uint32_t k = terminated; k < rayEnd; ++k) {
@@ -88,13 +88,13 @@ float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triB
 }
 
 void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
-                          std::uint32_t triEnd, std::uint32_t depth) {
+                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
     if (terminated >= rayEnd || triBegin >= triEnd) return;
     const std::uint32_t rayCount = rayEnd - terminated, triCount = triEnd - triBegin;
     const int axis = longestAxis(box);
     const float split = splitPosition(box, axis, triBegin, triEnd);
     if (rayCount < options_.rayLimit || triCount < options_.triLimit || depth >= options_.maxDepth ||
-        !(split > box.lo[axis] && split < box.hi[axis])) {
+        stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis])) {
         leaf(box, terminated, rayEnd, triBegin, triEnd);
         return;
     }
@@ -108,7 +108,8 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
         const std::uint32_t childRays = filterRays(cell, terminated, rayEnd);
         if (childRays == terminated) continue;
         const std::uint32_t childTris = filterTriangles(cell, triBegin, triEnd);
-        node(*child, terminated, childRays, triBegin, childTris, depth + 1);
+        const bool stalled = childRays == rayEnd && childTris == triEnd;
+        node(*child, terminated, childRays, triBegin, childTris, depth + 1, stalled ? stalls + 1 : 0);
     }
 }
 

@@ -32,7 +32,7 @@ public:
 
 private:
     void node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
-              std::uint32_t triEnd, std::uint32_t depth);
+              std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd);
     std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);

@@ -10,6 +10,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_EXT_control_flow_attributes : require
 
 #define IN(T) in T
 #include "layout.h"
@@ -27,6 +28,11 @@ int longestAxis(vec3 lo, vec3 hi) {
     vec3 e = hi - lo;
     return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
 }
+
+// Loop iterations a step (split, pop, leaf slice) costs besides its partitions and tests.
+// Measured with the loop probe (docs/stability.md): with 8 a slice of tiny nodes, as with
+// --ray-limit 1 --tri-limit 1, overran its estimate by up to 20%; with 16 none did.
+const uint kStepOverhead = 16u;
 
 bool overBudget(uint spent, uint cost) {
     return kLoopBudget != 0u && spent + cost > kLoopBudget;
@@ -66,7 +72,7 @@ void main() {
 
     vec3 lo = state.lo, hi = state.hi;
     uint nodeRayEnd = state.nodeRayEnd, triBegin = state.triBegin, triEnd = state.triEnd, depth = state.depth;
-    uint stackSize = state.stackSize;
+    uint stackSize = state.stackSize, stalls = state.stalls, leafNext = state.leafNext;
     if (state.phase == kPhaseNew && terminated >= rayEnd) {  // nothing to trace: finish at once
         if (lane == 0) {
             atomicAdd(counters.workItemsEmpty, 1u);
@@ -93,6 +99,8 @@ void main() {
         triEnd = regions[item.triRegion].triEnd;
         depth = 0;
         stackSize = 0;
+        stalls = 0;
+        leafNext = 0;
     } else {
         for (uint i = lane; i < stackSize; i += kWorkgroupSize) sStack[i] = stacks[itemIndex * (kMaxDepth + 1u) + i];
         spent = stackSize / kWorkgroupSize + 1u;
@@ -106,19 +114,41 @@ void main() {
             uint rayCount = nodeRayEnd - terminated, triCount = triEnd - triBegin;
             int axis = longestAxis(lo, hi);
             float split = 0.5 * (lo[axis] + hi[axis]);
-            bool canSplit = depth < kMaxDepth && split > lo[axis] && split < hi[axis];
-            bool isLeaf = rayCount < kRayLimit || triCount < kTriLimit || !canSplit;
-            // Under a loop budget a leaf too large for half a slice splits further instead:
-            // another tree, the same hits (every tree gives brute force's answer).
-            if (isLeaf && canSplit && kLoopBudget != 0u && leafCost(rayCount, triCount) > kLoopBudget / 2u) isLeaf = false;
-            uint cost = isLeaf ? leafCost(rayCount, triCount) : partitionCost(rayCount) + partitionCost(triCount) + 1u;
+            bool canSplit = depth < kMaxDepth && split > lo[axis] && split < hi[axis] &&
+                            stalls < DACRT_MAX_STALLED_SPLITS;
+            bool isLeaf = rayCount < kRayLimit || triCount < kTriLimit || !canSplit || leafNext != 0u;
+            // Under a loop budget a leaf too large for half a slice splits further instead
+            // while splitting still separates something: another tree, the same hits (every
+            // tree gives brute force's answer). A leaf that must stay one runs in slices.
+            if (isLeaf && canSplit && leafNext == 0u && kLoopBudget != 0u && leafCost(rayCount, triCount) > kLoopBudget / 2u)
+                isLeaf = false;
+            if (isLeaf) {
+                uint from = leafNext != 0u ? leafNext : terminated;
+                uint finish = partitionCost(rayCount);
+                uint take = nodeRayEnd - from;
+                if (kLoopBudget != 0u) {
+                    uint reserved = spent + retireCost + finish;
+                    reserved += kStepOverhead;
+                    take = reserved < kLoopBudget ? leafRaysWithin(take, triCount, kLoopBudget - reserved) : 0u;
+                    if (take == 0u) break;
+                }
+                leafTests(from, from + take, triBegin, triEnd);
+                spent += leafTestCost(take, triCount) + kStepOverhead;
+                progressed = true;
+                leafNext = from + take;
+                if (leafNext == nodeRayEnd) {
+                    terminated = finishLeaf(lo, hi, terminated, nodeRayEnd);
+                    spent += finish;
+                    nodeRayEnd = terminated;
+                    leafNext = 0u;
+                }
+                continue;
+            }
+            uint cost = partitionCost(rayCount) + partitionCost(triCount) + kStepOverhead;
             if (overBudget(spent, cost + retireCost)) break;
             spent += cost;
             progressed = true;
-            if (isLeaf) {
-                terminated = leaf(lo, hi, terminated, nodeRayEnd, triBegin, triEnd);
-                nodeRayEnd = terminated;
-            } else {
+            {
                 // Front to back: the child on the rays' origin side first; the other waits on
                 // the stack with this node's ranges, which it filters again later.
                 vec3 lowHi = hi, highLo = lo;
@@ -134,12 +164,16 @@ void main() {
                     far.triBegin = triBegin;
                     far.triEnd = triEnd;
                     far.depth = depth + 1u;
+                    far.stalls = stalls;
                     sStack[stackSize] = far;
                 }
                 ++stackSize;
                 uint childRayEnd = partitionRays(terminated, nodeRayEnd, kKeepCrossing, nearLo - margin, nearHi + margin);
+                uint childTriEnd = triEnd;
                 if (childRayEnd > terminated)
-                    triEnd = partitionTriangles(triBegin, triEnd, nearLo - margin, nearHi + margin);
+                    childTriEnd = partitionTriangles(triBegin, triEnd, nearLo - margin, nearHi + margin);
+                stalls = childRayEnd == nodeRayEnd && childTriEnd == triEnd ? stalls + 1u : 0u;
+                triEnd = childTriEnd;
                 lo = nearLo;
                 hi = nearHi;
                 nodeRayEnd = childRayEnd;
@@ -153,7 +187,7 @@ void main() {
         }
         workgroupSync();
         StackEntry far = sStack[stackSize - 1u];
-        uint cost = partitionCost(far.rayEnd - terminated) + partitionCost(far.triEnd - far.triBegin) + 1u;
+        uint cost = partitionCost(far.rayEnd - terminated) + partitionCost(far.triEnd - far.triBegin) + kStepOverhead;
         if (overBudget(spent, cost + retireCost)) break;
         spent += cost;
         progressed = true;
@@ -166,6 +200,7 @@ void main() {
         triEnd = nodeRayEnd > terminated ? partitionTriangles(far.triBegin, far.triEnd, lo - margin, hi + margin)
                                          : far.triBegin;
         depth = far.depth;
+        stalls = nodeRayEnd == far.rayEnd && triEnd == far.triEnd ? far.stalls + 1u : 0u;
     }
 
     if (!finished) {
@@ -184,6 +219,8 @@ void main() {
             saved.triEnd = triEnd;
             saved.depth = depth;
             saved.stackSize = stackSize;
+            saved.stalls = stalls;
+            saved.leafNext = leafNext;
             states[itemIndex] = saved;
             regions[item.rayRegion].terminated = terminated;
             if (cutShort) atomicAdd(counters.loopLimitHits, 1u);

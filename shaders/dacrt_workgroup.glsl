@@ -77,14 +77,27 @@ uint partitionCost(uint n) {
     return 2u * ((n + kPartitionChunk - 1u) / kPartitionChunk) + 2u;
 }
 
-// ... and a leaf of rayCount rays and triCount triangles, its final partition included.
-uint leafCost(uint rayCount, uint triCount) {
-    uint lanes = max(1u, kWorkgroupSize / rayCount);
+// ... the ray/triangle tests of rayCount rays against triCount triangles (leafTests) ...
+uint leafTestCost(uint rayCount, uint triCount) {
+    uint lanes = max(1u, kWorkgroupSize / max(rayCount, 1u));
     uint raysPerPass = kWorkgroupSize / lanes;
     uint passes = (rayCount + raysPerPass - 1u) / raysPerPass;
     uint tiles = (triCount + kWorkgroupSize - 1u) / kWorkgroupSize;
     uint perTile = 2u + (kWorkgroupSize + lanes - 1u) / lanes;
-    return passes * (2u + tiles * perTile + lanes) + partitionCost(rayCount);
+    return passes * (2u + tiles * perTile + lanes);
+}
+
+// ... and a whole leaf, its final partition included.
+uint leafCost(uint rayCount, uint triCount) {
+    return leafTestCost(rayCount, triCount) + partitionCost(rayCount);
+}
+
+// The most of a leaf's rayCount rays whose tests fit in `available` loop iterations: all of
+// them, or whole passes of one ray per invocation (0 if not even one fits).
+uint leafRaysWithin(uint rayCount, uint triCount, uint available) {
+    if (leafTestCost(rayCount, triCount) <= available) return rayCount;
+    uint passes = available / leafTestCost(kWorkgroupSize, triCount);
+    return min(rayCount, passes * kWorkgroupSize);
 }
 
 const uint kKeepOverlapping = 5u;  // triangles whose bounds overlap the (widened) cell
@@ -107,7 +120,7 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         uint ids[kIdsPerInvocation];
         bool keeps[kIdsPerInvocation];
         uint myKept = 0;
-        for (uint e = 0; e < kIdsPerInvocation; ++e) {
+        [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             uint index = first + e;
             bool inRange = index < end;
             ids[e] = inRange ? (triangleIds ? triIds[index] : rayIds[index]) : 0u;
@@ -119,7 +132,7 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         // Every invocation before this one had a full run of ids (runs fill in order).
         uint droppedBefore = min(lane * kIdsPerInvocation, end - base) - keptBefore;
         uint k = begin + kept + keptBefore, d = secondHalf + begin + dropped + droppedBefore;
-        for (uint e = 0; e < kIdsPerInvocation; ++e) {
+        [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             if (first + e >= end) continue;
             uint slot = keeps[e] ? k++ : d++;
             if (triangleIds) triScratch[slot] = ids[e];
@@ -130,7 +143,7 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
     }
     workgroupSync();
     for (uint base = begin; base < end; base += kPartitionChunk) {
-        for (uint e = 0; e < kIdsPerInvocation; ++e) {
+        [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             uint index = base + lane * kIdsPerInvocation + e;
             if (index >= end) continue;
             uint offset = index - begin;
@@ -152,23 +165,20 @@ uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
     return partitionIds(begin, end, kKeepOverlapping, lo, hi);
 }
 
-// Every live ray of the leaf against every triangle of it; then the rays whose best hit
-// ends them inside the leaf box move to the front and `terminated` advances past them.
-// Every invocation stays busy: with fewer rays than invocations each ray gets `lanes`
+// Rays rayIds[rayBegin, rayEnd) of a leaf against its triangles, updating their best hits.
+// A large leaf may take several calls (slices) over consecutive ray ranges. Every
+// invocation stays busy: with fewer rays than invocations each ray gets `lanes`
 // invocations that split the triangles and reduce their bests; triangles are staged in
 // shared memory one workgroup-sized tile at a time.
-uint leaf(vec3 lo, vec3 hi, uint terminated, uint rayEnd, uint triBegin, uint triEnd) {
+void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
     uint lane = gl_LocalInvocationIndex;
-    uint rayCount = rayEnd - terminated;
+    uint rayCount = rayEnd - rayBegin;
     uint lanes = max(1u, kWorkgroupSize / rayCount);
     uint raysPerPass = kWorkgroupSize / lanes;
     uint myRay = lane / lanes;
     uint mySlot = lane % lanes;
-    if (lane == 0) {
-        atomicAdd(counters.leaves, 1u);
-        atomicAdd(counters.rayTriangleTests, rayCount * (triEnd - triBegin));
-    }
-    for (uint first = terminated; first < rayEnd; first += raysPerPass) {
+    if (lane == 0) atomicAdd(counters.rayTriangleTests, rayCount * (triEnd - triBegin));
+    for (uint first = rayBegin; first < rayEnd; first += raysPerPass) {
         uint index = first + myRay;
         bool rayActive = myRay < raysPerPass && index < rayEnd;
         uint id = rayActive ? rayIds[index] : 0u;
@@ -215,7 +225,19 @@ uint leaf(vec3 lo, vec3 hi, uint terminated, uint rayEnd, uint triBegin, uint tr
         if (rayActive && mySlot == 0) hits[id] = best;
         workgroupSync();
     }
+}
+
+// After a leaf's tests: the rays whose best hit ends them inside the leaf box move to the
+// front and the returned `terminated` is past them.
+uint finishLeaf(vec3 lo, vec3 hi, uint terminated, uint rayEnd) {
+    if (gl_LocalInvocationIndex == 0) atomicAdd(counters.leaves, 1u);
     return partitionRays(terminated, rayEnd, kKeepFinished, lo, hi);
+}
+
+// A whole leaf at once: every live ray against every triangle, then finishLeaf.
+uint leaf(vec3 lo, vec3 hi, uint terminated, uint rayEnd, uint triBegin, uint triEnd) {
+    leafTests(terminated, rayEnd, triBegin, triEnd);
+    return finishLeaf(lo, hi, terminated, rayEnd);
 }
 
 #endif

@@ -86,6 +86,10 @@ struct TraversalState {
     uint triEnd;
     uint depth;
     uint stackSize;
+    uint stalls;       // splits in a row that kept every ray and triangle (DACRT_MAX_STALLED_SPLITS)
+    uint leafNext;     // a leaf in progress: its rays before this were tested; 0 when none
+    uint pad0;
+    uint pad1;
 };
 
 struct StackEntry {   // a far child waiting, with its parent's ranges
@@ -95,8 +99,8 @@ struct StackEntry {   // a far child waiting, with its parent's ranges
     uint triBegin;
     uint triEnd;
     uint depth;
+    uint stalls;      // the parent's stalled splits
     uint pad0;
-    uint pad1;
 };
 
 // Push constants of the DACRT kernel.
@@ -162,6 +166,12 @@ struct WorkgroupTestPush {
 #define DACRT_BINDING_STACKS 12
 #define DACRT_BINDING_COUNT 13
 
+// A split whose child keeps every ray and every triangle of its parent made no progress;
+// after this many such splits in a row the node is a leaf. Identical rays meeting coincident
+// triangles never separate, and without this rule the traversal visits every cell along
+// their path down to the maximum depth (docs/stability.md).
+#define DACRT_MAX_STALLED_SPLITS 3u
+
 // Specialization constants of the DACRT kernel (constant_id).
 #define DACRT_SPEC_WORKGROUP_SIZE 0
 #define DACRT_SPEC_RAY_LIMIT 1
@@ -173,9 +183,11 @@ struct WorkgroupTestPush {
 static_assert(sizeof(WorkItem) == 32);
 static_assert(offsetof(WorkItem, triRegion) == 4 && offsetof(WorkItem, retire) == 8);
 static_assert(offsetof(WorkItem, raySeq) == 12 && offsetof(WorkItem, triSeq) == 16);
-static_assert(sizeof(TraversalState) == 48 && offsetof(TraversalState, phase) == 12);
+static_assert(sizeof(TraversalState) == 64 && offsetof(TraversalState, phase) == 12);
+static_assert(offsetof(TraversalState, stalls) == 48 && offsetof(TraversalState, leafNext) == 52);
 static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalState, stackSize) == 44);
 static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depth) == 36);
+static_assert(offsetof(StackEntry, stalls) == 40);
 static_assert(sizeof(DacrtPush) == 48 && offsetof(DacrtPush, loopProbe) == 32);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);

@@ -7,27 +7,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_support.hpp"
 #include "test_support.hpp"
 
 namespace {
 
-struct CommandResult {
-    int code = -1;
-    std::string output;  // stdout and stderr together
-};
+using dacrt::test::CommandResult;
 
-CommandResult run(const std::string& args) {
-    const std::string command = std::string(DACRT_BINARY) + " " + args + " 2>&1";
-    CommandResult r;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (!pipe) return r;
-    std::array<char, 4096> buffer{};
-    std::size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
+CommandResult run(const std::string& args) { return dacrt::test::runDacrt(args); }
 
 std::string temp(const std::string& name) { return ::testing::TempDir() + "/cli_" + name; }
 
