@@ -54,6 +54,11 @@ CLI::CheckedTransformer choices(const std::map<std::string, E>& map) {
     return CLI::CheckedTransformer(map, CLI::ignore_case);
 }
 
+CLI::CheckedTransformer backendChoices() {
+    return choices<Backend>(
+        {{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}, {"gpu", Backend::Gpu}});
+}
+
 }  // namespace
 
 int runCli(int argc, char** argv) {
@@ -69,8 +74,7 @@ int runCli(int argc, char** argv) {
     renderCmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id and hit mask");
     renderCmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
     renderCmd->add_option("--backend", render.trace.backend, "brute | cpu-seq | cpu | gpu")
-        ->transform(choices<Backend>(
-            {{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}, {"gpu", Backend::Gpu}}))
+        ->transform(backendChoices())
         ->default_str("cpu");
     renderCmd->add_option("--size", size, "image size WIDTHxHEIGHT")->default_str("640x480");
     renderCmd->add_option("--regions", render.trace.regions, "sub-scenes of the cpu backend (default: one per thread)")
@@ -120,8 +124,7 @@ int runCli(int argc, char** argv) {
     bool stressDefaultsOnly = false, stressNoDeterminism = false;
     CLI::App* stressCmd = app.add_subcommand("stress", "try to break every backend numerically (docs/stability.md)");
     stressCmd->add_option("--backends", stressBackends, "backends to run (default: brute cpu-seq cpu gpu)")
-        ->transform(choices<Backend>(
-            {{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}, {"gpu", Backend::Gpu}}))
+        ->transform(backendChoices())
         ->delimiter(',');
     stressCmd->add_option("--families", stressFamilyNames, "case families (default: watertight split-plane degenerate)")
         ->check(CLI::IsMember({"watertight", "split-plane", "degenerate"}))

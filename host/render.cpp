@@ -131,13 +131,7 @@ int runRender(const RenderOptions& o) {
         const auto frameStart = Clock::now();
         const auto raysStart = Clock::now();
         const std::vector<Ray> rays = primaryRays(cameras[std::size_t(k)], o.width, o.height);
-        FrameGeometry g;
-        g.triangles = &scene.triangles;
-        g.triangleBounds = &triangleBounds;
-        g.rays = &rays;
-        g.sceneBox = box;
-        g.rayOrigin = rays.front().origin;
-        g.margin = filterMargin(box, g.rayOrigin);
+        const FrameGeometry g = frameGeometry(scene.triangles, triangleBounds, rays, box);
         const double prepareMs = sharedPrepareMs + msSince(raysStart);
 
         auto onPlan = [&](const MemoryPlan& plan) {

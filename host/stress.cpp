@@ -47,6 +47,8 @@ long firstDifference(const std::vector<Hit>& a, const std::vector<Hit>& b) {
 
 }  // namespace
 
+StressConfig defaultStressConfig(Backend backend) { return config(toString(backend), true, backend); }
+
 void StressTally::add(const StressTally& o) {
     cases += o.cases;
     rays += o.rays;
@@ -66,7 +68,7 @@ void StressTally::add(const StressTally& o) {
 
 std::vector<StressConfig> stressConfigs(const std::vector<Backend>& backends, bool withOptions) {
     std::vector<StressConfig> out;
-    for (Backend b : backends) out.push_back(config(toString(b), true, b));
+    for (Backend b : backends) out.push_back(defaultStressConfig(b));
     if (!withOptions) return out;
     for (Backend b : backends) {
         const std::string base = toString(b);
@@ -107,14 +109,7 @@ std::vector<StressConfig> stressConfigs(const std::vector<Backend>& backends, bo
 
 FrameGeometry stressGeometry(const StressCase& c, std::vector<Bounds>& bounds) {
     bounds = allTriangleBounds(c.triangles);
-    FrameGeometry g;
-    g.triangles = &c.triangles;
-    g.triangleBounds = &bounds;
-    g.rays = &c.rays;
-    g.sceneBox = sceneBounds(c.triangles);
-    g.rayOrigin = c.rays.front().origin;
-    g.margin = filterMargin(g.sceneBox, g.rayOrigin);
-    return g;
+    return frameGeometry(c.triangles, bounds, c.rays, sceneBounds(c.triangles));
 }
 
 std::vector<Hit> traceStressCase(const StressCase& c, const StressConfig& config, StressDevices& devices) {
@@ -171,7 +166,7 @@ std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& bac
     std::vector<DeterminismResult> out;
     ThreadPool referencePool(2);
     StressDevices referenceDevices{referencePool, nullptr, nullptr};
-    const std::vector<Hit> reference = traceStressCase(scene, config("brute", true, Backend::Brute), referenceDevices);
+    const std::vector<Hit> reference = traceStressCase(scene, defaultStressConfig(Backend::Brute), referenceDevices);
 
     auto check = [&](const std::string& name, const std::vector<std::pair<std::string, StressConfig>>& runs,
                      const std::vector<unsigned>& threadCounts) {
@@ -200,16 +195,16 @@ std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& bac
         const std::string base = toString(b);
         if (b == Backend::Gpu && !devices.gpu) continue;
         std::vector<std::pair<std::string, StressConfig>> repeats;
-        for (int k = 0; k < 10; ++k) repeats.emplace_back("run " + std::to_string(k), config(base, true, b));
+        for (int k = 0; k < 10; ++k) repeats.emplace_back("run " + std::to_string(k), defaultStressConfig(b));
         check(base + ": 10 runs", repeats, {});
         if (b != Backend::CpuSeq && b != Backend::Gpu) {
             // Thread counts change the default region count of cpu, and the work split of both.
-            check(base + ": threads 1, 2, 3, 4, 8", {{base, config(base, true, b)}}, {1, 2, 3, 4, 8});
+            check(base + ": threads 1, 2, 3, 4, 8", {{base, defaultStressConfig(b)}}, {1, 2, 3, 4, 8});
         }
         if (b == Backend::Cpu || b == Backend::Gpu) {
             std::vector<std::pair<std::string, StressConfig>> regions;
             for (unsigned n = 1; n <= 64; ++n) {
-                StressConfig c = config(base, true, b);
+                StressConfig c = defaultStressConfig(b);
                 c.trace.regions = n;
                 regions.emplace_back("--regions " + std::to_string(n), c);
             }
@@ -244,7 +239,7 @@ int runStressCommand(const StressCommand& command) {
 
     // Brute force is the reference every other configuration is compared with, bit for bit.
     std::vector<std::vector<Hit>> reference(cases.size());
-    const StressConfig brute = config("brute", true, Backend::Brute);
+    const StressConfig brute = defaultStressConfig(Backend::Brute);
     std::vector<double> referenceMs(cases.size());
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const auto start = Clock::now();

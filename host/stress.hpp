@@ -23,6 +23,9 @@ struct StressConfig {
     std::uint32_t workgroupSize = 0;  // gpu only; 0 = the device's default
 };
 
+// A backend's default configuration, named as the backend.
+StressConfig defaultStressConfig(Backend backend);
+
 // The default configuration of each backend, then, with options, every non-default value
 // of the options that could change which triangles a ray is tested against.
 std::vector<StressConfig> stressConfigs(const std::vector<Backend>& backends, bool withOptions);

@@ -42,6 +42,18 @@ float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin) {
     return std::max(m * 0x1p-18f, 0x1p-100f);
 }
 
+FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
+                            const std::vector<Ray>& rays, const Box& sceneBox) {
+    FrameGeometry g;
+    g.triangles = &triangles;
+    g.triangleBounds = &bounds;
+    g.rays = &rays;
+    g.sceneBox = sceneBox;
+    g.rayOrigin = rays.front().origin;
+    g.margin = filterMargin(sceneBox, g.rayOrigin);
+    return g;
+}
+
 std::string MemoryPlan::describe() const {
     std::ostringstream s;
     for (const auto& [name, bytes] : buffers)

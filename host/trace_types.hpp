@@ -51,6 +51,11 @@ struct FrameGeometry {
 // coordinate magnitude among the scene bounds and the ray origin.
 float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin);
 
+// The frame every tracer reads: the arrays (which must outlive it), the scene box, the rays'
+// common origin (the first ray's) and the filter margin derived from both.
+FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
+                            const std::vector<Ray>& rays, const Box& sceneBox);
+
 struct Counters {
     std::uint64_t rayBoxTests = 0;
     std::uint64_t rayTriangleTests = 0;

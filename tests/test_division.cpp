@@ -52,7 +52,9 @@ TEST(Division, BinsEveryRayThatCanHitAndEveryOverlappingTriangle) {
         std::vector<int> seen(frame.rays.size(), 0);
         for (unsigned k = 0; k < n; ++k) {
             const Region& r = d.regions[k];
-            if (k > 0) EXPECT_EQ(r.lo.x, d.regions[k - 1].hi.x);
+            if (k > 0) {
+                EXPECT_EQ(r.lo.x, d.regions[k - 1].hi.x);
+            }
             for (std::uint32_t i = r.rayBegin; i < r.rayEnd; ++i) ++seen[d.rayIds[i]];
             std::set<std::uint32_t> tris(d.triIds.begin() + r.triBegin, d.triIds.begin() + r.triEnd);
             EXPECT_EQ(tris.size(), r.triEnd - r.triBegin) << "a triangle twice in one region";
@@ -65,7 +67,9 @@ TEST(Division, BinsEveryRayThatCanHitAndEveryOverlappingTriangle) {
         const std::vector<Hit> brute = frame.trace(Backend::Brute, 0, 2).hits;
         for (std::size_t i = 0; i < seen.size(); ++i) {
             EXPECT_LE(seen[i], 1) << "ray " << i << " binned twice";
-            if (brute[i].prim != kMissPrim) EXPECT_EQ(seen[i], 1) << "ray " << i << " hits but was culled";
+            if (brute[i].prim != kMissPrim) {
+                EXPECT_EQ(seen[i], 1) << "ray " << i << " hits but was culled";
+            }
         }
         EXPECT_EQ(d.culledRays + d.rayIds.size(), frame.rays.size());
         EXPECT_EQ(d.triIds.size(), frame.bounds.size() + d.straddlerCopies);

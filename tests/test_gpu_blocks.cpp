@@ -196,7 +196,9 @@ TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
         EXPECT_EQ(in.rayIds, expectedIds);
         std::size_t hitsFound = 0;
         for (std::uint32_t k = begin; k < end; ++k) hitsFound += expectedHits[in.rayIds[k]].prim != kMissPrim;
-        if (rays >= 50) EXPECT_GT(hitsFound, 0u) << "the random leaf should hit something";
+        if (rays >= 50) {
+            EXPECT_GT(hitsFound, 0u) << "the random leaf should hit something";
+        }
     }
     EXPECT_TRUE(noValidationErrors(*context));
 }

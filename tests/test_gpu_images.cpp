@@ -101,7 +101,9 @@ TEST(GpuImages, SlicedWorkItemsMatchTheUnslicedOnes) {
     ThreadPool pool(1);
     const TraceResult r = traceGpu(frame.geometry, o, GpuTuning{context->info().subgroupSize}, *context, pool);
     EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, r.hits));
-    if (loopBudgetOf(context->info()) > 0) EXPECT_GT(r.gpu->slices, 1u) << "expected the work item to need several slices";
+    if (loopBudgetOf(context->info()) > 0) {
+        EXPECT_GT(r.gpu->slices, 1u) << "expected the work item to need several slices";
+    }
     EXPECT_TRUE(noValidationErrors(*context));
 }
 

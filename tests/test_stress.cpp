@@ -40,9 +40,7 @@ const FamilyData& family(const std::string& name) {
         slot->cases = stressCases({name}, StressSize::Small, kSeed);
         ThreadPool pool(2);
         StressDevices devices{pool};
-        StressConfig brute;
-        brute.name = "brute";
-        brute.trace.backend = Backend::Brute;
+        const StressConfig brute = defaultStressConfig(Backend::Brute);
         for (const StressCase& c : slot->cases) slot->brute.push_back(traceStressCase(c, brute, devices));
     }
     return *slot;
@@ -159,8 +157,7 @@ TEST(StressCases, LeakCountingCatchesAHole) {
     holed.triangles[0].v1 = holed.triangles[0].v0;  // zero area: never hit
     ThreadPool pool(2);
     StressDevices devices{pool};
-    StressConfig brute;
-    brute.trace.backend = Backend::Brute;
+    const StressConfig brute = defaultStressConfig(Backend::Brute);
     const StressTally t = tallyStressCase(holed, traceStressCase(holed, brute, devices), nullptr);
     EXPECT_GT(t.leaks, 0u);
     EXPECT_EQ(tallyStressCase(*sphere, traceStressCase(*sphere, brute, devices), nullptr).leaks, 0u);

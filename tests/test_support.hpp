@@ -36,12 +36,7 @@ struct Frame {
     Frame(Scene s, const Camera& camera, int w, int h) : scene(std::move(s)), width(w), height(h) {
         bounds = allTriangleBounds(scene.triangles);
         rays = primaryRays(camera, w, h);
-        geometry.triangles = &scene.triangles;
-        geometry.triangleBounds = &bounds;
-        geometry.rays = &rays;
-        geometry.sceneBox = sceneBounds(scene.triangles);
-        geometry.rayOrigin = rays.front().origin;
-        geometry.margin = filterMargin(geometry.sceneBox, geometry.rayOrigin);
+        geometry = frameGeometry(scene.triangles, bounds, rays, sceneBounds(scene.triangles));
     }
     Frame(const Frame&) = delete;
 
