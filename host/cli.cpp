@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench.hpp"
 #include "compare.hpp"
 #include "errors.hpp"
 #include "render.hpp"
@@ -54,9 +55,40 @@ CLI::CheckedTransformer choices(const std::map<std::string, E>& map) {
     return CLI::CheckedTransformer(map, CLI::ignore_case);
 }
 
-CLI::CheckedTransformer backendChoices() {
-    return choices<Backend>(
-        {{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}, {"gpu", Backend::Gpu}});
+std::map<std::string, Backend> dacrtBackends() {
+    return {{"brute", Backend::Brute}, {"cpu-seq", Backend::CpuSeq}, {"cpu", Backend::Cpu}, {"gpu", Backend::Gpu}};
+}
+
+CLI::CheckedTransformer backendChoices(bool withEmbree) {
+    std::map<std::string, Backend> m = dacrtBackends();
+    if (withEmbree) m.emplace("embree", Backend::Embree);
+    return choices<Backend>(m);
+}
+
+// The DACRT options that render and bench share.
+void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
+    cmd->add_option("--split", o.split, "DACRT split: spatial-median | centroid-mean | sampled-mean")
+        ->transform(choices<SplitMethod>({{"spatial-median", SplitMethod::SpatialMedian},
+                                          {"centroid-mean", SplitMethod::CentroidMean},
+                                          {"sampled-mean", SplitMethod::SampledMean}}))
+        ->default_str(toString(DacrtOptions{}.split));
+    const std::string limits = std::to_string(kCpuLeafLimit) + " on the cpu backends, " + std::to_string(kGpuLeafLimit) + " on gpu";
+    cmd->add_option("--ray-limit", o.rayLimit, "leaf when fewer live rays")
+        ->check(CLI::Range(1u, 1u << 30))->default_str(limits);
+    cmd->add_option("--tri-limit", o.triLimit, "leaf when fewer triangles")
+        ->check(CLI::Range(1u, 1u << 30))->default_str(limits);
+    cmd->add_option("--intersector", o.intersector, "leaf ray/triangle test: watertight | moller-trumbore (cpu, cpu-seq)")
+        ->transform(choices<Intersector>(
+            {{"watertight", Intersector::Watertight}, {"moller-trumbore", Intersector::MollerTrumbore}}))
+        ->default_str(toString(DacrtOptions{}.intersector));
+    cmd->add_option("--triangle-filter", o.triangleFilter,
+                    "triangle/box filter: bounds | sat (exact separating axes) | mora (inexact) (cpu, cpu-seq)")
+        ->transform(choices<TriangleFilter>(
+            {{"bounds", TriangleFilter::Bounds}, {"sat", TriangleFilter::Sat}, {"mora", TriangleFilter::Mora}}))
+        ->default_str(toString(DacrtOptions{}.triangleFilter));
+    cmd->add_option("--precision", o.precision, "leaf ray/triangle arithmetic: f32 | f64 (cpu, cpu-seq)")
+        ->transform(choices<Precision>({{"f32", Precision::F32}, {"f64", Precision::F64}}))
+        ->default_str(toString(DacrtOptions{}.precision));
 }
 
 }  // namespace
@@ -73,8 +105,8 @@ int runCli(int argc, char** argv) {
     renderCmd->add_option("-o,--output", render.outputPath, "shaded image (PNG or any OpenImageIO format)");
     renderCmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id and hit mask");
     renderCmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
-    renderCmd->add_option("--backend", render.trace.backend, "brute | cpu-seq | cpu | gpu")
-        ->transform(backendChoices())
+    renderCmd->add_option("--backend", render.trace.backend, "brute | cpu-seq | cpu | gpu | embree")
+        ->transform(backendChoices(true))
         ->default_str("cpu");
     renderCmd->add_option("--size", size, "image size WIDTHxHEIGHT")->default_str("640x480");
     renderCmd->add_option("--regions", render.trace.regions, "sub-scenes of the cpu backend (default: one per thread)")
@@ -85,15 +117,8 @@ int runCli(int argc, char** argv) {
         ->transform(choices<DivisionAxis>(
             {{"best", DivisionAxis::Best}, {"x", DivisionAxis::X}, {"y", DivisionAxis::Y}, {"z", DivisionAxis::Z}}))
         ->default_str("best");
-    renderCmd->add_option("--split", render.trace.dacrt.split, "DACRT split: spatial-median | centroid-mean | sampled-mean")
-        ->transform(choices<SplitMethod>({{"spatial-median", SplitMethod::SpatialMedian},
-                                          {"centroid-mean", SplitMethod::CentroidMean},
-                                          {"sampled-mean", SplitMethod::SampledMean}}))
-        ->default_str(toString(DacrtOptions{}.split));
-    renderCmd->add_option("--ray-limit", render.trace.dacrt.rayLimit, "leaf when fewer live rays")
-        ->check(CLI::Range(1u, 1u << 30))->default_str(std::to_string(DacrtOptions{}.rayLimit));
-    renderCmd->add_option("--tri-limit", render.trace.dacrt.triLimit, "leaf when fewer triangles")
-        ->check(CLI::Range(1u, 1u << 30))->default_str(std::to_string(DacrtOptions{}.triLimit));
+    addDacrtOptions(renderCmd, render.trace.dacrt);
+    renderCmd->add_flag("--embree-fast", render.embreeFast, "embree: without RTC_SCENE_FLAG_ROBUST (faster, leaks through edges)");
     renderCmd->add_option("--eye", eye, "camera position x,y,z");
     renderCmd->add_option("--target", target, "point the camera looks at x,y,z");
     renderCmd->add_option("--up", up, "camera up vector x,y,z");
@@ -124,7 +149,7 @@ int runCli(int argc, char** argv) {
     bool stressDefaultsOnly = false, stressNoDeterminism = false;
     CLI::App* stressCmd = app.add_subcommand("stress", "try to break every backend numerically (docs/stability.md)");
     stressCmd->add_option("--backends", stressBackends, "backends to run (default: brute cpu-seq cpu gpu)")
-        ->transform(backendChoices())
+        ->transform(backendChoices(false))
         ->delimiter(',');
     stressCmd->add_option("--families", stressFamilyNames, "case families (default: watertight split-plane degenerate)")
         ->check(CLI::IsMember({"watertight", "split-plane", "degenerate"}))
@@ -137,6 +162,28 @@ int runCli(int argc, char** argv) {
     stressCmd->add_option("--json", stress.jsonPath, "write the table and checks as JSON");
     stressCmd->add_option("--device", stress.device, "gpu: Vulkan device index or part of its name");
     stressCmd->add_flag("--validate", stress.validate, "gpu: run under the Vulkan validation layers; errors fail the run");
+
+    BenchCommand bench;
+    std::string benchSize = "640x480", benchSuite = "sweep";
+    bool benchNoCache = false;
+    CLI::App* benchCmd = app.add_subcommand("bench", "frame time against error for every backend and option (docs/benchmarks.md)");
+    benchCmd->add_option("scenes", bench.scenes, "glTF scenes")->required();
+    benchCmd->add_option("--backends", bench.backends, "backends (default: cpu-seq cpu gpu embree; gpu only with a device)")
+        ->transform(backendChoices(true))
+        ->delimiter(',');
+    benchCmd->add_option("--suite", benchSuite, "sweep (every option value) or table51 (the source's Table 5.1 and Figure 5.3)")
+        ->check(CLI::IsMember({"sweep", "table51"}))->default_str("sweep");
+    benchCmd->add_option("--orbit", bench.orbit, "K cameras on a circle about the vertical axis")->check(CLI::Range(1, 1000))->default_str("1");
+    benchCmd->add_option("--size", benchSize, "image size WIDTHxHEIGHT")->default_str("640x480");
+    benchCmd->add_option("--repeat", bench.repeat, "timed frames per camera and configuration")->check(CLI::Range(1, 1000))->default_str("3");
+    benchCmd->add_option("--warmup", bench.warmup, "untimed frames first")->check(CLI::Range(0, 1000))->default_str("1");
+    benchCmd->add_option("--csv", bench.csvPath, "write one row per scene and configuration");
+    benchCmd->add_option("--json", bench.jsonPath, "write the rows with their time parts");
+    benchCmd->add_option("--plot", bench.plotPath, "PNG of frame time against error per scene, Pareto front marked");
+    benchCmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
+    benchCmd->add_flag("--no-cache", benchNoCache, "always recompute the float64 reference");
+    benchCmd->add_option("--device", bench.device, "gpu: Vulkan device index or part of its name");
+    benchCmd->add_flag("--validate", bench.validate, "gpu: run under the Vulkan validation layers; errors fail the run");
 
     try {
         app.parse(argc, argv);
@@ -155,6 +202,12 @@ int runCli(int argc, char** argv) {
             if (!up.empty()) render.camera.up = parseVec3("--up", up);
             if (renderCmd->count("--fov")) render.camera.fovDegrees = fov;
             return runRender(render);
+        }
+        if (*benchCmd) {
+            parseSize(benchSize, bench.width, bench.height);
+            bench.suite = benchSuite == "table51" ? BenchSuite::Table51 : BenchSuite::Sweep;
+            bench.useCache = !benchNoCache;
+            return runBenchCommand(bench);
         }
         if (*stressCmd) {
             stress.size = stressSize == "small" ? StressSize::Small : StressSize::Large;

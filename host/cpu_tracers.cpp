@@ -4,6 +4,7 @@
 #include <numeric>
 
 #include "dacrt_traversal.hpp"
+#include "errors.hpp"
 #include "scene_division.hpp"
 #include "timing.hpp"
 
@@ -144,13 +145,17 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
 }
 
 TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool, const PlanHook& onPlan) {
+    if (options.backend == Backend::Brute && !options.dacrt.exactDefaults())
+        throw InputError("--intersector, --triangle-filter and --precision are DACRT options (cpu, cpu-seq); brute "
+                         "force always runs the watertight float32 test");
     switch (options.backend) {
         case Backend::Brute: return traceBrute(g, pool, onPlan);
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);
         case Backend::Cpu: return traceParallel(g, options, pool, onPlan);
-        case Backend::Gpu: break;
+        case Backend::Gpu:
+        case Backend::Embree: break;
     }
-    throw std::logic_error("traceCpu called for the gpu backend");
+    throw std::logic_error("traceCpu called for the " + toString(options.backend) + " backend");
 }
 
 }  // namespace dacrt

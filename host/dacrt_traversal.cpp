@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "triangle_tests.hpp"
+
 namespace dacrt {
 namespace {
 
@@ -27,7 +29,7 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       triangleBounds_(g.triangleBounds->data()),
       origin_(g.rayOrigin),
       margin_(g.margin),
-      options_(options),
+      options_(options.resolvedFor(Backend::Cpu)),
       hits_(hits),
       rayIds_(rayIds),
       triIds_(triIds),
@@ -63,11 +65,28 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
     return std::uint32_t(first - rayIds_);
 }
 
-std::uint32_t DacrtTraversal::filterTriangles(const Box& cell, std::uint32_t begin, std::uint32_t end) {
-    std::uint32_t* first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
-        const Bounds& b = triangleBounds_[id];
-        return shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
-    });
+std::uint32_t DacrtTraversal::filterTriangles(const Box& child, const Box& cell, std::uint32_t begin,
+                                              std::uint32_t end) {
+    std::uint32_t* first = triIds_ + begin;
+    switch (options_.triangleFilter) {
+        case TriangleFilter::Bounds:
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                const Bounds& b = triangleBounds_[id];
+                return shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
+            });
+            break;
+        case TriangleFilter::Sat:
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                return triangleOverlapsBoxSat(triangles_[id], triangleBounds_[id], cell.lo, cell.hi);
+            });
+            break;
+        case TriangleFilter::Mora:
+            // The unwidened child: Mora's test has no rounding margin (that is its price).
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                return triangleOverlapsBoxMora(triangles_[id], triangleBounds_[id], child.lo, child.hi, end - begin);
+            });
+            break;
+    }
     return std::uint32_t(first - triIds_);
 }
 
@@ -107,23 +126,37 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
         const Box cell = widen(*child, margin_);
         const std::uint32_t childRays = filterRays(cell, terminated, rayEnd);
         if (childRays == terminated) continue;
-        const std::uint32_t childTris = filterTriangles(cell, triBegin, triEnd);
+        const std::uint32_t childTris = filterTriangles(*child, cell, triBegin, triEnd);
         const bool stalled = childRays == rayEnd && childTris == triEnd;
         node(*child, terminated, childRays, triBegin, childTris, depth + 1, stalled ? stalls + 1 : 0);
     }
 }
 
-[[gnu::flatten]] void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
                           std::uint32_t triEnd) {
     ++counters_.leaves;
     counters_.rayTriangleTests += std::uint64_t(rayEnd - terminated) * (triEnd - triBegin);
+    auto same = [](const Ray& ray) -> const Ray& { return ray; };
+    if (options_.precision == Precision::F64)
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, toF64, testTriangleF64);
+    else if (options_.intersector == Intersector::MollerTrumbore)
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, same, testTriangleMollerTrumbore);
+    else
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, same, testTriangle);
+}
+
+template <typename PrepareRay, typename TestTriangle>
+[[gnu::flatten]] void DacrtTraversal::leafWith(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
+                                               std::uint32_t triBegin, std::uint32_t triEnd, PrepareRay prepare,
+                                               TestTriangle test) {
     for (std::uint32_t k = terminated; k < rayEnd; ++k) {
         const std::uint32_t rayId = rayIds_[k];
         const Ray& ray = rays_[rayId];
+        const auto& prepared = prepare(ray);
         Hit best = hits_[rayId];
         for (std::uint32_t j = triBegin; j < triEnd; ++j) {
             const std::uint32_t prim = triIds_[j];
-            testTriangle(ray, triangles_[prim], prim, best);
+            test(prepared, triangles_[prim], prim, best);
         }
         hits_[rayId] = best;
         if (best.prim != kMissPrim && shared::hitEndsInBox(ray, box.lo, box.hi, best.t)) {
@@ -131,6 +164,20 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
             ++terminated;
         }
     }
+}
+
+void testTriangleMollerTrumbore(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
+    const shared::TriangleHit h = intersectMollerTrumbore(ray, tri.v0, tri.v1, tri.v2);
+    if (h.hit && h.t > ray.tmin && shared::hitPrecedes(h.t, prim, best.t, best.prim)) best = Hit{h.t, prim, h.u, h.v};
+}
+
+void testTriangleF64(const RayF64& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
+    // The float64 hit is rounded to float32 for the tie rule and the result: hits closer than
+    // half a float32 ulp in depth become ties (lowest id), which the benchmark counts as near ties.
+    const TriangleHitF64 h = intersectWatertightF64(ray, tri.v0, tri.v1, tri.v2);
+    if (!h.hit || !(h.t > ray.tmin)) return;
+    const float t = float(h.t);
+    if (shared::hitPrecedes(t, prim, best.t, best.prim)) best = Hit{t, prim, float(h.u), float(h.v)};
 }
 
 }  // namespace dacrt

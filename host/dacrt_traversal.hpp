@@ -36,7 +36,11 @@ private:
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd);
     std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);
-    std::uint32_t filterTriangles(const Box& cell, std::uint32_t begin, std::uint32_t end);
+    template <typename PrepareRay, typename TestTriangle>
+    void leafWith(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                  std::uint32_t triEnd, PrepareRay prepare, TestTriangle test);
+    // cell is child widened by the filter margin; the Mora filter reads child itself.
+    std::uint32_t filterTriangles(const Box& child, const Box& cell, std::uint32_t begin, std::uint32_t end);
     float splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const;
 
     const Ray* rays_;
@@ -59,5 +63,10 @@ inline void testTriangle(const Ray& ray, const Triangle& tri, std::uint32_t prim
     const shared::TriangleHit h = shared::intersectWatertight(ray, tri.v0, tri.v1, tri.v2);
     if (h.hit && h.t > ray.tmin && shared::hitPrecedes(h.t, prim, best.t, best.prim)) best = Hit{h.t, prim, h.u, h.v};
 }
+
+// The leaf tests of the non-default options (docs/benchmarks.md prices them).
+void testTriangleMollerTrumbore(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best);
+struct RayF64;
+void testTriangleF64(const RayF64& ray, const Triangle& tri, std::uint32_t prim, Hit& best);
 
 }  // namespace dacrt

@@ -1,5 +1,7 @@
 #include "gpu_tracer.hpp"
 
+#include <thread>
+
 #include "dacrt_traversal.hpp"
 #include "errors.hpp"
 #include "scene_division.hpp"
@@ -39,11 +41,23 @@ vk::ComputePipeline& PipelineCache::get(const std::vector<std::uint32_t>& specia
     return *slot;
 }
 
+unsigned defaultGpuRegions(const vk::DeviceInfo& device) {
+    // A CPU device runs one workgroup per thread: one region per core, as for the cpu backend,
+    // measured best on lavapipe (docs/benchmarks.md: 2 regions beat 16 by 35% on the Bunny
+    // and 17% on the Dragon). A GPU wants many work items; 16 is unmeasured there.
+    return device.type == "cpu" ? std::max(1u, std::thread::hardware_concurrency()) : 16u;
+}
+
 TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const GpuTuning& tuning,
                      vk::Context& context, ThreadPool& pool, const PlanHook& onPlan, PipelineCache* pipelines) {
     const vk::DeviceInfo& device = context.info();
     if (options.dacrt.split != SplitMethod::SpatialMedian)
         throw InputError("--split " + toString(options.dacrt.split) + " is not available on the gpu backend (spatial-median only)");
+    if (!options.dacrt.exactDefaults())
+        throw InputError("--intersector " + toString(options.dacrt.intersector) + ", --triangle-filter " +
+                         toString(options.dacrt.triangleFilter) + ", --precision " + toString(options.dacrt.precision) +
+                         ": the gpu backend runs only the defaults (watertight, bounds, f32); the others are cpu and "
+                         "cpu-seq options");
     if (!device.subgroupArithmetic)
         throw InputError("device '" + device.name + "' lacks subgroup arithmetic in compute shaders, which the gpu backend needs");
     const std::uint32_t loopBudget = loopBudgetOf(device);
@@ -54,7 +68,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     report.device = device.name;
     report.driver = device.driver;
     report.subgroupSize = device.subgroupSize;
-    const unsigned regions = options.regions ? options.regions : 16;  // measured best on lavapipe (docs/gpu.md)
+    const unsigned regions = options.regions ? options.regions : defaultGpuRegions(device);
     result.regions = regions;
     result.threads = pool.size();
 
@@ -148,7 +162,8 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     start = Clock::now();
     PipelineCache frameOnly(context);
     vk::ComputePipeline& pipeline = (pipelines ? *pipelines : frameOnly)
-                                        .get({workgroupSize, options.dacrt.rayLimit, options.dacrt.triLimit,
+                                        .get({workgroupSize, options.dacrt.resolvedFor(Backend::Gpu).rayLimit,
+                                              options.dacrt.resolvedFor(Backend::Gpu).triLimit,
                                               options.dacrt.maxDepth, loopBudget});
     std::vector<const vk::Buffer*> bound;
     for (const vk::Buffer& b : buffers) bound.push_back(&b);

@@ -38,6 +38,9 @@ std::uint32_t loopBudgetOf(const vk::DeviceInfo& device);
 std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t largestRegionRays,
                                    std::uint32_t largestRegionTriangles);
 
+// Regions when --regions is not given.
+unsigned defaultGpuRegions(const vk::DeviceInfo& device);
+
 TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
                      vk::Context& context, ThreadPool& pool, const PlanHook& onPlan = {},
                      PipelineCache* pipelines = nullptr);

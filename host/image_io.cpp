@@ -32,7 +32,7 @@ void writePixels(const std::string& path, const OIIO::ImageSpec& spec, OIIO::Typ
 
 }  // namespace
 
-void writeShaded(const std::string& path, const Scene& scene, const HitImage& image) {
+std::vector<std::uint8_t> shadeImage(const Scene& scene, const HitImage& image) {
     const glm::vec3 background(0.18f, 0.20f, 0.24f);
     std::vector<std::uint8_t> rgb(std::size_t(image.width) * std::size_t(image.height) * 3);
     for (std::size_t i = 0; i < image.hits->size(); ++i) {
@@ -46,6 +46,11 @@ void writeShaded(const std::string& path, const Scene& scene, const HitImage& im
         }
         for (int k = 0; k < 3; ++k) rgb[i * 3 + std::size_t(k)] = srgb8(c[k]);
     }
+    return rgb;
+}
+
+void writeShaded(const std::string& path, const Scene& scene, const HitImage& image) {
+    const std::vector<std::uint8_t> rgb = shadeImage(scene, image);
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
     writePixels(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
 }

@@ -16,6 +16,10 @@ struct HitImage {
 };
 
 // Headlight Lambert (|cos| between ray and geometric normal) times the base colour, sRGB
+// encoded to 8-bit RGB; misses get a fixed background.
+std::vector<std::uint8_t> shadeImage(const Scene& scene, const HitImage& image);
+
+// Headlight Lambert (|cos| between ray and geometric normal) times the base colour, sRGB
 // encoded; misses get a fixed background. Any format OpenImageIO writes from the extension.
 void writeShaded(const std::string& path, const Scene& scene, const HitImage& image);
 

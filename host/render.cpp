@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cpu_tracers.hpp"
+#include "embree_tracer.hpp"
 #include "errors.hpp"
 #include "gltf_loader.hpp"
 #include "gpu_tracer.hpp"
@@ -42,9 +43,13 @@ nlohmann::ordered_json statsJson(const RenderOptions& o, const Scene& scene, con
     j["division_axis"] = r.axis < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(std::string(1, "xyz"[r.axis]));
     j["camera"] = {{"index", cameraIndex}, {"eye", vec(camera.eye)}, {"forward", vec(camera.forward)},
                    {"up", vec(camera.up)}, {"yfov_degrees", glm::degrees(camera.yfovRadians)}};
-    j["options"] = {{"ray_limit", o.trace.dacrt.rayLimit}, {"tri_limit", o.trace.dacrt.triLimit},
+    const DacrtOptions dacrt = o.trace.dacrt.resolvedFor(o.trace.backend);
+    j["options"] = {{"ray_limit", dacrt.rayLimit}, {"tri_limit", dacrt.triLimit},
                     {"max_depth", o.trace.dacrt.maxDepth}, {"split", toString(o.trace.dacrt.split)},
-                    {"axis", toString(o.trace.axis)}, {"intersector", "watertight"}};
+                    {"axis", toString(o.trace.axis)}, {"intersector", toString(o.trace.dacrt.intersector)},
+                    {"triangle_filter", toString(o.trace.dacrt.triangleFilter)},
+                    {"precision", toString(o.trace.dacrt.precision)}};
+    if (o.trace.backend == Backend::Embree) j["options"] = {{"robust", !o.embreeFast}};
     nlohmann::ordered_json t;
     for (const auto& [name, ms] : timings) t[name] = ms;
     nlohmann::ordered_json phases;
@@ -106,6 +111,10 @@ int runRender(const RenderOptions& o) {
     const auto start = Clock::now();
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw InputError("--size: width and height must lie in 1..16384");
+    if (o.trace.backend == Backend::Embree && o.planOnly)
+        throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
+    if (o.trace.backend == Backend::Embree && !o.trace.dacrt.exactDefaults())
+        throw InputError("--intersector, --triangle-filter and --precision are DACRT options; embree has its own test");
     Scene scene = loadGltf(o.scenePath);
     const double loadMs = msSince(start);
 
@@ -149,8 +158,13 @@ int runRender(const RenderOptions& o) {
             return true;
         };
         const auto traceStart = Clock::now();
-        const TraceResult result = gpu ? traceGpu(g, o.trace, GpuTuning{o.workgroupSize}, *gpu, pool, onPlan, pipelines.get())
-                                       : traceCpu(g, o.trace, pool, onPlan);
+        TraceResult result;
+        if (gpu)
+            result = traceGpu(g, o.trace, GpuTuning{o.workgroupSize}, *gpu, pool, onPlan, pipelines.get());
+        else if (o.trace.backend == Backend::Embree)
+            result = traceEmbree(g, EmbreeOptions{!o.embreeFast, threads}, pool);
+        else
+            result = traceCpu(g, o.trace, pool, onPlan);
         if (o.planOnly) continue;
         const double traceMs = msSince(traceStart);
 

@@ -12,6 +12,7 @@ std::string toString(Backend b) {
         case Backend::CpuSeq: return "cpu-seq";
         case Backend::Cpu: return "cpu";
         case Backend::Gpu: return "gpu";
+        case Backend::Embree: return "embree";
     }
     return "?";
 }
@@ -34,6 +35,21 @@ std::string toString(DivisionAxis a) {
     }
     return "?";
 }
+
+std::string toString(Intersector i) {
+    return i == Intersector::Watertight ? "watertight" : "moller-trumbore";
+}
+
+std::string toString(TriangleFilter f) {
+    switch (f) {
+        case TriangleFilter::Bounds: return "bounds";
+        case TriangleFilter::Sat: return "sat";
+        case TriangleFilter::Mora: return "mora";
+    }
+    return "?";
+}
+
+std::string toString(Precision p) { return p == Precision::F32 ? "f32" : "f64"; }
 
 float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin) {
     float m = 0.0f;

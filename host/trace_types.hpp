@@ -12,19 +12,54 @@
 
 namespace dacrt {
 
-enum class Backend { Brute, CpuSeq, Cpu, Gpu };
+enum class Backend { Brute, CpuSeq, Cpu, Gpu, Embree };
 enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
 enum class DivisionAxis { Best, X, Y, Z };
+// Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks
+// through shared edges; Moller-Trumbore is the classic faster test without that guarantee.
+enum class Intersector { Watertight, MollerTrumbore };
+// Which triangles a DACRT node keeps for a child cell. Bounds (the default) and Sat are
+// conservative; Mora is deliberately inexact (docs/benchmarks.md measures its price).
+enum class TriangleFilter { Bounds, Sat, Mora };
+// Arithmetic of the leaf's ray/triangle test: the filters stay float32 in both cases (their
+// margin also covers the smaller float64 rounding).
+enum class Precision { F32, F64 };
 
 std::string toString(Backend b);
 std::string toString(SplitMethod s);
 std::string toString(DivisionAxis a);
+std::string toString(Intersector i);
+std::string toString(TriangleFilter f);
+std::string toString(Precision p);
+
+// Leaf limits of each backend when DacrtOptions leaves them 0, chosen by measurement
+// (docs/benchmarks.md): a leaf costs the CPU one test per pair, while a workgroup pays a
+// fixed cost per partition step, so the gpu stops splitting earlier.
+constexpr std::uint32_t kCpuLeafLimit = 8;
+constexpr std::uint32_t kGpuLeafLimit = 32;
 
 struct DacrtOptions {
-    std::uint32_t rayLimit = 16;   // a node with fewer live rays is a leaf
-    std::uint32_t triLimit = 16;   // a node with fewer triangles is a leaf
+    std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default
+    std::uint32_t triLimit = 0;    // a node with fewer triangles is a leaf; 0: the backend's default
     std::uint32_t maxDepth = 48;   // guards against coincident triangles that never separate
     SplitMethod split = SplitMethod::SpatialMedian;
+    Intersector intersector = Intersector::Watertight;
+    TriangleFilter triangleFilter = TriangleFilter::Bounds;
+    Precision precision = Precision::F32;
+
+    // These options with the leaf limits of `backend` filled in where they are 0.
+    DacrtOptions resolvedFor(Backend backend) const {
+        DacrtOptions o = *this;
+        const std::uint32_t limit = backend == Backend::Gpu ? kGpuLeafLimit : kCpuLeafLimit;
+        if (o.rayLimit == 0) o.rayLimit = limit;
+        if (o.triLimit == 0) o.triLimit = limit;
+        return o;
+    }
+
+    bool exactDefaults() const {
+        return intersector == Intersector::Watertight && triangleFilter == TriangleFilter::Bounds &&
+               precision == Precision::F32;
+    }
 };
 
 struct TraceOptions {

@@ -1,0 +1,166 @@
+#include "error_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "compare.hpp"
+#include "errors.hpp"
+
+namespace dacrt {
+namespace {
+
+struct SegmentPoint {
+    double distance;
+    double s;  // 0 at the segment's start, 1 at its end
+};
+
+SegmentPoint closestOnSegment(const glm::dvec2& a, const glm::dvec2& b) {
+    const glm::dvec2 ab = b - a;
+    const double len2 = glm::dot(ab, ab);
+    const double s = len2 > 0.0 ? std::clamp(-glm::dot(a, ab) / len2, 0.0, 1.0) : 0.0;
+    return {glm::length(a + s * ab), s};
+}
+
+double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+}  // namespace
+
+void ErrorMetrics::add(const ErrorMetrics& o) {
+    pixels += o.pixels;
+    differingPrim += o.differingPrim;
+    nearTies += o.nearTies;
+    realErrors += o.realErrors;
+    leaks += o.leaks;
+    realLeaks += o.realLeaks;
+    spuriousHits += o.spuriousHits;
+    bothHit += o.bothHit;
+    maxRelDepth = std::max(maxRelDepth, o.maxRelDepth);
+    sumSqRelDepth += o.sumSqRelDepth;
+    sumSqShaded += o.sumSqShaded;
+    shadedSamples += o.shadedSamples;
+}
+
+double ErrorMetrics::rmsRelDepth() const { return bothHit ? std::sqrt(sumSqRelDepth / double(bothHit)) : 0.0; }
+
+double ErrorMetrics::psnr() const {
+    if (sumSqShaded == 0.0 || shadedSamples == 0) return std::numeric_limits<double>::infinity();
+    return 10.0 * std::log10(255.0 * 255.0 / (sumSqShaded / double(shadedSamples)));
+}
+
+RayTriangleProximity rayTriangleProximity(const Ray& ray, const Triangle& tri) {
+    const glm::dvec3 d = glm::normalize(glm::dvec3(ray.dir));
+    // An orthonormal frame with d: the plane it spans with u, w is perpendicular to the ray.
+    const glm::dvec3 helper = std::abs(d.x) < 0.5 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    const glm::dvec3 u = glm::normalize(glm::cross(d, helper)), w = glm::cross(d, u);
+    glm::dvec2 p[3];
+    double along[3];
+    const glm::vec3* v[3] = {&tri.v0, &tri.v1, &tri.v2};
+    for (int i = 0; i < 3; ++i) {
+        const glm::dvec3 q = glm::dvec3(*v[i]) - glm::dvec3(ray.origin);
+        p[i] = {glm::dot(q, u), glm::dot(q, w)};
+        along[i] = glm::dot(q, d) / glm::length(glm::dvec3(ray.dir));
+    }
+    RayTriangleProximity r;
+    r.boundaryDistance = std::numeric_limits<double>::infinity();
+    double bary[3] = {0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        const SegmentPoint sp = closestOnSegment(p[i], p[(i + 1) % 3]);
+        if (sp.distance < r.boundaryDistance) {
+            r.boundaryDistance = sp.distance;
+            bary[0] = bary[1] = bary[2] = 0.0;
+            bary[i] = 1.0 - sp.s;
+            bary[(i + 1) % 3] = sp.s;
+        }
+    }
+    r.distance = r.boundaryDistance;
+    // The line's own point in the projection is the origin (0, 0).
+    const double area = cross2(p[1] - p[0], p[2] - p[0]);
+    const double e0 = cross2(p[1], p[2]), e1 = cross2(p[2], p[0]), e2 = cross2(p[0], p[1]);
+    if (area != 0.0 && ((e0 >= 0 && e1 >= 0 && e2 >= 0) || (e0 <= 0 && e1 <= 0 && e2 <= 0))) {
+        r.distance = 0.0;
+        bary[0] = e0 / area;
+        bary[1] = e1 / area;
+        bary[2] = e2 / area;
+    }
+    r.t = bary[0] * along[0] + bary[1] * along[1] + bary[2] * along[2];
+    return r;
+}
+
+ErrorMetrics measureErrors(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
+                           const std::vector<Ray>& rays, const std::vector<ReferenceHit>& reference,
+                           const std::vector<Hit>& hits, const std::vector<std::uint8_t>& shadedReference,
+                           const std::vector<std::uint8_t>& shadedBackend, ThreadPool& pool) {
+    if (reference.size() != rays.size() || hits.size() != rays.size() || shadedReference.size() != 3 * rays.size() ||
+        shadedBackend.size() != 3 * rays.size())
+        throw std::logic_error("measureErrors: the images do not match the rays");
+    double magnitude = 0.0;
+    for (const Bounds& b : bounds)
+        for (int a = 0; a < 3; ++a) magnitude = std::max({magnitude, std::abs(double(b.lo[a])), std::abs(double(b.hi[a]))});
+    if (!rays.empty())
+        for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::abs(double(rays[0].origin[a])));
+
+    const std::size_t chunks = std::min<std::size_t>(rays.size(), 64);
+    std::vector<ErrorMetrics> parts(chunks);
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        ErrorMetrics& m = parts[c];
+        const std::size_t begin = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks;
+        for (std::size_t i = begin; i < end; ++i) {
+            ++m.pixels;
+            for (int k = 0; k < 3; ++k) {
+                const double diff = double(shadedReference[3 * i + k]) - double(shadedBackend[3 * i + k]);
+                m.sumSqShaded += diff * diff;
+            }
+            m.shadedSamples += 3;
+            const ReferenceHit& ref = reference[i];
+            const Hit& got = hits[i];
+            const bool refHit = ref.prim != kMissPrim, gotHit = got.prim != kMissPrim;
+            if (refHit && gotHit) {
+                const double rel = std::abs(double(got.t) - ref.t) / ref.t;
+                ++m.bothHit;
+                m.maxRelDepth = std::max(m.maxRelDepth, rel);
+                m.sumSqRelDepth += rel * rel;
+            }
+            if (ref.prim == got.prim) continue;
+            ++m.differingPrim;
+            const Ray& ray = rays[i];
+            const double tol = kNearTieRelativeDepth * std::max(refHit ? ref.t : double(got.t), magnitude);
+            bool nearTie = false;
+            if (gotHit) {
+                const RayTriangleProximity p = rayTriangleProximity(ray, triangles[got.prim]);
+                nearTie = p.distance <= tol && (refHit ? std::abs(p.t - ref.t) <= tol : p.t > -tol);
+                if (!refHit) ++m.spuriousHits;
+            } else {
+                ++m.leaks;
+                const RayTriangleProximity p = rayTriangleProximity(ray, triangles[ref.prim]);
+                nearTie = p.boundaryDistance <= tol;
+                if (nearTie) {
+                    // The surface continues over that edge if another triangle comes as close
+                    // at the same depth; its bounds then lie within 2 tol of the hit point.
+                    const glm::dvec3 hitPoint = glm::dvec3(ray.origin) + ref.t * glm::dvec3(ray.dir);
+                    for (std::uint32_t q = 0; q < triangles.size() && nearTie; ++q) {
+                        if (q == ref.prim) continue;
+                        const Bounds& b = bounds[q];
+                        bool inside = true;
+                        for (int a = 0; a < 3; ++a)
+                            inside = inside && hitPoint[a] >= double(b.lo[a]) - 2 * tol &&
+                                     hitPoint[a] <= double(b.hi[a]) + 2 * tol;
+                        if (!inside) continue;
+                        const RayTriangleProximity other = rayTriangleProximity(ray, triangles[q]);
+                        if (other.distance <= tol && std::abs(other.t - ref.t) <= tol) nearTie = false;
+                    }
+                }
+                if (!nearTie) ++m.realLeaks;
+            }
+            if (nearTie)
+                ++m.nearTies;
+            else
+                ++m.realErrors;
+        }
+    });
+    ErrorMetrics total;
+    for (const ErrorMetrics& m : parts) total.add(m);
+    return total;
+}
+
+}  // namespace dacrt
