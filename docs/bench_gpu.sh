@@ -27,15 +27,17 @@ for model in bunny dragon; do
   [ -f "$scene" ] || { echo "$scene is absent: skipped"; continue; }
   build/dacrt render "$scene" --backend cpu-seq --aov "$out/seq.exr" 2>/dev/null
   for backend in cpu-seq cpu gpu; do
-    regions=$([ "$backend" = gpu ] && echo 16 || echo 2)
     for k in $(seq "$repeats"); do
-      build/dacrt render "$scene" --backend "$backend" --regions "$regions" --threads 2 --aov "$out/b.exr" \
+      # Each backend's default regions and leaf limits (cpu: one region per thread; gpu on
+      # lavapipe: one per core, docs/benchmarks.md).
+      build/dacrt render "$scene" --backend "$backend" --threads 2 --aov "$out/b.exr" \
         --stats "$out/$backend$k.json" 2>/dev/null
       if [ "$backend" = gpu ]; then
         build/dacrt compare "$out/seq.exr" "$out/b.exr" --json | python3 -c \
           'import json,sys; d=json.load(sys.stdin); assert d["differing_prim_id"] == 0 and d["differing_depth"] == 0, d'
       fi
     done
+    regions=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["regions"])' "$out/${backend}1.json")
     echo "$model | $backend | $([ "$backend" = cpu-seq ] && echo - || echo "$regions") | $(best "$out"/$backend*.json)"
   done
 done

@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # Regenerates every figure of docs/benchmarks.md (run from the repository root after
-# `bash .ci/setup`; needs ../shared/scenes). About 30 minutes on the 2-core VM.
+# `bash .ci/setup`; needs ../shared/scenes). About 30 minutes on the 2-core VM. The tables in
+# docs/benchmarks.md come from `python3 docs/bench/tables.py KIND FILE.json`.
 set -euo pipefail
 export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
 S=../shared/scenes
 out=docs/bench
-date -u +"%Y-%m-%d %H:%M UTC" > $out/date.txt
 build/dacrt bench $S/bunny.glb --orbit 8 \
   --csv $out/bunny_sweep.csv --json $out/bunny_sweep.json --plot $out/bunny_sweep.png | tee $out/bunny_sweep.txt
 build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --orbit 4 --repeat 2 \
   --csv $out/table51.csv --json $out/table51.json | tee $out/table51.txt
+build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --orbit 1 --repeat 3 \
+  --csv $out/figure53.csv --json $out/figure53.json | tee $out/figure53.txt
+build/dacrt bench $S/dragon.glb --backends cpu-seq,cpu,embree --orbit 4 --repeat 2 \
+  --csv $out/dragon_sweep.csv --json $out/dragon_sweep.json --plot $out/dragon_sweep.png | tee $out/dragon_sweep.txt
