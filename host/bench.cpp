@@ -185,13 +185,12 @@ std::uint64_t fnv1a(const std::string& bytes, std::uint64_t h = 1469598103934665
     return h;
 }
 
-std::string fileDigest(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) throw InputError(path + ": cannot read the scene");
-    std::ostringstream s;
-    s << f.rdbuf();
+std::string digestOf(const void* data, std::size_t bytes) {
+    std::uint64_t h = 1469598103934665603ull;
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
     std::ostringstream hex;
-    hex << std::hex << std::setw(16) << std::setfill('0') << fnv1a(s.str()) << "-" << std::dec << s.str().size();
+    hex << std::hex << std::setw(16) << std::setfill('0') << h << "-" << std::dec << bytes;
     return hex.str();
 }
 
@@ -382,6 +381,7 @@ void writeCsv(const std::string& path, const std::vector<BenchRow>& rows) {
         }
         f << "\n";
     }
+    if (!f.flush()) throw InputError(path + ": cannot write the CSV file");
 }
 
 void printSummary(const std::vector<BenchRow>& rows) {
@@ -412,9 +412,29 @@ void printSummary(const std::vector<BenchRow>& rows) {
     std::cout << "(* = the backend's default; errors are pixels summed over the cameras)\n";
 }
 
+// Resolves the output paths and checks that they can be written before anything is timed:
+// a long run must not fail at its end.
+BenchCommand withOutputs(BenchCommand cmd) {
+    auto resolve = [&](std::string& path, const char* name) {
+        if (path.empty()) path = (std::filesystem::path(cmd.outDir) / name).string();
+        const std::filesystem::path file(path), parent = file.parent_path().empty() ? "." : file.parent_path();
+        std::error_code ec;
+        std::filesystem::create_directories(parent, ec);
+        const bool writable = std::filesystem::exists(file) ? access(path.c_str(), W_OK) == 0
+                                                             : access(parent.c_str(), W_OK | X_OK) == 0;
+        if (ec || !writable || std::filesystem::is_directory(file))
+            throw InputError(path + ": cannot write here" + (ec ? " (" + ec.message() + ")" : std::string()));
+    };
+    resolve(cmd.csvPath, "bench.csv");
+    resolve(cmd.jsonPath, "bench.json");
+    resolve(cmd.plotPath, "bench.png");
+    return cmd;
+}
+
 }  // namespace
 
-int runBenchCommand(const BenchCommand& cmd) {
+int runBenchCommand(const BenchCommand& request) {
+    const BenchCommand cmd = withOutputs(request);
     if (cmd.scenes.empty()) throw InputError("bench: name at least one scene");
     if (cmd.orbit < 1 || cmd.repeat < 1 || cmd.warmup < 0) throw InputError("bench: --orbit and --repeat must be >= 1, --warmup >= 0");
     if (cmd.width < 1 || cmd.height < 1 || cmd.width > 16384 || cmd.height > 16384)
@@ -451,7 +471,9 @@ int runBenchCommand(const BenchCommand& cmd) {
     std::vector<BenchRow> rows;
     for (const std::string& scenePath : cmd.scenes) {
         const Scene scene = loadGltf(scenePath);
-        const std::string sceneName = std::filesystem::path(scenePath).stem().string();
+        std::string sceneName = std::filesystem::path(scenePath).stem().string();
+        for (int copy = 2; std::any_of(rows.begin(), rows.end(), [&](const BenchRow& r) { return r.scene == sceneName; }); ++copy)
+            sceneName = std::filesystem::path(scenePath).stem().string() + "_" + std::to_string(copy);  // rows key on it
         const Box box = sceneBounds(scene.triangles);
         const std::vector<Bounds> bounds = allTriangleBounds(scene.triangles);
         CameraOptions cameraOptions;
@@ -461,19 +483,30 @@ int runBenchCommand(const BenchCommand& cmd) {
         Progress progress(cameras.size() * (1 + configs.size() * std::size_t(cmd.warmup + cmd.repeat)));
 
         // The reference and its shaded image, per camera.
-        const std::string digest = fileDigest(scenePath);
+        const std::string trianglesDigest =
+            digestOf(scene.triangles.data(), scene.triangles.size() * sizeof(Triangle));
         std::vector<std::vector<ReferenceHit>> reference(cameras.size());
         std::vector<std::vector<std::uint8_t>> referenceShaded(cameras.size());
         for (std::size_t k = 0; k < cameras.size(); ++k) {
             progress.step(sceneName + " float64 reference, camera " + std::to_string(k));
             const std::vector<Ray> rays = primaryRays(cameras[k], cmd.width, cmd.height);
-            const std::string key = std::string(kReferenceVersion) + "|" + digest + "|" + cameraKey(cameras[k], cmd.width, cmd.height);
+            // The key holds what the reference depends on: the triangles as loaded and the
+            // rays as generated (so a change to the loader or the camera code misses the cache).
+            const std::string key = std::string(kReferenceVersion) + "|" + trianglesDigest + "|" +
+                                    digestOf(rays.data(), rays.size() * sizeof(Ray)) + "|" +
+                                    cameraKey(cameras[k], cmd.width, cmd.height);
             std::ostringstream name;
             name << std::hex << std::setw(16) << std::setfill('0') << fnv1a(key) << ".ref";
             const std::string cachePath = cacheDir + "/" + name.str();
-            if (!cmd.useCache || !readReferenceCache(cachePath, key, rays.size(), reference[k])) {
+            if (!cmd.useCache || !readReferenceCache(cachePath, key, rays.size(), scene.triangleCount(), reference[k])) {
                 reference[k] = traceReference(scene.triangles, rays, devices.pool(hardwareThreads));
-                if (cmd.useCache) writeReferenceCache(cachePath, key, reference[k]);
+                if (cmd.useCache) {
+                    try {
+                        writeReferenceCache(cachePath, key, reference[k]);
+                    } catch (const std::exception& e) {  // the run needs no cache, only the reference
+                        std::cerr << "dacrt bench: warning: reference not cached: " << e.what() << "\n";
+                    }
+                }
             }
             std::vector<Hit> asHits(rays.size());
             for (std::size_t i = 0; i < rays.size(); ++i)
@@ -535,8 +568,8 @@ int runBenchCommand(const BenchCommand& cmd) {
     std::uint32_t validationErrors = devices.gpu ? devices.gpu->validationErrors() : 0;
 
     printSummary(rows);
-    if (!cmd.csvPath.empty()) writeCsv(cmd.csvPath, rows);
-    if (!cmd.jsonPath.empty()) {
+    writeCsv(cmd.csvPath, rows);
+    {
         nlohmann::ordered_json j;
         j["command"] = {{"orbit", cmd.orbit},
                         {"size", std::to_string(cmd.width) + "x" + std::to_string(cmd.height)},
@@ -552,10 +585,10 @@ int runBenchCommand(const BenchCommand& cmd) {
         j["rows"] = nlohmann::ordered_json::array();
         for (const BenchRow& r : rows) j["rows"].push_back(rowJson(r));
         std::ofstream f(cmd.jsonPath);
-        if (!f) throw InputError(cmd.jsonPath + ": cannot write the JSON file");
         f << j.dump(2) << "\n";
+        if (!f.flush()) throw InputError(cmd.jsonPath + ": cannot write the JSON file");
     }
-    if (!cmd.plotPath.empty()) {
+    {
         std::vector<std::string> scenes;
         for (const BenchRow& r : rows)
             if (std::find(scenes.begin(), scenes.end(), r.scene) == scenes.end()) scenes.push_back(r.scene);
@@ -570,7 +603,7 @@ int runBenchCommand(const BenchCommand& cmd) {
                 p.error = r.errors.realErrorFraction();
                 p.pareto = r.pareto;
                 p.highlighted = r.config.isDefault;
-                p.labelled = r.pareto || r.config.isDefault || p.error > 0.0;
+                p.labelled = r.config.isDefault || p.error > 0.0;  // the zero band is crowded
                 points.push_back(p);
             }
             const std::string path = scenes.size() > 1 ? withSuffix(cmd.plotPath, s) : cmd.plotPath;
@@ -580,6 +613,8 @@ int runBenchCommand(const BenchCommand& cmd) {
                                "pixels with a real error (fraction)", points);
         }
     }
+    std::cerr << "dacrt bench: wrote " << cmd.csvPath << ", " << cmd.jsonPath << " and the plot "
+              << cmd.plotPath << (rows.empty() || cmd.scenes.size() == 1 ? "" : " (one per scene)") << "\n";
     if (cmd.validate && validationErrors > 0) {
         for (const std::string& m : devices.gpu->validationMessages()) std::cerr << "dacrt: validation " << m << "\n";
         std::cerr << "dacrt: error: " << validationErrors << " Vulkan validation errors\n";

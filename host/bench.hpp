@@ -21,6 +21,8 @@ struct BenchCommand {
     int height = 480;
     int repeat = 3;
     int warmup = 1;
+    // Outputs; an empty path means outDir/bench.csv, outDir/bench.json, outDir/bench.png.
+    std::string outDir = "dacrt-bench";
     std::string csvPath;
     std::string jsonPath;
     std::string plotPath;      // with several scenes, each gets "_<scene>" before the extension

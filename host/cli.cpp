@@ -177,9 +177,10 @@ int runCli(int argc, char** argv) {
     benchCmd->add_option("--size", benchSize, "image size WIDTHxHEIGHT")->default_str("640x480");
     benchCmd->add_option("--repeat", bench.repeat, "timed frames per camera and configuration")->check(CLI::Range(1, 1000))->default_str("3");
     benchCmd->add_option("--warmup", bench.warmup, "untimed frames first")->check(CLI::Range(0, 1000))->default_str("1");
-    benchCmd->add_option("--csv", bench.csvPath, "write one row per scene and configuration");
-    benchCmd->add_option("--json", bench.jsonPath, "write the rows with their time parts");
-    benchCmd->add_option("--plot", bench.plotPath, "PNG of frame time against error per scene, Pareto front marked");
+    benchCmd->add_option("--out", bench.outDir, "directory of the outputs not named below")->default_str("dacrt-bench");
+    benchCmd->add_option("--csv", bench.csvPath, "one row per scene and configuration (default OUT/bench.csv)");
+    benchCmd->add_option("--json", bench.jsonPath, "the rows with their time parts (default OUT/bench.json)");
+    benchCmd->add_option("--plot", bench.plotPath, "PNG of frame time against error per scene, Pareto front marked (default OUT/bench.png)");
     benchCmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
     benchCmd->add_flag("--no-cache", benchNoCache, "always recompute the float64 reference");
     benchCmd->add_option("--device", bench.device, "gpu: Vulkan device index or part of its name");

@@ -148,6 +148,9 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
     if (options.backend == Backend::Brute && !options.dacrt.exactDefaults())
         throw InputError("--intersector, --triangle-filter and --precision are DACRT options (cpu, cpu-seq); brute "
                          "force always runs the watertight float32 test");
+    if (options.dacrt.precision == Precision::F64 && options.dacrt.intersector != Intersector::Watertight)
+        throw InputError("--precision f64 runs the watertight test in float64; it does not combine with --intersector " +
+                         toString(options.dacrt.intersector));
     switch (options.backend) {
         case Backend::Brute: return traceBrute(g, pool, onPlan);
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -37,41 +38,68 @@ struct GeometryReleaser {
 };
 using GeometryHandle = std::unique_ptr<RTCGeometryTy, GeometryReleaser>;
 
-}  // namespace
-
-struct EmbreeScene::Impl {
+// One Embree device per thread count for the whole process: a device is Embree's thread pool
+// and ISA dispatch, which a renderer creates once, so a dynamic scene's frame must not pay
+// for it. Deliberately never released: releasing it during static destruction could run
+// after TBB's own teardown.
+struct SharedDevice {
     RTCDevice device = nullptr;
-    RTCScene scene = nullptr;
-
     // Embree passes the error text only to the callback, and may call it from any thread
     // that uses the device (the pool's workers during a trace, TBB's during a commit).
     std::mutex messageMutex;
     std::string lastMessage;
 
+    static void recordError(void* self, RTCError, const char* message) {
+        SharedDevice& d = *static_cast<SharedDevice*>(self);
+        std::lock_guard<std::mutex> lock(d.messageMutex);
+        d.lastMessage = message ? message : "";
+    }
+};
+
+SharedDevice& sharedDevice(unsigned threads) {
+    static std::mutex mutex;
+    static std::map<unsigned, SharedDevice*> devices;
+    std::lock_guard<std::mutex> lock(mutex);
+    SharedDevice*& slot = devices[threads];
+    if (!slot) {
+        const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
+        RTCDevice device = rtcNewDevice(config.c_str());
+        if (!device) {
+            // No device, so no callback to have received a message: only the code is known.
+            throw std::runtime_error(std::string("embree: rtcNewDevice: ") + errorName(rtcGetDeviceError(nullptr)) +
+                                     ": device creation failed (config \"" + config + "\")");
+        }
+        slot = new SharedDevice;
+        slot->device = device;
+        rtcSetDeviceErrorFunction(device, &SharedDevice::recordError, slot);
+    }
+    return *slot;
+}
+
+}  // namespace
+
+struct EmbreeScene::Impl {
+    SharedDevice* shared = nullptr;
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+
     Impl() = default;
     Impl(const Impl&) = delete;
     Impl& operator=(const Impl&) = delete;
 
-    // Owns the handles from the moment they exist, so a constructor that throws halfway
-    // still releases them (~EmbreeScene does not run then).
+    // Owns the scene from the moment it exists, so a constructor that throws halfway still
+    // releases it (~EmbreeScene does not run then).
     ~Impl() {
         if (scene) rtcReleaseScene(scene);
-        if (device) rtcReleaseDevice(device);
-    }
-
-    static void recordError(void* self, RTCError, const char* message) {
-        Impl& impl = *static_cast<Impl*>(self);
-        std::lock_guard<std::mutex> lock(impl.messageMutex);
-        impl.lastMessage = message ? message : "";
     }
 
     // The error code is per thread, so this reports failures of calls made on this thread.
     std::string pendingError(const char* call) {
         const RTCError code = rtcGetDeviceError(device);
         if (code == RTC_ERROR_NONE) return {};
-        std::lock_guard<std::mutex> lock(messageMutex);
+        std::lock_guard<std::mutex> lock(shared->messageMutex);
         return std::string("embree: ") + call + ": " + errorName(code) + ": " +
-               (lastMessage.empty() ? "(no message)" : lastMessage);
+               (shared->lastMessage.empty() ? "(no message)" : shared->lastMessage);
     }
 
     void check(const char* call) {
@@ -82,19 +110,10 @@ struct EmbreeScene::Impl {
 
 EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOptions& options)
     : impl_(std::make_unique<Impl>()) {
-    const std::string config = options.threads > 0 ? "threads=" + std::to_string(options.threads) : "";
-    impl_->device = rtcNewDevice(config.c_str());
-    if (!impl_->device) {
-        // No device, so no callback to have received a message: only the code is known.
-        throw std::runtime_error(std::string("embree: rtcNewDevice: ") + errorName(rtcGetDeviceError(nullptr)) +
-                                 ": device creation failed (config \"" + config + "\")");
-    }
-    rtcSetDeviceErrorFunction(impl_->device, &Impl::recordError, impl_.get());
-    impl_->check("rtcSetDeviceErrorFunction");
+    impl_->shared = &sharedDevice(options.threads);
+    impl_->device = impl_->shared->device;
 
-    // The device outlives frames in a dynamic scene (it is Embree's thread pool and ISA
-    // dispatch), so only what a new frame repeats is timed: copying the triangles and the
-    // BVH build.
+    // Only what a new frame repeats is timed: copying the triangles and the BVH build.
     const Clock::time_point start = Clock::now();
     impl_->scene = rtcNewScene(impl_->device);
     impl_->check("rtcNewScene");

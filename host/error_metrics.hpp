@@ -7,9 +7,9 @@
 //   within the tolerance of the reference depth (another triangle at the same surface point:
 //   a shared edge, a vertex, a coincident face);
 // - the backend misses (a leak): the reference hit lies within the tolerance of its
-//   triangle's boundary and no other triangle comes that close at that depth (the ray grazes
-//   a silhouette or a hole's rim). A miss where the surface continues over an edge is a real
-//   leak: a watertight test never does that, whatever the rounding;
+//   triangle's boundary and the surface ends there (a silhouette, where the neighbour folds
+//   back, or a hole's rim). A miss where the surface continues across that boundary is a real
+//   leak: a watertight test never lets a ray through between two triangles sharing an edge;
 // - the backend hits where the reference misses: its triangle passes within the tolerance.
 // The tolerance is kNearTieRelativeDepth (1e-5, about 170 float32 ulps) times the larger of
 // the hit distance and the scene's coordinate magnitude (rays have unit directions).

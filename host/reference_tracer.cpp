@@ -1,10 +1,14 @@
 #include "reference_tracer.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+
+#include <unistd.h>
 
 #include "errors.hpp"
 #include "triangle_tests.hpp"
@@ -203,9 +207,10 @@ std::vector<ReferenceHit> traceReferenceBrute(const std::vector<Triangle>& trian
 
 namespace {
 constexpr char kCacheMagic[8] = {'D', 'A', 'C', 'R', 'T', 'R', 'F', '1'};
+static_assert(std::endian::native == std::endian::little, "the reference cache is written in little-endian order");
 }
 
-bool readReferenceCache(const std::string& path, const std::string& key, std::size_t rays,
+bool readReferenceCache(const std::string& path, const std::string& key, std::size_t rays, std::size_t triangleCount,
                         std::vector<ReferenceHit>& hits) {
     std::ifstream f(path, std::ios::binary);
     if (!f) return false;
@@ -219,15 +224,19 @@ bool readReferenceCache(const std::string& path, const std::string& key, std::si
         throw InputError(path + ": truncated reference cache file; delete it");
     if (storedKey != key || count != rays) return false;
     hits.resize(rays);
-    for (ReferenceHit& h : hits)
+    for (ReferenceHit& h : hits) {
         if (!f.read(reinterpret_cast<char*>(&h.t), 8) || !f.read(reinterpret_cast<char*>(&h.prim), 4))
             throw InputError(path + ": truncated reference cache file; delete it");
+        const bool valid = h.prim == kMissPrim ? std::isinf(h.t) && h.t > 0 : h.prim < triangleCount && h.t > 0 && std::isfinite(h.t);
+        if (!valid) throw InputError(path + ": damaged reference cache file (a hit that cannot be); delete it");
+    }
+    if (f.peek() != std::char_traits<char>::eof()) throw InputError(path + ": reference cache file too long; delete it");
     return true;
 }
 
 void writeReferenceCache(const std::string& path, const std::string& key, const std::vector<ReferenceHit>& hits) {
     std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-    const std::string temporary = path + ".tmp";
+    const std::string temporary = path + ".tmp" + std::to_string(getpid());  // concurrent runs do not collide
     {
         std::ofstream f(temporary, std::ios::binary | std::ios::trunc);
         const std::uint64_t keySize = key.size(), count = hits.size();

@@ -35,8 +35,9 @@ std::vector<ReferenceHit> traceReferenceBrute(const std::vector<Triangle>& trian
 
 // Reads or writes a cached reference frame (raw little-endian records behind a header that
 // holds `key` and the ray count). readReferenceCache returns false when the file is
-// missing or was written for another key; a damaged file is an error.
-bool readReferenceCache(const std::string& path, const std::string& key, std::size_t rays,
+// missing or was written for another key; a damaged file (truncated, too long, a primitive
+// id not below triangleCount, an impossible t) is an error.
+bool readReferenceCache(const std::string& path, const std::string& key, std::size_t rays, std::size_t triangleCount,
                         std::vector<ReferenceHit>& hits);
 void writeReferenceCache(const std::string& path, const std::string& key, const std::vector<ReferenceHit>& hits);
 

@@ -114,6 +114,21 @@ TEST(Bench, Table51SuiteReportsSpeedupsOverSequential) {
     for (const auto& row : j["rows"]) EXPECT_TRUE(row["speedup_over_cpu_seq"].is_number());
 }
 
+TEST(Bench, OutputsDefaultToOneDirectoryAndAreCheckedFirst) {
+    const BenchOutputs out("defaults");
+    const std::string cache = " --cache " + (out.dir / "cache").string();
+    test::CommandResult r = test::runDacrt("bench " + roomScene() + " --backends cpu-seq --size 16x12 --repeat 1 --warmup 0 --out " +
+                                           (out.dir / "results").string() + cache);
+    ASSERT_EQ(r.code, 0) << r.output;
+    for (const char* name : {"bench.csv", "bench.json", "bench.png"})
+        EXPECT_GT(fs::file_size(out.dir / "results" / name), 100u) << name;
+    // A path that cannot be written fails at once, before the reference or any frame.
+    r = test::runDacrt("bench " + roomScene() + " --backends cpu-seq --size 16x12 --csv /proc/version/x.csv" + cache);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("/proc/version/x.csv"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("series"), std::string::npos) << "it ran before failing: " << r.output;
+}
+
 TEST(Bench, BadInputGetsAClearError) {
     test::CommandResult r = test::runDacrt("bench /nonexistent.glb --backends cpu-seq");
     EXPECT_EQ(r.code, 2);
@@ -125,6 +140,9 @@ TEST(Bench, BadInputGetsAClearError) {
     EXPECT_NE(r.output.find("table51"), std::string::npos) << r.output;
     r = test::runDacrt("render " + roomScene() + " --backend gpu --intersector moller-trumbore");
     EXPECT_NE(r.code, 0);
+    r = test::runDacrt("render " + roomScene() + " --backend cpu-seq --size 8x6 --precision f64 --intersector moller-trumbore");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("f64"), std::string::npos) << r.output;
     r = test::runDacrt("render " + roomScene() + " --backend embree --plan");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.output.find("embree"), std::string::npos) << r.output;
