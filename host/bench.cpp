@@ -514,48 +514,66 @@ int runBenchCommand(const BenchCommand& request) {
             referenceShaded[k] = shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &asHits});
         }
 
-        for (const BenchConfig& config : configs) {
+        // Configurations are interleaved (camera, then repeat, then configuration), so that a
+        // slow spell of this shared machine lands on every configuration alike instead of on
+        // whichever one happened to run then.
+        struct Accumulator {
             BenchRow row;
-            row.scene = sceneName;
-            row.triangles = scene.triangleCount();
-            row.raysPerFrame = raysPerFrame;
-            row.cameras = int(cameras.size());
-            row.config = config;
             double minSum = 0.0, medianSum = 0.0;
             std::map<std::string, double> partSums;
             std::vector<std::string> partOrder;
             std::unique_ptr<EmbreeScene> staticEmbree;
-            if (config.embreeStatic)  // built once: a static scene pays for its BVH outside the frame
-                staticEmbree = std::make_unique<EmbreeScene>(scene.triangles, EmbreeOptions{config.embreeRobust, config.threads});
-            for (std::size_t k = 0; k < cameras.size(); ++k) {
-                FrameOutcome last;
-                std::vector<double> cameraMs;
-                for (int w = 0; w < cmd.warmup + cmd.repeat; ++w) {
+            std::vector<double> cameraMs;
+        };
+        std::vector<Accumulator> acc(configs.size());
+        for (std::size_t c = 0; c < configs.size(); ++c) {
+            BenchRow& row = acc[c].row;
+            row.scene = sceneName;
+            row.triangles = scene.triangleCount();
+            row.raysPerFrame = raysPerFrame;
+            row.cameras = int(cameras.size());
+            row.config = configs[c];
+            if (configs[c].embreeStatic)  // built once: a static scene pays for its BVH outside the frame
+                acc[c].staticEmbree =
+                    std::make_unique<EmbreeScene>(scene.triangles, EmbreeOptions{configs[c].embreeRobust, configs[c].threads});
+        }
+        for (std::size_t k = 0; k < cameras.size(); ++k) {
+            const std::vector<Ray> rays = primaryRays(cameras[k], cmd.width, cmd.height);
+            for (int w = 0; w < cmd.warmup + cmd.repeat; ++w) {
+                for (std::size_t c = 0; c < configs.size(); ++c) {
+                    const BenchConfig& config = configs[c];
+                    Accumulator& a = acc[c];
                     progress.step(sceneName + " " + config.series + " " + config.name + " camera " + std::to_string(k));
-                    last = traceFrame(config, scene, cameras[k], cmd.width, cmd.height, devices, staticEmbree.get());
+                    const FrameOutcome frame =
+                        traceFrame(config, scene, cameras[k], cmd.width, cmd.height, devices, a.staticEmbree.get());
                     if (w < cmd.warmup) continue;
-                    cameraMs.push_back(last.ms);
-                    for (const auto& [name, ms] : last.parts) {
-                        if (!partSums.count(name)) partOrder.push_back(name);
-                        partSums[name] += ms / double(cameras.size() * std::size_t(cmd.repeat));
+                    a.cameraMs.push_back(frame.ms);
+                    for (const auto& [name, ms] : frame.parts) {
+                        if (!a.partSums.count(name)) a.partOrder.push_back(name);
+                        a.partSums[name] += ms / double(cameras.size() * std::size_t(cmd.repeat));
                     }
+                    if (w != cmd.warmup) continue;  // every backend is deterministic: one frame's hits stand for all
+                    const std::vector<std::uint8_t> shaded =
+                        shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &frame.result.hits});
+                    a.row.errors.add(measureErrors(scene.triangles, bounds, rays, reference[k], frame.result.hits,
+                                                   referenceShaded[k], shaded, devices.pool(hardwareThreads)));
+                    a.row.regions = frame.result.regions;
+                    a.row.divisionAxis = frame.result.axis;
                 }
-                minSum += *std::min_element(cameraMs.begin(), cameraMs.end());
-                medianSum += median(cameraMs);
-                const std::vector<Ray> rays = primaryRays(cameras[k], cmd.width, cmd.height);
-                const std::vector<std::uint8_t> shaded =
-                    shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &last.result.hits});
-                row.errors.add(measureErrors(scene.triangles, bounds, rays, reference[k], last.result.hits,
-                                             referenceShaded[k], shaded, devices.pool(hardwareThreads)));
-                row.regions = last.result.regions;
-                row.divisionAxis = last.result.axis;
             }
-            for (const std::string& name : partOrder) row.partsMs.emplace_back(name, partSums[name]);
-            // Per camera over the repeats, then the mean over the orbit: each camera is its own
-            // workload, so its own minimum is the least noisy figure for it.
-            row.frameMsMin = minSum / double(cameras.size());
-            row.frameMsMedian = medianSum / double(cameras.size());
-            rows.push_back(row);
+            for (Accumulator& a : acc) {
+                // Per camera over the repeats, then the mean over the orbit: each camera is its
+                // own workload, so its own minimum is the least noisy figure for it.
+                a.minSum += *std::min_element(a.cameraMs.begin(), a.cameraMs.end());
+                a.medianSum += median(a.cameraMs);
+                a.cameraMs.clear();
+            }
+        }
+        for (Accumulator& a : acc) {
+            for (const std::string& name : a.partOrder) a.row.partsMs.emplace_back(name, a.partSums[name]);
+            a.row.frameMsMin = a.minSum / double(cameras.size());
+            a.row.frameMsMedian = a.medianSum / double(cameras.size());
+            rows.push_back(std::move(a.row));
         }
         progress.finish();
     }
