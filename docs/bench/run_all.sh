@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates every figure of docs/benchmarks.md (run from the repository root after
-# `bash .ci/setup`; needs ../shared/scenes). About 30 minutes on the 2-core VM. The tables in
-# docs/benchmarks.md come from `python3 docs/bench/tables.py KIND FILE.json`.
+# `bash .ci/setup`; needs ../shared/scenes). About 15 minutes on the 2-core VM. Then
+# `python3 docs/bench/tables.py update docs/benchmarks.md` refreshes the tables there.
 set -euo pipefail
 export VK_DRIVER_FILES=${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}
 S=../shared/scenes

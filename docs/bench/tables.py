@@ -75,5 +75,30 @@ def figure53(path):
               f"{(sp['best'] / worst_inface - 1) * 100:+.0f}% |")
 
 
+KINDS = {"sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
+
+
+def update(doc):
+    """Regenerates every block between <!-- bench-table KIND FILE --> and <!-- /bench-table -->."""
+    import contextlib
+    import io
+    import os
+    import re
+    text = open(doc).read()
+    here = os.path.dirname(os.path.abspath(__file__))
+
+    def table(match):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            KINDS[match.group(1)](os.path.join(here, match.group(2)))
+        return f"<!-- bench-table {match.group(1)} {match.group(2)} -->\n{out.getvalue()}<!-- /bench-table -->"
+
+    text = re.sub(r"<!-- bench-table (\S+) (\S+) -->\n.*?<!-- /bench-table -->", table, text, flags=re.S)
+    open(doc, "w").write(text)
+
+
 if __name__ == "__main__":
-    {"sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}[sys.argv[1]](sys.argv[2])
+    if sys.argv[1] == "update":
+        update(sys.argv[2])
+    else:
+        KINDS[sys.argv[1]](sys.argv[2])
