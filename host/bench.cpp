@@ -68,7 +68,6 @@ struct BenchRow {
     ErrorMetrics errors;
     bool pareto = false;
     std::optional<double> speedupOverSequential;
-    std::uint32_t validationErrors = 0;
 };
 
 std::string optionText(const BenchConfig& c) {
@@ -180,19 +179,20 @@ std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads) {
     return out;
 }
 
-std::uint64_t fnv1a(const std::string& bytes, std::uint64_t h = 1469598103934665603ull) {
-    for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ull;
-    return h;
-}
-
-std::string digestOf(const void* data, std::size_t bytes) {
+std::uint64_t fnv1a(const void* data, std::size_t bytes) {
     std::uint64_t h = 1469598103934665603ull;
     const auto* p = static_cast<const unsigned char*>(data);
     for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+std::string hex16(std::uint64_t h) {
     std::ostringstream hex;
-    hex << std::hex << std::setw(16) << std::setfill('0') << h << "-" << std::dec << bytes;
+    hex << std::hex << std::setw(16) << std::setfill('0') << h;
     return hex.str();
 }
+
+std::string digestOf(const void* data, std::size_t bytes) { return hex16(fnv1a(data, bytes)) + "-" + std::to_string(bytes); }
 
 std::string defaultCacheDir() {
     if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/dacrt";
@@ -217,6 +217,23 @@ double median(std::vector<double> v) {
 std::string withSuffix(const std::string& path, const std::string& suffix) {
     const std::filesystem::path p(path);
     return (p.parent_path() / (p.stem().string() + "_" + suffix + p.extension().string())).string();
+}
+
+// The float64 reference of one camera, read from cacheDir when it holds one for `key`, else
+// traced (and stored there). An empty cacheDir means no cache.
+std::vector<ReferenceHit> cachedReference(const Scene& scene, const std::vector<Ray>& rays, const std::string& key,
+                                          const std::string& cacheDir, ThreadPool& pool) {
+    std::vector<ReferenceHit> hits;
+    const std::string path = cacheDir + "/" + hex16(fnv1a(key.data(), key.size())) + ".ref";
+    if (!cacheDir.empty() && readReferenceCache(path, key, rays.size(), scene.triangleCount(), hits)) return hits;
+    hits = traceReference(scene.triangles, rays, pool);
+    if (cacheDir.empty()) return hits;
+    try {
+        writeReferenceCache(path, key, hits);
+    } catch (const std::exception& e) {  // the run needs no cache, only the reference
+        std::cerr << "dacrt bench: warning: reference not cached: " << e.what() << "\n";
+    }
+    return hits;
 }
 
 class Progress {
@@ -346,7 +363,6 @@ nlohmann::ordered_json rowJson(const BenchRow& r) {
     j["depth_rel_rms"] = e.rmsRelDepth();
     j["psnr_db"] = std::isinf(e.psnr()) ? nlohmann::ordered_json("inf") : nlohmann::ordered_json(e.psnr());
     j["pareto"] = r.pareto;
-    j["validation_errors"] = r.validationErrors;
     return j;
 }
 
@@ -482,37 +498,8 @@ int runBenchCommand(const BenchCommand& request) {
         const std::size_t raysPerFrame = std::size_t(cmd.width) * std::size_t(cmd.height);
         Progress progress(cameras.size() * (1 + configs.size() * std::size_t(cmd.warmup + cmd.repeat)));
 
-        // The reference and its shaded image, per camera.
         const std::string trianglesDigest =
             digestOf(scene.triangles.data(), scene.triangles.size() * sizeof(Triangle));
-        std::vector<std::vector<ReferenceHit>> reference(cameras.size());
-        std::vector<std::vector<std::uint8_t>> referenceShaded(cameras.size());
-        for (std::size_t k = 0; k < cameras.size(); ++k) {
-            progress.step(sceneName + " float64 reference, camera " + std::to_string(k));
-            const std::vector<Ray> rays = primaryRays(cameras[k], cmd.width, cmd.height);
-            // The key holds what the reference depends on: the triangles as loaded and the
-            // rays as generated (so a change to the loader or the camera code misses the cache).
-            const std::string key = std::string(kReferenceVersion) + "|" + trianglesDigest + "|" +
-                                    digestOf(rays.data(), rays.size() * sizeof(Ray)) + "|" +
-                                    cameraKey(cameras[k], cmd.width, cmd.height);
-            std::ostringstream name;
-            name << std::hex << std::setw(16) << std::setfill('0') << fnv1a(key) << ".ref";
-            const std::string cachePath = cacheDir + "/" + name.str();
-            if (!cmd.useCache || !readReferenceCache(cachePath, key, rays.size(), scene.triangleCount(), reference[k])) {
-                reference[k] = traceReference(scene.triangles, rays, devices.pool(hardwareThreads));
-                if (cmd.useCache) {
-                    try {
-                        writeReferenceCache(cachePath, key, reference[k]);
-                    } catch (const std::exception& e) {  // the run needs no cache, only the reference
-                        std::cerr << "dacrt bench: warning: reference not cached: " << e.what() << "\n";
-                    }
-                }
-            }
-            std::vector<Hit> asHits(rays.size());
-            for (std::size_t i = 0; i < rays.size(); ++i)
-                asHits[i] = Hit{float(reference[k][i].t), reference[k][i].prim, 0.0f, 0.0f};
-            referenceShaded[k] = shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &asHits});
-        }
 
         // Configurations are interleaved (camera, then repeat, then configuration), so that a
         // slow spell of this shared machine lands on every configuration alike instead of on
@@ -538,7 +525,19 @@ int runBenchCommand(const BenchCommand& request) {
                     std::make_unique<EmbreeScene>(scene.triangles, EmbreeOptions{configs[c].embreeRobust, configs[c].threads});
         }
         for (std::size_t k = 0; k < cameras.size(); ++k) {
+            progress.step(sceneName + " float64 reference, camera " + std::to_string(k));
             const std::vector<Ray> rays = primaryRays(cameras[k], cmd.width, cmd.height);
+            // The key holds what the reference depends on: the triangles as loaded and the
+            // rays as generated (so a change to the loader or the camera code misses the cache).
+            const std::string key = std::string(kReferenceVersion) + "|" + trianglesDigest + "|" +
+                                    digestOf(rays.data(), rays.size() * sizeof(Ray)) + "|" +
+                                    cameraKey(cameras[k], cmd.width, cmd.height);
+            const std::vector<ReferenceHit> reference =
+                cachedReference(scene, rays, key, cmd.useCache ? cacheDir : std::string(), devices.pool(hardwareThreads));
+            std::vector<Hit> asHits(rays.size());
+            for (std::size_t i = 0; i < rays.size(); ++i) asHits[i] = Hit{float(reference[i].t), reference[i].prim, 0.0f, 0.0f};
+            const std::vector<std::uint8_t> referenceShaded =
+                shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &asHits});
             for (int w = 0; w < cmd.warmup + cmd.repeat; ++w) {
                 for (std::size_t c = 0; c < configs.size(); ++c) {
                     const BenchConfig& config = configs[c];
@@ -555,8 +554,8 @@ int runBenchCommand(const BenchCommand& request) {
                     if (w != cmd.warmup) continue;  // every backend is deterministic: one frame's hits stand for all
                     const std::vector<std::uint8_t> shaded =
                         shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &frame.result.hits});
-                    a.row.errors.add(measureErrors(scene.triangles, bounds, rays, reference[k], frame.result.hits,
-                                                   referenceShaded[k], shaded, devices.pool(hardwareThreads)));
+                    a.row.errors.add(measureErrors(scene.triangles, bounds, rays, reference, frame.result.hits,
+                                                   referenceShaded, shaded, devices.pool(hardwareThreads)));
                     a.row.regions = frame.result.regions;
                     a.row.divisionAxis = frame.result.axis;
                 }

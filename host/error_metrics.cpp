@@ -50,6 +50,13 @@ double ErrorMetrics::psnr() const {
 
 namespace {
 
+// Why a differing pixel is or is not a near tie.
+struct RayTriangleProximity {
+    double distance = 0.0;          // from the ray's line to the triangle, perpendicular to the ray
+    double boundaryDistance = 0.0;  // from the ray's line to the triangle's edges
+    double t = 0.0;                 // ray parameter of the triangle's point closest to the line
+};
+
 struct ProximityDetail {
     RayTriangleProximity p;
     glm::dvec3 towardsBoundary{0.0};  // from the ray's line to the triangle's nearest boundary point
@@ -102,9 +109,8 @@ ProximityDetail proximityDetail(const Ray& ray, const Triangle& tri) {
 // ray moved 2 tolerances outward across the nearest boundary point of the reference's
 // triangle still hits another triangle at about the same depth; a watertight test can never
 // let a ray through between two such triangles, whatever its rounding.
-bool surfaceContinues(const Ray& ray, const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
-                      std::uint32_t refPrim, double refT, double tol) {
-    const ProximityDetail near = proximityDetail(ray, triangles[refPrim]);
+bool surfaceContinues(const Ray& ray, const ProximityDetail& near, const std::vector<Triangle>& triangles,
+                      const std::vector<Bounds>& bounds, std::uint32_t refPrim, double refT, double tol) {
     const double reach = glm::length(near.towardsBoundary);
     if (reach == 0.0) return false;  // degenerate: the ray runs along the edge itself
     Ray moved = ray;
@@ -126,8 +132,6 @@ bool surfaceContinues(const Ray& ray, const std::vector<Triangle>& triangles, co
 }
 
 }  // namespace
-
-RayTriangleProximity rayTriangleProximity(const Ray& ray, const Triangle& tri) { return proximityDetail(ray, tri).p; }
 
 ErrorMetrics measureErrors(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
                            const std::vector<Ray>& rays, const std::vector<ReferenceHit>& reference,
@@ -167,19 +171,15 @@ ErrorMetrics measureErrors(const std::vector<Triangle>& triangles, const std::ve
             ++m.differingPrim;
             const Ray& ray = rays[i];
             const double tol = kNearTieRelativeDepth * std::max(refHit ? ref.t : double(got.t), magnitude);
-            bool nearTie = false;
-            if (gotHit && got.prim >= triangles.size()) {
-                nearTie = false;  // a primitive that does not exist: a backend bug, counted, not a crash
-                if (!refHit) ++m.spuriousHits;
-            } else if (gotHit) {
-                const RayTriangleProximity p = rayTriangleProximity(ray, triangles[got.prim]);
+            bool nearTie = false;  // a backend primitive that does not exist stays a real error, not a crash
+            if (gotHit && !refHit) ++m.spuriousHits;
+            if (gotHit && got.prim < triangles.size()) {
+                const RayTriangleProximity p = proximityDetail(ray, triangles[got.prim]).p;
                 nearTie = p.distance <= tol && (refHit ? std::abs(p.t - ref.t) <= tol : p.t > -tol);
-                if (!refHit) ++m.spuriousHits;
-            } else {
+            } else if (!gotHit) {
                 ++m.leaks;
-                const RayTriangleProximity p = rayTriangleProximity(ray, triangles[ref.prim]);
-                nearTie = p.boundaryDistance <= tol &&
-                          !surfaceContinues(ray, triangles, bounds, ref.prim, ref.t, tol);
+                const ProximityDetail near = proximityDetail(ray, triangles[ref.prim]);
+                nearTie = near.p.boundaryDistance <= tol && !surfaceContinues(ray, near, triangles, bounds, ref.prim, ref.t, tol);
                 if (!nearTie) ++m.realLeaks;
             }
             if (nearTie)

@@ -42,14 +42,6 @@ struct ErrorMetrics {
     double psnr() const;  // dB; +inf when the shaded images are identical
 };
 
-// Why a differing pixel is or is not a near tie: exposed for the tests.
-struct RayTriangleProximity {
-    double distance = 0.0;          // from the ray's line to the triangle, perpendicular to the ray
-    double boundaryDistance = 0.0;  // from the ray's line to the triangle's edges
-    double t = 0.0;                 // ray parameter of the triangle's point closest to the line
-};
-RayTriangleProximity rayTriangleProximity(const Ray& ray, const Triangle& triangle);
-
 // Compares one frame. shadedBackend and shadedReference are 8-bit RGB images of the same
 // size as the rays (see shadeImage in image_io.hpp).
 ErrorMetrics measureErrors(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,

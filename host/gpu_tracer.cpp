@@ -61,6 +61,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     if (!device.subgroupArithmetic)
         throw InputError("device '" + device.name + "' lacks subgroup arithmetic in compute shaders, which the gpu backend needs");
     const std::uint32_t loopBudget = loopBudgetOf(device);
+    const DacrtOptions leafLimits = options.dacrt.resolvedFor(Backend::Gpu);
 
     TraceResult result;
     result.gpu = GpuReport{};
@@ -162,8 +163,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     start = Clock::now();
     PipelineCache frameOnly(context);
     vk::ComputePipeline& pipeline = (pipelines ? *pipelines : frameOnly)
-                                        .get({workgroupSize, options.dacrt.resolvedFor(Backend::Gpu).rayLimit,
-                                              options.dacrt.resolvedFor(Backend::Gpu).triLimit,
+                                        .get({workgroupSize, leafLimits.rayLimit, leafLimits.triLimit,
                                               options.dacrt.maxDepth, loopBudget});
     std::vector<const vk::Buffer*> bound;
     for (const vk::Buffer& b : buffers) bound.push_back(&b);

@@ -109,14 +109,6 @@ Agreement expectAgreesWithBrute(const Frame& frame, const std::string& name) {
     return robust;
 }
 
-Scene shapes() {
-    Mesh floor = grid({-2, -1, 2}, {4, 0, 0}, {0, 0, -4}, 12, 12);
-    return sceneFromMeshes({icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 3), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 40, 16),
-                            box({-0.3f, -1.0f, -1.2f}, {0.4f, 0.6f, -0.6f}), cylinder({1.2f, -1.0f, -1.0f}, 0.3f, 1.5f, 24, 4),
-                            floor},
-                           "shapes");
-}
-
 CameraOptions lookAt(const glm::dvec3& eye, const glm::dvec3& target, double fovDegrees) {
     CameraOptions o;
     o.eye = eye;
@@ -130,14 +122,14 @@ bool bitIdentical(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeo
 }  // namespace
 
 TEST(EmbreeAgreesWithBrute, ProceduralShapes) {
-    const Scene s = shapes();
-    const Frame front(shapes(), defaultCamera(s, 96, 72), 96, 72);
+    const Scene s = test::shapesScene();
+    const Frame front(test::shapesScene(), defaultCamera(s, 96, 72), 96, 72);
     expectAgreesWithBrute(front, "shapes, front");
     CameraOptions o;
     o.orbit = 3;
     const std::vector<Camera> cams = makeCameras(s, sceneBounds(s.triangles), o, 4.0 / 3.0);
     for (std::size_t k = 1; k < cams.size(); ++k) {
-        const Frame frame(shapes(), cams[k], 64, 48);
+        const Frame frame(test::shapesScene(), cams[k], 64, 48);
         expectAgreesWithBrute(frame, "shapes, orbit " + std::to_string(k));
     }
 }
@@ -203,7 +195,7 @@ TEST(EmbreeAgreesWithBrute, CoincidentAndZeroAreaTriangles) {
 }
 
 TEST(EmbreeScene, EmptyTriangleListMissesEveryRay) {
-    const Scene s = shapes();
+    const Scene s = test::shapesScene();
     const std::vector<Ray> rays = primaryRays(defaultCamera(s, 32, 24), 32, 24);
     const std::vector<Triangle> none;
     ThreadPool pool(2);
@@ -219,8 +211,8 @@ TEST(EmbreeScene, EmptyTriangleListMissesEveryRay) {
 }
 
 TEST(EmbreeScene, ReportsBuildAndTraceTimes) {
-    const Scene s = shapes();
-    const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
+    const Scene s = test::shapesScene();
+    const Frame frame(test::shapesScene(), defaultCamera(s, 48, 36), 48, 36);
     ThreadPool pool(2);
     const EmbreeScene scene(frame.scene.triangles, EmbreeOptions{});
     EXPECT_GE(scene.buildMs(), 0.0);

@@ -20,7 +20,7 @@ namespace {
 
 using test::Frame;
 
-Scene shapesScene() {
+Scene shapesWithFloorGrid() {
     return sceneFromMeshes({icosphere({0, 0, 0}, 1.0f, 3), torus({2.5f, 0, 0}, 1.0f, 0.3f, 24, 12),
                             box({-3.5f, -1, -1}, {-2, 1, 1}), grid({-4, -1.2f, -2}, {8, 0, 0}, {0, 0, 4}, 16, 8)},
                            "shapes");
@@ -40,7 +40,7 @@ Scene shapesScene() {
 
 TEST(Reference, MatchesFloat64BruteForceOnShapesFromSeveralCameras) {
     ThreadPool pool(2);
-    const Scene s = shapesScene();
+    const Scene s = shapesWithFloorGrid();
     CameraOptions orbit;
     orbit.orbit = 5;
     const std::vector<Camera> cameras = makeCameras(s, sceneBounds(s.triangles), orbit, 4.0 / 3.0);
@@ -83,7 +83,7 @@ TEST(Reference, MatchesFloat64BruteForceOnTheBunny) {
 
 TEST(Reference, EmptySceneMissesAndBadRaysAreRejected) {
     ThreadPool pool(1);
-    const Scene s = shapesScene();
+    const Scene s = shapesWithFloorGrid();
     std::vector<Ray> rays = primaryRays(test::defaultCamera(s, 8, 6), 8, 6);
     for (const ReferenceHit& h : traceReference({}, rays, pool)) EXPECT_EQ(h.prim, kMissPrim);
     rays[3].origin.x = std::nanf("");
@@ -255,11 +255,11 @@ TraceResult traceWith(const Frame& f, Backend b, DacrtOptions dacrt) {
 // Conservative filters change which triangles a leaf sees, never the answer: hit for hit the
 // same as the default. The float64 leaf has no real error against the reference.
 TEST(DacrtOptions, ConservativeOptionsMatchTheDefaultAndF64MatchesTheReference) {
-    const Scene s = shapesScene();
+    const Scene s = shapesWithFloorGrid();
     CameraOptions orbit;
     orbit.orbit = 3;
     for (const Camera& c : makeCameras(s, sceneBounds(s.triangles), orbit, 4.0 / 3.0)) {
-        const Frame f(shapesScene(), c, 96, 72);
+        const Frame f(shapesWithFloorGrid(), c, 96, 72);
         for (Backend b : {Backend::CpuSeq, Backend::Cpu}) {
             const TraceResult base = traceWith(f, b, {});
             DacrtOptions sat;
@@ -283,8 +283,8 @@ TEST(DacrtOptions, ConservativeOptionsMatchTheDefaultAndF64MatchesTheReference) 
 }
 
 TEST(DacrtOptions, InexactOptionsRunAndAreMeasured) {
-    const Scene s = shapesScene();
-    const Frame f(shapesScene(), test::defaultCamera(s, 96, 72), 96, 72);
+    const Scene s = shapesWithFloorGrid();
+    const Frame f(shapesWithFloorGrid(), test::defaultCamera(s, 96, 72), 96, 72);
     ThreadPool pool(2);
     const std::vector<ReferenceHit> ref = traceReference(f.scene.triangles, f.rays, pool);
     const std::vector<std::uint8_t> shade(3 * f.rays.size(), 0);

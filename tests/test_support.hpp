@@ -9,6 +9,7 @@
 
 #include "camera.hpp"
 #include "cpu_tracers.hpp"
+#include "procedural.hpp"
 #include "scene.hpp"
 
 namespace dacrt::test {
@@ -24,6 +25,15 @@ inline std::string sharedScene(const std::string& name) {
 #define DACRT_REQUIRE_SHARED_SCENE(var, name)                                                       \
     const std::string var = ::dacrt::test::sharedScene(name);                                       \
     if (var.empty()) GTEST_SKIP() << "../shared/scenes/" << name << " is absent (fresh clone): skipped"
+
+// Sphere, torus, box and cylinder on a floor: shared edges, silhouettes and occlusion.
+inline Scene shapesScene() {
+    Mesh floor = grid({-2, -1, 2}, {4, 0, 0}, {0, 0, -4}, 12, 12);
+    return sceneFromMeshes({icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 3), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 40, 16),
+                            box({-0.3f, -1.0f, -1.2f}, {0.4f, 0.6f, -0.6f}), cylinder({1.2f, -1.0f, -1.0f}, 0.3f, 1.5f, 24, 4),
+                            floor},
+                           "shapes");
+}
 
 // A scene, its bounds and one camera's rays: everything a tracer reads.
 struct Frame {

@@ -12,14 +12,6 @@ namespace {
 
 const Backend kAllBackends[] = {Backend::Brute, Backend::CpuSeq, Backend::Cpu};
 
-Scene shapes() {
-    Mesh floor = grid({-2, -1, 2}, {4, 0, 0}, {0, 0, -4}, 12, 12);
-    return sceneFromMeshes({icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 3), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 40, 16),
-                            box({-0.3f, -1.0f, -1.2f}, {0.4f, 0.6f, -0.6f}), cylinder({1.2f, -1.0f, -1.0f}, 0.3f, 1.5f, 24, 4),
-                            floor},
-                           "shapes");
-}
-
 // Every backend (and every region and thread count of cpu) against brute force.
 void expectAllBackendsAgree(const Frame& frame, std::initializer_list<unsigned> regionCounts,
                             DivisionAxis axis = DivisionAxis::Best) {
@@ -89,19 +81,19 @@ TEST(KnownAnswers, ZeroAreaTrianglesNeverHit) {
 }
 
 TEST(BackendsAgree, ProceduralShapesFromTheFront) {
-    const Scene s = shapes();
-    const Frame frame(shapes(), defaultCamera(s, 96, 72), 96, 72);
+    const Scene s = test::shapesScene();
+    const Frame frame(test::shapesScene(), defaultCamera(s, 96, 72), 96, 72);
     expectAllBackendsAgree(frame, {1, 2, 3, 4, 8});
 }
 
 TEST(BackendsAgree, ProceduralShapesOrbit) {
-    const Scene s = shapes();
+    const Scene s = test::shapesScene();
     CameraOptions o;
     o.orbit = 5;
     const std::vector<Camera> cams = makeCameras(s, sceneBounds(s.triangles), o, 4.0 / 3.0);
     for (std::size_t k = 1; k < cams.size(); ++k) {
         SCOPED_TRACE("orbit camera " + std::to_string(k));
-        const Frame frame(shapes(), cams[k], 64, 48);
+        const Frame frame(test::shapesScene(), cams[k], 64, 48);
         expectAllBackendsAgree(frame, {2, 4, 8});
     }
 }
@@ -153,8 +145,8 @@ TEST(BackendsAgree, StanfordBunnySmall) {
 }
 
 TEST(ParallelScheme, CountersAndPlanAreConsistent) {
-    const Scene s = shapes();
-    const Frame frame(shapes(), defaultCamera(s, 64, 48), 64, 48);
+    const Scene s = test::shapesScene();
+    const Frame frame(test::shapesScene(), defaultCamera(s, 64, 48), 64, 48);
     const TraceResult r = frame.trace(Backend::Cpu, 4, 2);
     std::uint64_t afterRounds = r.counters.terminatedStep1;
     for (std::uint64_t n : r.counters.terminatedPerRound) afterRounds += n;
