@@ -132,7 +132,7 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         variant("split=sampled-mean", [](BenchConfig& c) { c.trace.dacrt.split = SplitMethod::SampledMean; });
     }
     const std::uint32_t defaultLimit = base.trace.dacrt.resolvedFor(b).rayLimit;
-    const std::vector<std::uint32_t> limits = cpu ? std::vector<std::uint32_t>{4, 8, 16, 32, 64} : std::vector<std::uint32_t>{8, 16, 32, 64};
+    const std::vector<std::uint32_t> limits = cpu ? std::vector<std::uint32_t>{4, 8, 16, 32, 64} : std::vector<std::uint32_t>{8, 16, 32, 64, 128};
     for (std::uint32_t l : limits)
         if (l != defaultLimit)
             variant("leaf-limits=" + std::to_string(l), [l](BenchConfig& c) { c.trace.dacrt.rayLimit = c.trace.dacrt.triLimit = l; });

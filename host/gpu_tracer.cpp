@@ -1,5 +1,7 @@
 #include "gpu_tracer.hpp"
 
+#include <algorithm>
+#include <cstring>
 #include <thread>
 
 #include "dacrt_traversal.hpp"
@@ -41,6 +43,14 @@ vk::ComputePipeline& PipelineCache::get(const std::vector<std::uint32_t>& specia
     return *slot;
 }
 
+bool raysShareStart(const std::vector<Ray>& rays) {
+    // Bitwise, so that the kernel's arithmetic on the shared values is the per-ray one.
+    return std::all_of(rays.begin(), rays.end(), [&](const Ray& r) {
+        return std::memcmp(&r.origin, &rays.front().origin, sizeof(r.origin)) == 0 &&
+               std::memcmp(&r.tmin, &rays.front().tmin, sizeof(r.tmin)) == 0;
+    });
+}
+
 unsigned defaultGpuRegions(const vk::DeviceInfo& device) {
     // A CPU device runs one workgroup per thread: one region per core, as for the cpu backend,
     // measured best on lavapipe (docs/benchmarks.md: 2 regions beat 16 by 35% on the Bunny
@@ -58,9 +68,10 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
                          toString(options.dacrt.triangleFilter) + ", --precision " + toString(options.dacrt.precision) +
                          ": the gpu backend runs only the defaults (watertight, bounds, f32); the others are cpu and "
                          "cpu-seq options");
-    if (!device.subgroupArithmetic)
-        throw InputError("device '" + device.name + "' lacks subgroup arithmetic in compute shaders, which the gpu backend needs");
+    if (!device.subgroupOperations)
+        throw InputError("device '" + device.name + "' lacks subgroup arithmetic or shuffles in compute shaders, which the gpu backend needs");
     const std::uint32_t loopBudget = loopBudgetOf(device);
+    const bool sharedStart = raysShareStart(*g.rays);
     const DacrtOptions leafLimits = options.dacrt.resolvedFor(Backend::Gpu);
 
     TraceResult result;
@@ -119,10 +130,8 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
         {"device: triangles", triCount * sizeof(Triangle)},
         {"device: triangle bounds", triCount * sizeof(Bounds)},
         {"device: hits", rayCount * sizeof(Hit)},
-        {"device: ray ids", rayIdCount * 4},
-        {"device: triangle ids", triIdCount * 4},
-        {"device: ray scratch", rayIdCount * 8},
-        {"device: triangle scratch", triIdCount * 8},
+        {"device: ray ids and scratch", rayIdCount * 8},
+        {"device: triangle ids and scratch", triIdCount * 8},
         {"device: regions", std::uint64_t(regions) * sizeof(Region)},
         {"device: work items", items.size() * sizeof(WorkItem)},
         {"device: counters", sizeof(GpuCounters)},
@@ -164,7 +173,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     PipelineCache frameOnly(context);
     vk::ComputePipeline& pipeline = (pipelines ? *pipelines : frameOnly)
                                         .get({workgroupSize, leafLimits.rayLimit, leafLimits.triLimit,
-                                              options.dacrt.maxDepth, loopBudget});
+                                              options.dacrt.maxDepth, loopBudget, sharedStart ? 1u : 0u});
     std::vector<const vk::Buffer*> bound;
     for (const vk::Buffer& b : buffers) bound.push_back(&b);
     pipeline.bind(bound);
@@ -181,6 +190,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     push.rayScratchHalf = std::uint32_t(rayIdCount);
     push.triScratchHalf = std::uint32_t(triIdCount);
     push.loopProbe = 2;
+    push.rayTmin = g.rays->front().tmin;
     GpuCounters counters{};
     {
         vk::DispatchRecorder recorder(context, std::uint32_t(1 + schedule.size()));

@@ -38,6 +38,10 @@ std::uint32_t loopBudgetOf(const vk::DeviceInfo& device);
 std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t largestRegionRays,
                                    std::uint32_t largestRegionTriangles);
 
+// Whether every ray has the first ray's origin and tmin, bit for bit (primary rays do): the
+// kernel then takes them from push constants instead of loading them per ray.
+bool raysShareStart(const std::vector<Ray>& rays);
+
 // Regions when --regions is not given.
 unsigned defaultGpuRegions(const vk::DeviceInfo& device);
 

@@ -117,8 +117,9 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     info.maxComputeWorkGroupCountX = l.maxComputeWorkGroupCount[0];
     info.maxPerStageStorageBuffers = l.maxPerStageDescriptorStorageBuffers;
     info.subgroupSize = subgroup.subgroupSize;
-    const VkSubgroupFeatureFlags needed = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
-    info.subgroupArithmetic = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+    const VkSubgroupFeatureFlags needed =
+        VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT;
+    info.subgroupOperations = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
                               (subgroup.supportedOperations & needed) == needed;
     info.timestamps = l.timestampComputeAndGraphics && l.timestampPeriod > 0.0f;
     return info;
@@ -147,7 +148,7 @@ std::string DeviceInfo::describe() const {
       << "   workgroup: " << maxComputeWorkGroupInvocations << " invocations, size x " << maxComputeWorkGroupSizeX
       << ", count x " << maxComputeWorkGroupCountX << "\n"
       << "   storage buffers per stage: " << maxPerStageStorageBuffers << "\n"
-      << "   subgroup size: " << subgroupSize << (subgroupArithmetic ? " (arithmetic in compute)" : " (no compute arithmetic)")
+      << "   subgroup size: " << subgroupSize << (subgroupOperations ? " (arithmetic and shuffles in compute)" : " (no compute arithmetic or shuffles)")
       << "\n   timestamps: " << (timestamps ? "yes" : "no") << "\n";
     return s.str();
 }

@@ -24,7 +24,7 @@ struct DeviceInfo {
     std::uint32_t maxComputeWorkGroupCountX = 0;
     std::uint32_t maxPerStageStorageBuffers = 0;
     std::uint32_t subgroupSize = 0;
-    bool subgroupArithmetic = false;  // compute-stage arithmetic and ballot operations
+    bool subgroupOperations = false;  // compute-stage arithmetic and shuffle operations (the kernel's)
     bool timestamps = false;
     std::string describe() const;
 };

@@ -10,6 +10,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_shuffle : require
 #extension GL_EXT_control_flow_attributes : require
 
 #define IN(T) in T
@@ -41,6 +42,7 @@ bool overBudget(uint spent, uint cost) {
 void main() {
     gMargin = push.margin;
     gRayOrigin = push.rayOrigin;
+    gRayTmin = push.rayTmin;
     gAxis = push.axis;
     gRayScratchHalf = push.rayScratchHalf;
     gTriScratchHalf = push.triScratchHalf;

@@ -8,15 +8,19 @@ layout(constant_id = DACRT_SPEC_TRI_LIMIT) const uint kTriLimit = 16;
 layout(constant_id = DACRT_SPEC_MAX_DEPTH) const uint kMaxDepth = 48;
 // Loop iterations one slice of a work item may spend (0: no limit, one slice per work item).
 layout(constant_id = DACRT_SPEC_LOOP_BUDGET) const uint kLoopBudget = 0;
+// Primary rays share their origin and tmin: filters then take them from push constants and
+// load only invDir (llvmpipe loads a buffer component one invocation at a time).
+layout(constant_id = DACRT_SPEC_SHARED_START) const bool kSharedStart = false;
 
 layout(std430, binding = DACRT_BINDING_RAYS) readonly buffer RayBuffer { Ray rays[]; };
 layout(std430, binding = DACRT_BINDING_TRIANGLES) readonly buffer TriangleBuffer { Triangle triangles[]; };
 layout(std430, binding = DACRT_BINDING_TRIANGLE_BOUNDS) readonly buffer BoundsBuffer { Bounds triangleBounds[]; };
 layout(std430, binding = DACRT_BINDING_HITS) coherent buffer HitBuffer { Hit hits[]; };
+// Id arrays with scratch space behind them: one buffer each, so that a partition writes every
+// id with one store, kept or dropped (llvmpipe runs a store one invocation at a time, both
+// sides of a branch included).
 layout(std430, binding = DACRT_BINDING_RAY_IDS) coherent buffer RayIdBuffer { uint rayIds[]; };
 layout(std430, binding = DACRT_BINDING_TRI_IDS) coherent buffer TriIdBuffer { uint triIds[]; };
-layout(std430, binding = DACRT_BINDING_RAY_SCRATCH) coherent buffer RayScratchBuffer { uint rayScratch[]; };
-layout(std430, binding = DACRT_BINDING_TRI_SCRATCH) coherent buffer TriScratchBuffer { uint triScratch[]; };
 layout(std430, binding = DACRT_BINDING_REGIONS) coherent buffer RegionBuffer { Region regions[]; };
 layout(std430, binding = DACRT_BINDING_WORK_ITEMS) readonly buffer WorkItemBuffer { WorkItem workItems[]; };
 layout(std430, binding = DACRT_BINDING_COUNTERS) coherent buffer CounterBuffer { GpuCounters counters; };
@@ -26,6 +30,7 @@ layout(std430, binding = DACRT_BINDING_STACKS) coherent buffer StackBuffer { Sta
 // Frame parameters, set from push constants at the start of main.
 float gMargin;
 vec3 gRayOrigin;
+float gRayTmin;
 uint gAxis;
 uint gRayScratchHalf;
 uint gTriScratchHalf;
@@ -33,12 +38,6 @@ uint gTriScratchHalf;
 const uint kWorkgroupSize = gl_WorkGroupSize.x;
 
 shared uint sSubgroupTotals[kWorkgroupSize];
-shared Triangle sTriangles[kWorkgroupSize];   // leaf staging
-shared uint sPrims[kWorkgroupSize];
-shared float sBestT[kWorkgroupSize];          // leaf reduction across the lanes of one ray
-shared uint sBestPrim[kWorkgroupSize];
-shared float sBestU[kWorkgroupSize];
-shared float sBestV[kWorkgroupSize];
 shared bool sReady;                           // this work item may run now
 // The DACRT stack of the running slice (saved to `stacks` between slices).
 shared StackEntry sStack[kMaxDepth + 1];

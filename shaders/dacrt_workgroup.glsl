@@ -56,12 +56,21 @@ const uint kKeepStill = 2u;        // rays with no motion along gAxis
 const uint kKeepStuckHigh = 3u;    // rays moving up gAxis that cannot reach the cell
 const uint kKeepStuckLow = 4u;     // rays moving down gAxis that cannot reach the cell
 
+// The fields of a ray that its filters read: origin, tmin and invDir.
+Ray filterRay(uint id) {
+    Ray ray;
+    ray.origin = kSharedStart ? gRayOrigin : rays[id].origin;
+    ray.tmin = kSharedStart ? gRayTmin : rays[id].tmin;
+    ray.invDir = rays[id].invDir;
+    return ray;
+}
+
 bool keepRay(uint id, uint rule, vec3 lo, vec3 hi) {
-    Ray ray = rays[id];
+    Ray ray = filterRay(id);
     float bestT = hits[id].t;
     if (rule == kKeepCrossing) return rayMayCrossCell(ray, lo, hi, bestT);
     if (rule == kKeepFinished) return hits[id].prim != kMissPrim && hitEndsInBox(ray, lo, hi, bestT);
-    float d = ray.dir[gAxis];
+    float d = ray.invDir[gAxis];  // 0 exactly where dir is 0 (slabInterval)
     if (rule == kKeepStill) return d == 0.0;
     bool moving = rule == kKeepStuckHigh ? d > 0.0 : d < 0.0;
     return moving && !rayMayCrossCell(ray, lo, hi, bestT);
@@ -77,13 +86,15 @@ uint partitionCost(uint n) {
     return 2u * ((n + kPartitionChunk - 1u) / kPartitionChunk) + 2u;
 }
 
+uint leafLanesPerRay(uint rayCount);
+
 // ... the ray/triangle tests of rayCount rays against triCount triangles (leafTests) ...
 uint leafTestCost(uint rayCount, uint triCount) {
-    uint lanes = max(1u, kWorkgroupSize / max(rayCount, 1u));
-    uint raysPerPass = kWorkgroupSize / lanes;
+    uint lanes = leafLanesPerRay(rayCount);
+    uint raysPerPass = gl_NumSubgroups * (gl_SubgroupSize / lanes);
     uint passes = (rayCount + raysPerPass - 1u) / raysPerPass;
-    uint tiles = (triCount + kWorkgroupSize - 1u) / kWorkgroupSize;
-    uint perTile = 2u + (kWorkgroupSize + lanes - 1u) / lanes;
+    uint tiles = (triCount + gl_SubgroupSize - 1u) / gl_SubgroupSize;
+    uint perTile = 2u + (gl_SubgroupSize + lanes - 1u) / lanes;
     return passes * (2u + tiles * perTile + lanes);
 }
 
@@ -108,11 +119,12 @@ bool keepId(uint id, uint rule, vec3 lo, vec3 hi) {
 }
 
 // Stable partition of rayIds[begin, end) (or triIds, for kKeepOverlapping): the ids `rule`
-// keeps first, in their order, then the others in theirs. Out of place through the two
-// halves of the matching scratch buffer, then copied back. Returns the end of the kept ids.
+// keeps first, in their order, then the others in theirs. Kept ids move down in place (never
+// onto an unread id); dropped ids wait in the buffer's scratch half and are copied back
+// behind them. Returns the end of the kept ids.
 uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
     bool triangleIds = rule == kKeepOverlapping;
-    uint secondHalf = triangleIds ? gTriScratchHalf : gRayScratchHalf;
+    uint scratch = (triangleIds ? gTriScratchHalf : gRayScratchHalf) + begin;
     uint kept = 0, dropped = 0;
     uint lane = gl_LocalInvocationIndex;
     for (uint base = begin; base < end; base += kPartitionChunk) {
@@ -129,32 +141,34 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         }
         uint total;
         uint keptBefore = workgroupExclusiveSum(myKept, total);
+        // Kept ids move down in place: every id of the chunk must be read before any of the
+        // chunk's slots is written (several subgroups already met at a barrier in the sum).
+        subgroupBarrier();
         // Every invocation before this one had a full run of ids (runs fill in order).
         uint droppedBefore = min(lane * kIdsPerInvocation, end - base) - keptBefore;
-        uint k = begin + kept + keptBefore, d = secondHalf + begin + dropped + droppedBefore;
+        uint k = begin + kept + keptBefore, d = scratch + dropped + droppedBefore;
         [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             if (first + e >= end) continue;
             uint slot = keeps[e] ? k++ : d++;
-            if (triangleIds) triScratch[slot] = ids[e];
-            else rayScratch[slot] = ids[e];
+            if (triangleIds) triIds[slot] = ids[e];
+            else rayIds[slot] = ids[e];
         }
         kept += total;
         dropped += min(kPartitionChunk, end - base) - total;
     }
     workgroupSync();
-    for (uint base = begin; base < end; base += kPartitionChunk) {
+    uint keptEnd = begin + kept;
+    for (uint base = 0; base < dropped; base += kPartitionChunk) {
         [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
-            uint index = base + lane * kIdsPerInvocation + e;
-            if (index >= end) continue;
-            uint offset = index - begin;
-            uint from = offset < kept ? index : secondHalf + begin + offset - kept;
-            if (triangleIds) triIds[index] = triScratch[from];
-            else rayIds[index] = rayScratch[from];
+            uint offset = base + lane * kIdsPerInvocation + e;
+            if (offset >= dropped) continue;
+            if (triangleIds) triIds[keptEnd + offset] = triIds[scratch + offset];
+            else rayIds[keptEnd + offset] = rayIds[scratch + offset];
         }
     }
     workgroupSync();
     if (rule == kKeepCrossing && lane == 0) atomicAdd(counters.rayBoxTests, end - begin);
-    return begin + kept;
+    return keptEnd;
 }
 
 uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
@@ -165,66 +179,77 @@ uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
     return partitionIds(begin, end, kKeepOverlapping, lo, hi);
 }
 
+// Invocations that share one ray in a leaf with rayCount rays: a power of two, so that one
+// ray's lanes are a run of one subgroup that a butterfly of shuffles reduces.
+uint leafLanesPerRay(uint rayCount) {
+    return 1u << findMSB(max(1u, gl_SubgroupSize / max(rayCount, 1u)));
+}
+
+// The fields of a ray that the triangle test reads: origin, tmin, axes and shear.
+Ray leafRay(uint id) {
+    Ray ray;
+    ray.origin = kSharedStart ? gRayOrigin : rays[id].origin;
+    ray.tmin = kSharedStart ? gRayTmin : rays[id].tmin;
+    ray.axes = rays[id].axes;
+    ray.shear = rays[id].shear;
+    return ray;
+}
+
 // Rays rayIds[rayBegin, rayEnd) of a leaf against its triangles, updating their best hits.
-// A large leaf may take several calls (slices) over consecutive ray ranges. Every
-// invocation stays busy: with fewer rays than invocations each ray gets `lanes`
-// invocations that split the triangles and reduce their bests; triangles are staged in
-// shared memory one workgroup-sized tile at a time.
+// A large leaf may take several calls (slices) over consecutive ray ranges. Each subgroup
+// works alone: every lane loads one triangle of a subgroup-sized tile and the tile reaches
+// the other lanes by shuffles, not through shared memory (llvmpipe reads and writes memory
+// one invocation at a time, but shuffles in registers). With fewer rays than lanes each ray
+// gets `lanes` lanes that split the tile; a butterfly then gives all of them the best hit.
 void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
-    uint lane = gl_LocalInvocationIndex;
+    uint lane = gl_SubgroupInvocationID;
     uint rayCount = rayEnd - rayBegin;
-    uint lanes = max(1u, kWorkgroupSize / rayCount);
-    uint raysPerPass = kWorkgroupSize / lanes;
-    uint myRay = lane / lanes;
-    uint mySlot = lane % lanes;
-    if (lane == 0) atomicAdd(counters.rayTriangleTests, rayCount * (triEnd - triBegin));
+    uint lanes = leafLanesPerRay(rayCount);
+    uint slot = lane & (lanes - 1u);
+    uint raysPerSubgroup = gl_SubgroupSize / lanes;
+    uint raysPerPass = gl_NumSubgroups * raysPerSubgroup;
+    uint myRay = gl_SubgroupID * raysPerSubgroup + lane / lanes;
+    if (gl_LocalInvocationIndex == 0) atomicAdd(counters.rayTriangleTests, rayCount * (triEnd - triBegin));
     for (uint first = rayBegin; first < rayEnd; first += raysPerPass) {
         uint index = first + myRay;
-        bool rayActive = myRay < raysPerPass && index < rayEnd;
+        bool rayActive = index < rayEnd;
         uint id = rayActive ? rayIds[index] : 0u;
-        Ray ray = rays[id];
+        Ray ray = leafRay(id);
         Hit best = hits[id];
-        for (uint tile = triBegin; tile < triEnd; tile += kWorkgroupSize) {
-            workgroupSync();
-            if (tile + lane < triEnd) {
-                uint prim = triIds[tile + lane];
-                sPrims[lane] = prim;
-                sTriangles[lane] = triangles[prim];
-            }
-            workgroupSync();
-            uint tileSize = min(kWorkgroupSize, triEnd - tile);
-            if (rayActive) {
-                for (uint k = mySlot; k < tileSize; k += lanes) {
-                    TriangleHit h = intersectWatertight(ray, sTriangles[k].v0, sTriangles[k].v1, sTriangles[k].v2);
-                    if (h.hit && h.t > ray.tmin && hitPrecedes(h.t, sPrims[k], best.t, best.prim)) {
+        for (uint tile = triBegin; tile < triEnd; tile += gl_SubgroupSize) {
+            uint tileSize = min(gl_SubgroupSize, triEnd - tile);
+            uint myPrim = lane < tileSize ? triIds[tile + lane] : 0u;
+            Triangle mine = triangles[myPrim];
+            for (uint j = 0; j < tileSize; j += lanes) {  // uniform: every lane shuffles
+                uint k = j + slot;
+                uint prim = subgroupShuffle(myPrim, k);
+                vec3 v0 = subgroupShuffle(mine.v0, k);
+                vec3 v1 = subgroupShuffle(mine.v1, k);
+                vec3 v2 = subgroupShuffle(mine.v2, k);
+                if (rayActive && k < tileSize) {
+                    TriangleHit h = intersectWatertight(ray, v0, v1, v2);
+                    if (h.hit && h.t > ray.tmin && hitPrecedes(h.t, prim, best.t, best.prim)) {
                         best.t = h.t;
-                        best.prim = sPrims[k];
+                        best.prim = prim;
                         best.u = h.u;
                         best.v = h.v;
                     }
                 }
             }
         }
-        if (lanes > 1) {
-            sBestT[lane] = best.t;
-            sBestPrim[lane] = best.prim;
-            sBestU[lane] = best.u;
-            sBestV[lane] = best.v;
-            workgroupSync();
-            if (rayActive && mySlot == 0) {
-                for (uint k = lane + 1; k < lane + lanes; ++k) {
-                    if (hitPrecedes(sBestT[k], sBestPrim[k], best.t, best.prim)) {
-                        best.t = sBestT[k];
-                        best.prim = sBestPrim[k];
-                        best.u = sBestU[k];
-                        best.v = sBestV[k];
-                    }
-                }
-            }
+        // hitPrecedes is a total order on (t, prim), so the butterfly's order of comparisons
+        // gives the sequential answer.
+        for (uint mask = 1u; mask < lanes; mask <<= 1u) {
+            Hit other;
+            other.t = subgroupShuffleXor(best.t, mask);
+            other.prim = subgroupShuffleXor(best.prim, mask);
+            other.u = subgroupShuffleXor(best.u, mask);
+            other.v = subgroupShuffleXor(best.v, mask);
+            if (hitPrecedes(other.t, other.prim, best.t, best.prim)) best = other;
         }
-        if (rayActive && mySlot == 0) hits[id] = best;
-        workgroupSync();
+        if (rayActive && slot == 0u) hits[id] = best;
     }
+    workgroupSync();
 }
 
 // After a leaf's tests: the rays whose best hit ends them inside the leaf box move to the

@@ -109,10 +109,10 @@ struct DacrtPush {
     float margin;          // filter widening (filterMargin)
     uint firstWorkItem;    // this dispatch's work items are [firstWorkItem, + group count)
     uint axis;             // division axis
-    uint rayScratchHalf;   // ray id count: the second half of the ray scratch starts here
-    uint triScratchHalf;   // triangle id count: likewise for the triangle scratch
+    uint rayScratchHalf;   // ray id count: the ray id buffer's second half, scratch, starts here
+    uint triScratchHalf;   // triangle id count: likewise in the triangle id buffer
     uint loopProbe;        // 2; a loop of this many iterations at the end detects a loop limiter
-    uint pad0;
+    float rayTmin;         // every ray's tmin, where DACRT_SPEC_SHARED_START says they share it
     uint pad1;
     uint pad2;
 };
@@ -155,16 +155,14 @@ struct WorkgroupTestPush {
 #define DACRT_BINDING_TRIANGLES 1
 #define DACRT_BINDING_TRIANGLE_BOUNDS 2
 #define DACRT_BINDING_HITS 3
-#define DACRT_BINDING_RAY_IDS 4
-#define DACRT_BINDING_TRI_IDS 5
-#define DACRT_BINDING_RAY_SCRATCH 6
-#define DACRT_BINDING_TRI_SCRATCH 7
-#define DACRT_BINDING_REGIONS 8
-#define DACRT_BINDING_WORK_ITEMS 9
-#define DACRT_BINDING_COUNTERS 10
-#define DACRT_BINDING_STATES 11
-#define DACRT_BINDING_STACKS 12
-#define DACRT_BINDING_COUNT 13
+#define DACRT_BINDING_RAY_IDS 4      // the ray ids, then as many again of scratch
+#define DACRT_BINDING_TRI_IDS 5      // the triangle ids, then as many again of scratch
+#define DACRT_BINDING_REGIONS 6
+#define DACRT_BINDING_WORK_ITEMS 7
+#define DACRT_BINDING_COUNTERS 8
+#define DACRT_BINDING_STATES 9
+#define DACRT_BINDING_STACKS 10
+#define DACRT_BINDING_COUNT 11
 
 // A split whose child keeps every ray and every triangle of its parent made no progress;
 // after this many such splits in a row the node is a leaf. Identical rays meeting coincident
@@ -178,6 +176,7 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_TRI_LIMIT 2
 #define DACRT_SPEC_MAX_DEPTH 3
 #define DACRT_SPEC_LOOP_BUDGET 4
+#define DACRT_SPEC_SHARED_START 5   // 1: every ray has origin rayOrigin and tmin rayTmin (DacrtPush)
 
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 32);
@@ -189,6 +188,7 @@ static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalSt
 static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depth) == 36);
 static_assert(offsetof(StackEntry, stalls) == 40);
 static_assert(sizeof(DacrtPush) == 48 && offsetof(DacrtPush, loopProbe) == 32);
+static_assert(offsetof(DacrtPush, rayTmin) == 36);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);

@@ -20,14 +20,16 @@ struct RayInterval {
 // The interval of one slab lo <= origin + t dir <= hi, each bound within three roundings of
 // the exact one. A zero direction component never divides: the slab then either holds the
 // origin (no constraint) or the interval is empty. makeRay keeps |invDir| <= 2^64 and
-// coordinates are at most 1e9, so every bound is finite: no inf, no NaN.
-RayInterval slabInterval(float origin, float dir, float invDir, float lo, float hi) {
+// coordinates are at most 1e9, so every bound is finite: no inf, no NaN. invDir is 0
+// exactly where dir is 0 (makeRay flushes |dir| < 2^-64 to 0, so 1/dir never overflows), so
+// the test reads invDir only: a filter on the gpu then loads 3 floats of the ray, not 6.
+RayInterval slabInterval(float origin, float invDir, float lo, float hi) {
     precise float t0 = (lo - origin) * invDir;
     precise float t1 = (hi - origin) * invDir;
     RayInterval r;
     r.tNear = min(t0, t1);
     r.tFar = max(t0, t1);
-    if (dir == 0.0) {
+    if (invDir == 0.0) {
         bool inside = origin >= lo && origin <= hi;
         r.tNear = inside ? -kNoHitT : kNoHitT;
         r.tFar = inside ? kNoHitT : -kNoHitT;
@@ -37,9 +39,9 @@ RayInterval slabInterval(float origin, float dir, float invDir, float lo, float 
 
 // The rounded interval of a ray inside [lo, hi]; empty when tNear > tFar.
 RayInterval rayBoxIntervalRounded(IN(Ray) ray, vec3 lo, vec3 hi) {
-    RayInterval x = slabInterval(ray.origin.x, ray.dir.x, ray.invDir.x, lo.x, hi.x);
-    RayInterval y = slabInterval(ray.origin.y, ray.dir.y, ray.invDir.y, lo.y, hi.y);
-    RayInterval z = slabInterval(ray.origin.z, ray.dir.z, ray.invDir.z, lo.z, hi.z);
+    RayInterval x = slabInterval(ray.origin.x, ray.invDir.x, lo.x, hi.x);
+    RayInterval y = slabInterval(ray.origin.y, ray.invDir.y, lo.y, hi.y);
+    RayInterval z = slabInterval(ray.origin.z, ray.invDir.z, lo.z, hi.z);
     RayInterval r;
     r.tNear = max(x.tNear, max(y.tNear, z.tNear));
     r.tFar = min(x.tFar, min(y.tFar, z.tFar));

@@ -4,6 +4,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_shuffle : require
 #extension GL_EXT_control_flow_attributes : require
 
 #define IN(T) in T
@@ -17,6 +18,7 @@ layout(push_constant) uniform Push { WorkgroupTestPush push; };
 void main() {
     gMargin = 0.0;
     gRayOrigin = vec3(0.0);
+    gRayTmin = 0.0;
     gAxis = push.axis;
     gRayScratchHalf = push.rayScratchHalf;
     gTriScratchHalf = push.triScratchHalf;

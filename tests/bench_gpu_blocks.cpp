@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
     std::iota(triIds.begin(), triIds.end(), 0u);
     const std::uint64_t sizes[DACRT_BINDING_COUNT] = {
         rayCount * sizeof(Ray), triCount * sizeof(Triangle), triCount * sizeof(Bounds), rayCount * sizeof(Hit),
-        rayCount * 4ull, triCount * 4ull, rayCount * 8ull, triCount * 8ull, sizeof(Region), sizeof(WorkItem),
+        rayCount * 8ull, triCount * 8ull, sizeof(Region), sizeof(WorkItem),
         sizeof(GpuCounters), sizeof(TraversalState), sizeof(StackEntry)};
     std::vector<vk::Buffer> buffers;
     for (std::uint32_t b = 0; b < DACRT_BINDING_COUNT; ++b) buffers.emplace_back(context, sizes[b], "bench");
@@ -48,8 +48,8 @@ int main(int argc, char** argv) {
     buffers[DACRT_BINDING_TRIANGLES].upload(tris.data(), sizes[DACRT_BINDING_TRIANGLES]);
     buffers[DACRT_BINDING_TRIANGLE_BOUNDS].upload(bounds.data(), sizes[DACRT_BINDING_TRIANGLE_BOUNDS]);
     buffers[DACRT_BINDING_HITS].upload(hits.data(), sizes[DACRT_BINDING_HITS]);
-    buffers[DACRT_BINDING_RAY_IDS].upload(rayIds.data(), sizes[DACRT_BINDING_RAY_IDS]);
-    buffers[DACRT_BINDING_TRI_IDS].upload(triIds.data(), sizes[DACRT_BINDING_TRI_IDS]);
+    buffers[DACRT_BINDING_RAY_IDS].upload(rayIds.data(), rayCount * 4ull);
+    buffers[DACRT_BINDING_TRI_IDS].upload(triIds.data(), triCount * 4ull);
     const std::uint32_t subgroup = context.info().subgroupSize;
     for (std::uint32_t workgroup : {subgroup, 4 * subgroup}) {
         vk::ComputePipeline pipeline(context, std::span<const std::uint32_t>(workgroup_test_spv, sizeof(workgroup_test_spv) / 4),

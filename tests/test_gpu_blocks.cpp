@@ -81,16 +81,15 @@ std::uint32_t runBlock(vk::Context& context, BlockInputs& in, WorkgroupTestPush 
     std::vector<vk::Buffer> buffers;
     const std::uint64_t sizes[DACRT_BINDING_COUNT] = {
         in.rays.size() * sizeof(Ray), in.triangles.size() * sizeof(Triangle), in.bounds.size() * sizeof(Bounds),
-        in.hits.size() * sizeof(Hit), in.rayIds.size() * 4, in.triIds.size() * 4, in.rayIds.size() * 8,
-        in.triIds.size() * 8, sizeof(Region), sizeof(WorkItem), sizeof(GpuCounters), sizeof(TraversalState),
+        in.hits.size() * sizeof(Hit), in.rayIds.size() * 8, in.triIds.size() * 8, sizeof(Region), sizeof(WorkItem), sizeof(GpuCounters), sizeof(TraversalState),
         sizeof(StackEntry)};
     for (std::uint32_t b = 0; b < DACRT_BINDING_COUNT; ++b) buffers.emplace_back(context, sizes[b], "test " + std::to_string(b));
     buffers[DACRT_BINDING_RAYS].upload(in.rays.data(), sizes[DACRT_BINDING_RAYS]);
     buffers[DACRT_BINDING_TRIANGLES].upload(in.triangles.data(), sizes[DACRT_BINDING_TRIANGLES]);
     buffers[DACRT_BINDING_TRIANGLE_BOUNDS].upload(in.bounds.data(), sizes[DACRT_BINDING_TRIANGLE_BOUNDS]);
     buffers[DACRT_BINDING_HITS].upload(in.hits.data(), sizes[DACRT_BINDING_HITS]);
-    buffers[DACRT_BINDING_RAY_IDS].upload(in.rayIds.data(), sizes[DACRT_BINDING_RAY_IDS]);
-    buffers[DACRT_BINDING_TRI_IDS].upload(in.triIds.data(), sizes[DACRT_BINDING_TRI_IDS]);
+    buffers[DACRT_BINDING_RAY_IDS].upload(in.rayIds.data(), in.rayIds.size() * 4);
+    buffers[DACRT_BINDING_TRI_IDS].upload(in.triIds.data(), in.triIds.size() * 4);
     const GpuCounters zero{};
     buffers[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
     vk::ComputePipeline pipeline(context, std::span<const std::uint32_t>(workgroup_test_spv, sizeof(workgroup_test_spv) / 4),
@@ -102,8 +101,8 @@ std::uint32_t runBlock(vk::Context& context, BlockInputs& in, WorkgroupTestPush 
     recorder.dispatch("block", pipeline, 1, &push);
     recorder.submitAndWait();
     buffers[DACRT_BINDING_HITS].download(in.hits.data(), sizes[DACRT_BINDING_HITS]);
-    buffers[DACRT_BINDING_RAY_IDS].download(in.rayIds.data(), sizes[DACRT_BINDING_RAY_IDS]);
-    buffers[DACRT_BINDING_TRI_IDS].download(in.triIds.data(), sizes[DACRT_BINDING_TRI_IDS]);
+    buffers[DACRT_BINDING_RAY_IDS].download(in.rayIds.data(), in.rayIds.size() * 4);
+    buffers[DACRT_BINDING_TRI_IDS].download(in.triIds.data(), in.triIds.size() * 4);
     GpuCounters counters{};
     buffers[DACRT_BINDING_COUNTERS].download(&counters, sizeof(counters));
     EXPECT_EQ(counters.loopLimitHits, 0u) << "the driver's loop limiter cut the block short";
@@ -164,15 +163,42 @@ TEST_P(GpuBlocks, TrianglePartitionsAreStableAndExact) {
     EXPECT_TRUE(noValidationErrors(*context));
 }
 
+TEST(GpuBlocks, PrimaryRaysShareTheirStart) {
+    Camera camera;
+    camera.eye = glm::dvec3(0.1, 0.2, 3.0);
+    camera.yfovRadians = 0.8;
+    std::vector<Ray> rays = primaryRays(camera, 8, 6);
+    EXPECT_TRUE(raysShareStart(rays));
+    rays[17].origin.y = std::nextafter(rays[17].origin.y, 10.0f);
+    EXPECT_FALSE(raysShareStart(rays)) << "one origin a unit in the last place away";
+    rays = primaryRays(camera, 8, 6);
+    rays[40].tmin = 1e-6f;
+    EXPECT_FALSE(raysShareStart(rays)) << "one tmin differs";
+}
+
 TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
     DACRT_REQUIRE_GPU(context);
     const std::uint32_t wg = GetParam();
     std::mt19937 rng(200 + wg);
-    // Few rays and many triangles (lanes share a ray), many rays and few triangles, and both.
-    for (const auto& [rays, tris] : {std::pair{3u, 500u}, std::pair{200u, 5u}, std::pair{50u, 70u}, std::pair{1u, 1u}}) {
+    // Few rays and many triangles (lanes share a ray and reduce their bests), many rays and few
+    // triangles, and both; `copies` > 0 repeats that many triangles throughout, so that equal
+    // t from different lanes must go to the smaller primitive id.
+    for (const auto& [rays, tris, copies] : {std::tuple{3u, 500u, 0u}, std::tuple{200u, 5u, 0u}, std::tuple{50u, 70u, 0u},
+                                             std::tuple{1u, 1u, 0u}, std::tuple{2u, 37u, 3u}, std::tuple{1u, 29u, 2u},
+                                             std::tuple{20u, 45u, 4u}}) {
         BlockInputs in = randomInputs(rng, rays + 4, tris + 3);
         const glm::vec3 lo(-1.5f, -1.5f, -1.0f), hi(1.5f, 1.5f, 0.1f);
         const std::uint32_t begin = 2, end = 2 + rays, triBegin = 1, triEnd = 1 + tris;
+        if (copies > 0) {  // every leaf ray aimed at the centre of triangle 1 (0 is degenerate), which has copies
+            for (std::size_t j = copies; j < in.triangles.size(); ++j) in.triangles[j] = in.triangles[j % copies];
+            const Triangle& t = in.triangles[1];
+            const glm::dvec3 centre = (glm::dvec3(t.v0) + glm::dvec3(t.v1) + glm::dvec3(t.v2)) / 3.0;
+            for (std::uint32_t k = begin; k < end; ++k) {
+                const std::uint32_t id = in.rayIds[k];
+                in.rays[id] = makeRay(in.rays[id].origin, centre - glm::dvec3(in.rays[id].origin));
+                in.hits[id] = missHit();
+            }
+        }
         std::vector<Hit> expectedHits = in.hits;
         std::vector<std::uint32_t> expectedIds = in.rayIds;
         for (std::uint32_t k = begin; k < end; ++k) {
@@ -196,8 +222,8 @@ TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
         EXPECT_EQ(in.rayIds, expectedIds);
         std::size_t hitsFound = 0;
         for (std::uint32_t k = begin; k < end; ++k) hitsFound += expectedHits[in.rayIds[k]].prim != kMissPrim;
-        if (rays >= 50) {
-            EXPECT_GT(hitsFound, 0u) << "the random leaf should hit something";
+        if (rays >= 50 || copies > 0) {
+            EXPECT_GT(hitsFound, 0u) << "the leaf should hit something";
         }
     }
     EXPECT_TRUE(noValidationErrors(*context));
