@@ -51,6 +51,7 @@ struct BenchConfig {
     unsigned threads = 1;
     bool embreeRobust = true;
     bool embreeStatic = false;
+    std::uint32_t rayGroups = 0;  // gpu: 0 = the device's default
     bool isDefault = false;
 };
 
@@ -81,6 +82,7 @@ std::string optionText(const BenchConfig& c) {
       << " precision=" << toString(d.precision) << " split=" << toString(d.split) << " ray_limit=" << d.rayLimit
       << " tri_limit=" << d.triLimit << " axis=" << toString(c.trace.axis) << " regions=" << c.trace.regions
       << " threads=" << c.threads;
+    if (c.backend == Backend::Gpu) s << " ray_groups=" << (c.rayGroups ? std::to_string(c.rayGroups) : "auto");
     return s.str();
 }
 
@@ -96,7 +98,8 @@ BenchConfig baseConfig(Backend b, unsigned hardwareThreads) {
     return c;
 }
 
-std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions) {
+std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions,
+                                      std::uint32_t gpuDefaultRayGroups) {
     std::vector<BenchConfig> out;
     const BenchConfig base = baseConfig(b, hardwareThreads);
     auto variant = [&](const std::string& name, auto&& change) {
@@ -143,6 +146,10 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
             variant("regions=" + std::to_string(r), [r](BenchConfig& c) { c.trace.regions = r; });
     for (DivisionAxis a : {DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z})
         variant("axis=" + toString(a), [a](BenchConfig& c) { c.trace.axis = a; });
+    if (b == Backend::Gpu)
+        for (std::uint32_t groups : {1u, 2u, 4u})
+            if (groups != gpuDefaultRayGroups)
+                variant("ray-groups=" + std::to_string(groups), [groups](BenchConfig& c) { c.rayGroups = groups; });
     return out;
 }
 
@@ -298,7 +305,7 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
         const double prepareMs = msSince(start);
         const auto traceStart = Clock::now();
         out.result = c.backend == Backend::Gpu
-                         ? traceGpu(g, c.trace, GpuTuning{}, *devices.gpu, pool, {}, devices.pipelines.get())
+                         ? traceGpu(g, c.trace, GpuTuning{0, c.rayGroups}, *devices.gpu, pool, {}, devices.pipelines.get())
                          : traceCpu(g, c.trace, pool);
         out.ms = msSince(start);
         out.parts.emplace_back("rays and bounds", prepareMs);
@@ -469,15 +476,17 @@ int runBenchCommand(const BenchCommand& request) {
     }
     Devices devices;
     unsigned gpuDefaultRegions = 16;
+    std::uint32_t gpuDefaultRayGroups = 1;
     if (std::find(backends.begin(), backends.end(), Backend::Gpu) != backends.end()) {
         devices.gpu = std::make_unique<vk::Context>(vk::ContextOptions{cmd.device, cmd.validate});
         devices.pipelines = std::make_unique<PipelineCache>(*devices.gpu);
         gpuDefaultRegions = defaultGpuRegions(devices.gpu->info());
+        gpuDefaultRayGroups = defaultRayGroups(devices.gpu->info(), gpuDefaultRegions);
     }
     std::vector<BenchConfig> configs;
     for (Backend b : backends) {
         const std::vector<BenchConfig> more =
-            cmd.suite == BenchSuite::Sweep ? sweepConfigs(b, hardwareThreads, gpuDefaultRegions)
+            cmd.suite == BenchSuite::Sweep ? sweepConfigs(b, hardwareThreads, gpuDefaultRegions, gpuDefaultRayGroups)
                                            : table51Configs(b, hardwareThreads);
         configs.insert(configs.end(), more.begin(), more.end());
     }

@@ -130,6 +130,10 @@ int runCli(int argc, char** argv) {
     renderCmd->add_flag("--validate", render.validate, "gpu: run under the Vulkan validation layers; errors fail the run");
     renderCmd->add_option("--workgroup-size", render.workgroupSize, "gpu: invocations per workgroup (default: per device)")
         ->check(CLI::Range(1u, 1024u));
+    renderCmd->add_option("--ray-groups", render.rayGroups,
+                          "gpu: work items per region, each a band of its rays with its own copy of the region's "
+                          "triangle ids (default: per device)")
+        ->check(CLI::Range(1u, 64u));
 
     CLI::App* devicesCmd = app.add_subcommand("devices", "list the Vulkan devices and the limits that matter here");
 

@@ -43,12 +43,36 @@ vk::ComputePipeline& PipelineCache::get(const std::vector<std::uint32_t>& specia
     return *slot;
 }
 
+RayGroups groupRays(const Division& division, std::uint32_t groups) {
+    RayGroups out;
+    for (const Region& r : division.regions) {
+        const std::uint32_t rays = r.rayEnd - r.rayBegin;
+        for (std::uint32_t g = 0; g < groups; ++g) {
+            Region slot = r;
+            slot.rayBegin = r.rayBegin + std::uint32_t(std::uint64_t(rays) * g / groups);
+            slot.rayEnd = r.rayBegin + std::uint32_t(std::uint64_t(rays) * (g + 1) / groups);
+            slot.terminated = slot.rayBegin;
+            slot.triBegin = std::uint32_t(out.triIds.size());
+            out.triIds.insert(out.triIds.end(), division.triIds.begin() + r.triBegin, division.triIds.begin() + r.triEnd);
+            slot.triEnd = std::uint32_t(out.triIds.size());
+            out.regions.push_back(slot);
+        }
+    }
+    return out;
+}
+
 bool raysShareStart(const std::vector<Ray>& rays) {
     // Bitwise, so that the kernel's arithmetic on the shared values is the per-ray one.
     return std::all_of(rays.begin(), rays.end(), [&](const Ray& r) {
         return std::memcmp(&r.origin, &rays.front().origin, sizeof(r.origin)) == 0 &&
                std::memcmp(&r.tmin, &rays.front().tmin, sizeof(r.tmin)) == 0;
     });
+}
+
+std::uint32_t defaultRayGroups(const vk::DeviceInfo& device, unsigned regions) {
+    // A CPU device: two per region, so that a thread whose work item ends early finds
+    // another (docs/gpu.md). A GPU: at least 64 work items in Step 1 (unmeasured).
+    return device.type == "cpu" ? 2u : std::max(1u, (64u + regions - 1u) / regions);
 }
 
 unsigned defaultGpuRegions(const vk::DeviceInfo& device) {
@@ -93,17 +117,25 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     const std::vector<TransferRound> schedule = transferSchedule(division);
     result.counters.raysCulled = division.culledRays;
 
+    const std::uint32_t groups = tuning.rayGroups ? tuning.rayGroups : defaultRayGroups(device, regions);
+    report.rayGroups = groups;
+    const RayGroups grouped = groupRays(division, groups);
+
     // Work items in schedule order; raySeq and triSeq count the earlier users of each range.
+    const std::uint32_t slots = std::uint32_t(grouped.regions.size());
     std::vector<WorkItem> items;
-    std::vector<std::uint32_t> rayUses(regions, 0), triUses(regions, 0);
+    std::vector<std::uint32_t> rayUses(slots, 0), triUses(slots, 0);
     auto addItem = [&](std::uint32_t rayRegion, std::uint32_t triRegion, std::uint32_t retire) {
-        items.push_back(WorkItem{rayRegion, triRegion, retire, rayUses[rayRegion]++, triUses[triRegion]++, 0, 0, 0});
+        for (std::uint32_t g = 0; g < groups; ++g) {
+            const std::uint32_t raySlot = rayRegion * groups + g, triSlot = triRegion * groups + g;
+            items.push_back(WorkItem{raySlot, triSlot, retire, rayUses[raySlot]++, triUses[triSlot]++, 0, 0, 0});
+        }
     };
     for (std::uint32_t k = 0; k < regions; ++k) addItem(k, k, 0);
     for (const TransferRound& round : schedule)
         for (const TransferPair& p : round.pairs) addItem(p.rayRegion, p.triRegion, p.triRegion > p.rayRegion ? 1u : 2u);
     std::uint32_t largestRays = 0, largestTris = 0;
-    for (const Region& r : division.regions) {
+    for (const Region& r : grouped.regions) {
         largestRays = std::max(largestRays, r.rayEnd - r.rayBegin);
         largestTris = std::max(largestTris, r.triEnd - r.triBegin);
     }
@@ -120,7 +152,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
 
     // Every device buffer, sized from the counts before anything is allocated on the device.
     const std::uint64_t rayCount = g.rays->size(), triCount = g.triangles->size();
-    const std::uint64_t rayIdCount = division.rayIds.size(), triIdCount = division.triIds.size();
+    const std::uint64_t rayIdCount = division.rayIds.size(), triIdCount = grouped.triIds.size();
     struct Planned {
         const char* name;
         std::uint64_t bytes;
@@ -132,7 +164,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
         {"device: hits", rayCount * sizeof(Hit)},
         {"device: ray ids and scratch", rayIdCount * 8},
         {"device: triangle ids and scratch", triIdCount * 8},
-        {"device: regions", std::uint64_t(regions) * sizeof(Region)},
+        {"device: regions", std::uint64_t(slots) * sizeof(Region)},
         {"device: work items", items.size() * sizeof(WorkItem)},
         {"device: counters", sizeof(GpuCounters)},
         {"device: traversal states", items.size() * sizeof(TraversalState)},
@@ -160,8 +192,8 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     buffers[DACRT_BINDING_TRIANGLE_BOUNDS].upload(g.triangleBounds->data(), triCount * sizeof(Bounds));
     buffers[DACRT_BINDING_HITS].upload(hits.data(), rayCount * sizeof(Hit));
     buffers[DACRT_BINDING_RAY_IDS].upload(division.rayIds.data(), rayIdCount * 4);
-    buffers[DACRT_BINDING_TRI_IDS].upload(division.triIds.data(), triIdCount * 4);
-    buffers[DACRT_BINDING_REGIONS].upload(division.regions.data(), regions * sizeof(Region));
+    buffers[DACRT_BINDING_TRI_IDS].upload(grouped.triIds.data(), triIdCount * 4);
+    buffers[DACRT_BINDING_REGIONS].upload(grouped.regions.data(), slots * sizeof(Region));
     buffers[DACRT_BINDING_WORK_ITEMS].upload(items.data(), items.size() * sizeof(WorkItem));
     const GpuCounters zero{};
     buffers[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
@@ -195,11 +227,11 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     {
         vk::DispatchRecorder recorder(context, std::uint32_t(1 + schedule.size()));
         push.firstWorkItem = 0;
-        recorder.dispatch("step1", pipeline, regions, &push);
-        push.firstWorkItem = regions;
+        recorder.dispatch("step1", pipeline, regions * groups, &push);
+        push.firstWorkItem = regions * groups;
         for (const TransferRound& round : schedule) {
-            recorder.dispatch(round.name, pipeline, std::uint32_t(round.pairs.size()), &push);
-            push.firstWorkItem += std::uint32_t(round.pairs.size());
+            recorder.dispatch(round.name, pipeline, std::uint32_t(round.pairs.size()) * groups, &push);
+            push.firstWorkItem += std::uint32_t(round.pairs.size()) * groups;
         }
         recorder.submitAndWait();
         for (const auto& t : recorder.timingsMs()) report.dispatchMs.push_back(t);
@@ -243,8 +275,8 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     start = Clock::now();
     result.hits.resize(rayCount);
     buffers[DACRT_BINDING_HITS].download(result.hits.data(), rayCount * sizeof(Hit));
-    std::vector<Region> after(regions);
-    buffers[DACRT_BINDING_REGIONS].download(after.data(), regions * sizeof(Region));
+    std::vector<Region> after(slots);
+    buffers[DACRT_BINDING_REGIONS].download(after.data(), slots * sizeof(Region));
     result.phaseMs.emplace_back("readback", msSince(start));
 
     checkLoopLimit();
@@ -255,7 +287,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     std::uint64_t finished = 0;
     for (const Region& r : after) finished += r.terminated - r.rayBegin;
     report.raysFinished = finished;  // one command buffer: no per-round readback
-    result.counters.transferWorkItems = items.size() - regions;
+    result.counters.transferWorkItems = items.size() - std::size_t(regions) * groups;
     report.dispatches = std::uint32_t(report.dispatchMs.size());
     report.slices = counters.slices;
     report.workItemsRun = counters.workItemsRun;

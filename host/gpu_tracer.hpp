@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cpu_tracers.hpp"
+#include "scene_division.hpp"
 #include "trace_types.hpp"
 #include "vk_context.hpp"
 #include "vk_resources.hpp"
@@ -14,6 +15,7 @@ namespace dacrt {
 
 struct GpuTuning {
     std::uint32_t workgroupSize = 0;  // 0: the device's default (defaultWorkgroupSize)
+    std::uint32_t rayGroups = 0;      // 0: the device's default (defaultRayGroups)
 };
 
 // Compiled pipelines kept across frames (an orbit, a benchmark), one per set of
@@ -38,9 +40,23 @@ std::uint32_t loopBudgetOf(const vk::DeviceInfo& device);
 std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t largestRegionRays,
                                    std::uint32_t largestRegionTriangles);
 
+// Each region's rays split into `groups` consecutive runs (rays are in pixel order, so
+// these are bands of the image), each with its own copy of the region's triangle ids: the
+// groups of a region are separate work items that run at once and finish at different
+// times, which evens out the load of the workgroups. Region k's group g is slot
+// k * groups + g; the ray ids are unchanged.
+struct RayGroups {
+    std::vector<Region> regions;
+    std::vector<std::uint32_t> triIds;
+};
+RayGroups groupRays(const Division& division, std::uint32_t groups);
+
 // Whether every ray has the first ray's origin and tmin, bit for bit (primary rays do): the
 // kernel then takes them from push constants instead of loading them per ray.
 bool raysShareStart(const std::vector<Ray>& rays);
+
+// Ray groups per region when --ray-groups is not given.
+std::uint32_t defaultRayGroups(const vk::DeviceInfo& device, unsigned regions);
 
 // Regions when --regions is not given.
 unsigned defaultGpuRegions(const vk::DeviceInfo& device);

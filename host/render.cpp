@@ -85,6 +85,7 @@ nlohmann::ordered_json statsJson(const RenderOptions& o, const Scene& scene, con
                     {"driver", g.driver},
                     {"workgroup_size", g.workgroupSize},
                     {"subgroup_size", g.subgroupSize},
+                    {"ray_groups", g.rayGroups},
                     {"dispatches", g.dispatches},
                     {"dispatch_times", dispatches},
                     {"work_items_run", g.workItemsRun},
@@ -115,6 +116,9 @@ int runRender(const RenderOptions& o) {
         throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
     if (o.trace.backend == Backend::Embree && !o.trace.dacrt.exactDefaults())
         throw InputError("--intersector, --triangle-filter and --precision are DACRT options; embree has its own test");
+    if (o.trace.backend != Backend::Gpu && (o.workgroupSize || o.rayGroups))
+        throw InputError("--workgroup-size and --ray-groups tune the gpu backend; --backend " + toString(o.trace.backend) +
+                         " has no workgroups");
     Scene scene = loadGltf(o.scenePath);
     const double loadMs = msSince(start);
 
@@ -160,7 +164,7 @@ int runRender(const RenderOptions& o) {
         const auto traceStart = Clock::now();
         TraceResult result;
         if (gpu)
-            result = traceGpu(g, o.trace, GpuTuning{o.workgroupSize}, *gpu, pool, onPlan, pipelines.get());
+            result = traceGpu(g, o.trace, GpuTuning{o.workgroupSize, o.rayGroups}, *gpu, pool, onPlan, pipelines.get());
         else if (o.trace.backend == Backend::Embree)
             result = traceEmbree(g, EmbreeOptions{!o.embreeFast, threads}, pool);
         else

@@ -19,6 +19,7 @@ struct RenderOptions {
     std::string device;       // gpu: index or part of the name
     bool validate = false;    // gpu: Vulkan validation layers; errors make the run fail
     std::uint32_t workgroupSize = 0;  // gpu: 0 = the device's default
+    std::uint32_t rayGroups = 0;      // gpu: 0 = the device's default
     bool embreeFast = false;          // embree: without RTC_SCENE_FLAG_ROBUST
     TraceOptions trace;
     CameraOptions camera;

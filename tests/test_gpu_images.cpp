@@ -22,7 +22,7 @@ Scene shapes() {
 // gpu == cpu-seq, bit for bit, for every region count (work items too large for llvmpipe's
 // loop limiter run in several slices; none may be cut short). Returns how many ran.
 int expectGpuMatchesCpu(vk::Context& context, const Frame& frame, std::initializer_list<unsigned> regionCounts,
-                        std::uint32_t workgroupSize = 0) {
+                        std::uint32_t workgroupSize = 0, std::uint32_t rayGroups = 0) {
     const TraceResult reference = frame.trace(Backend::CpuSeq);
     int ran = 0;
     for (unsigned regions : regionCounts) {
@@ -30,10 +30,11 @@ int expectGpuMatchesCpu(vk::Context& context, const Frame& frame, std::initializ
         o.backend = Backend::Gpu;
         o.regions = regions;
         ThreadPool pool(2);
-        const TraceResult r = traceGpu(frame.geometry, o, GpuTuning{workgroupSize}, context, pool);
-        EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << regions << " regions";
+        const TraceResult r = traceGpu(frame.geometry, o, GpuTuning{workgroupSize, rayGroups}, context, pool);
+        EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << regions << " regions, " << r.gpu->rayGroups << " ray groups";
         EXPECT_EQ(r.gpu->dispatches, r.gpu->dispatchMs.size());
-        EXPECT_EQ(r.gpu->workItemsRun + r.gpu->workItemsEmpty, regions + r.counters.transferWorkItems);
+        if (rayGroups) EXPECT_EQ(r.gpu->rayGroups, rayGroups);
+        EXPECT_EQ(r.gpu->workItemsRun + r.gpu->workItemsEmpty, regions * r.gpu->rayGroups + r.counters.transferWorkItems);
         EXPECT_GE(r.gpu->slices, r.gpu->workItemsRun);
         ++ran;
     }
@@ -49,6 +50,23 @@ TEST(GpuImages, ProceduralShapes) {
     const Frame frame(shapes(), defaultCamera(s, 96, 72), 96, 72);
     expectGpuMatchesCpu(*context, frame, {1, 2, 3, 4, 8, 16});
     expectGpuMatchesCpu(*context, frame, {1, 4}, 32);
+}
+
+TEST(GpuImages, RayGroupsGiveTheSameHits) {
+    // Groups split each region's rays into bands with private triangle ids; with transfer
+    // rounds (camera inside, 4 regions) and with more groups than some regions have rays.
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
+    for (std::uint32_t groups : {1u, 3u, 5u}) expectGpuMatchesCpu(*context, frame, {1, 2, 4}, 0, groups);
+    std::vector<Mesh> meshes = {box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)};
+    CameraOptions o;
+    o.eye = glm::dvec3(0.1, 0.0, 0.2);
+    o.target = glm::dvec3(0.3, 0.0, -1.0);
+    o.fovDegrees = 100.0;
+    const Scene inside = sceneFromMeshes(meshes);
+    const Frame insideFrame(sceneFromMeshes(meshes), defaultCamera(inside, 40, 30, o), 40, 30);
+    expectGpuMatchesCpu(*context, insideFrame, {4}, 0, 64);
 }
 
 TEST(GpuImages, CameraInsideTheSceneAndOnSplitPlanes) {
