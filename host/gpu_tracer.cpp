@@ -171,6 +171,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
         {"device: traversal stacks", items.size() * (options.dacrt.maxDepth + 1) * sizeof(StackEntry)},
     };
     for (const auto& [name, bytes] : hostPlan.buffers) result.memory.add("host: " + name, bytes);
+    result.memory.add("host: triangle ids per ray group", triIdCount * 4);
     for (const Planned& b : deviceBuffers) {
         result.memory.add(b.name, b.bytes);
         if (b.bytes > device.maxStorageBufferRange)

@@ -33,10 +33,11 @@ std::string toString(TriangleFilter f);
 std::string toString(Precision p);
 
 // Leaf limits of each backend when DacrtOptions leaves them 0, chosen by measurement
-// (docs/benchmarks.md): a leaf costs the CPU one test per pair, while a workgroup pays a
-// fixed cost per partition step, so the gpu stops splitting earlier.
+// (docs/benchmarks.md): a leaf costs the CPU one test per pair, while on lavapipe a
+// partition costs several times a leaf's test per element (docs/gpu.md), so the gpu stops
+// splitting earlier.
 constexpr std::uint32_t kCpuLeafLimit = 8;
-constexpr std::uint32_t kGpuLeafLimit = 32;
+constexpr std::uint32_t kGpuLeafLimit = 64;
 
 struct DacrtOptions {
     std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default

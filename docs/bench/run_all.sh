@@ -12,5 +12,5 @@ build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --orbit 4 --repeat 
   --csv $out/table51.csv --json $out/table51.json | tee $out/table51.txt
 build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --orbit 1 --repeat 3 \
   --csv $out/figure53.csv --json $out/figure53.json | tee $out/figure53.txt
-build/dacrt bench $S/dragon.glb --backends cpu-seq,cpu,embree --orbit 4 --repeat 2 \
+build/dacrt bench $S/dragon.glb --backends cpu-seq,cpu,gpu,embree --orbit 4 --repeat 2 \
   --csv $out/dragon_sweep.csv --json $out/dragon_sweep.json --plot $out/dragon_sweep.png | tee $out/dragon_sweep.txt
