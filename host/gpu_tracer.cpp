@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <thread>
 
 #include "dacrt_traversal.hpp"
@@ -43,8 +44,12 @@ vk::ComputePipeline& PipelineCache::get(const std::vector<std::uint32_t>& specia
     return *slot;
 }
 
-RayGroups groupRays(const Division& division, std::uint32_t groups) {
-    RayGroups out;
+std::vector<Region> groupRegions(const Division& division, std::uint32_t groups) {
+    if (std::uint64_t(division.triIds.size()) * groups > std::numeric_limits<std::uint32_t>::max())
+        throw InputError(std::to_string(division.triIds.size()) + " triangle ids times " + std::to_string(groups) +
+                         " ray groups exceed the kernel's 32-bit ids; use fewer --ray-groups");
+    std::vector<Region> slots;
+    std::uint32_t triNext = 0;
     for (const Region& r : division.regions) {
         const std::uint32_t rays = r.rayEnd - r.rayBegin;
         for (std::uint32_t g = 0; g < groups; ++g) {
@@ -52,13 +57,22 @@ RayGroups groupRays(const Division& division, std::uint32_t groups) {
             slot.rayBegin = r.rayBegin + std::uint32_t(std::uint64_t(rays) * g / groups);
             slot.rayEnd = r.rayBegin + std::uint32_t(std::uint64_t(rays) * (g + 1) / groups);
             slot.terminated = slot.rayBegin;
-            slot.triBegin = std::uint32_t(out.triIds.size());
-            out.triIds.insert(out.triIds.end(), division.triIds.begin() + r.triBegin, division.triIds.begin() + r.triEnd);
-            slot.triEnd = std::uint32_t(out.triIds.size());
-            out.regions.push_back(slot);
+            slot.triBegin = triNext;
+            triNext += r.triEnd - r.triBegin;
+            slot.triEnd = triNext;
+            slots.push_back(slot);
         }
     }
-    return out;
+    return slots;
+}
+
+std::vector<std::uint32_t> groupTriangleIds(const Division& division, std::uint32_t groups) {
+    std::vector<std::uint32_t> ids;
+    ids.reserve(division.triIds.size() * groups);
+    for (const Region& r : division.regions)
+        for (std::uint32_t g = 0; g < groups; ++g)
+            ids.insert(ids.end(), division.triIds.begin() + r.triBegin, division.triIds.begin() + r.triEnd);
+    return ids;
 }
 
 bool raysShareStart(const std::vector<Ray>& rays) {
@@ -119,10 +133,10 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
 
     const std::uint32_t groups = tuning.rayGroups ? tuning.rayGroups : defaultRayGroups(device, regions);
     report.rayGroups = groups;
-    const RayGroups grouped = groupRays(division, groups);
+    const std::vector<Region> slotRegions = groupRegions(division, groups);
 
     // Work items in schedule order; raySeq and triSeq count the earlier users of each range.
-    const std::uint32_t slots = std::uint32_t(grouped.regions.size());
+    const std::uint32_t slots = std::uint32_t(slotRegions.size());
     std::vector<WorkItem> items;
     std::vector<std::uint32_t> rayUses(slots, 0), triUses(slots, 0);
     auto addItem = [&](std::uint32_t rayRegion, std::uint32_t triRegion, std::uint32_t retire) {
@@ -135,7 +149,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     for (const TransferRound& round : schedule)
         for (const TransferPair& p : round.pairs) addItem(p.rayRegion, p.triRegion, p.triRegion > p.rayRegion ? 1u : 2u);
     std::uint32_t largestRays = 0, largestTris = 0;
-    for (const Region& r : grouped.regions) {
+    for (const Region& r : slotRegions) {
         largestRays = std::max(largestRays, r.rayEnd - r.rayBegin);
         largestTris = std::max(largestTris, r.triEnd - r.triBegin);
     }
@@ -152,7 +166,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
 
     // Every device buffer, sized from the counts before anything is allocated on the device.
     const std::uint64_t rayCount = g.rays->size(), triCount = g.triangles->size();
-    const std::uint64_t rayIdCount = division.rayIds.size(), triIdCount = grouped.triIds.size();
+    const std::uint64_t rayIdCount = division.rayIds.size(), triIdCount = std::uint64_t(division.triIds.size()) * groups;
     struct Planned {
         const char* name;
         std::uint64_t bytes;
@@ -181,6 +195,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
                              "); render at a smaller --size or split the scene");
     }
     if (onPlan && !onPlan(result.memory)) return result;
+    const std::vector<std::uint32_t> slotTriIds = groupTriangleIds(division, groups);
 
     start = Clock::now();
     auto buffer = [&](const Planned& p) { return vk::Buffer(context, p.bytes, p.name); };
@@ -193,8 +208,8 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     buffers[DACRT_BINDING_TRIANGLE_BOUNDS].upload(g.triangleBounds->data(), triCount * sizeof(Bounds));
     buffers[DACRT_BINDING_HITS].upload(hits.data(), rayCount * sizeof(Hit));
     buffers[DACRT_BINDING_RAY_IDS].upload(division.rayIds.data(), rayIdCount * 4);
-    buffers[DACRT_BINDING_TRI_IDS].upload(grouped.triIds.data(), triIdCount * 4);
-    buffers[DACRT_BINDING_REGIONS].upload(grouped.regions.data(), slots * sizeof(Region));
+    buffers[DACRT_BINDING_TRI_IDS].upload(slotTriIds.data(), triIdCount * 4);
+    buffers[DACRT_BINDING_REGIONS].upload(slotRegions.data(), slots * sizeof(Region));
     buffers[DACRT_BINDING_WORK_ITEMS].upload(items.data(), items.size() * sizeof(WorkItem));
     const GpuCounters zero{};
     buffers[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
@@ -225,14 +240,22 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     push.loopProbe = 2;
     push.rayTmin = g.rays->front().tmin;
     GpuCounters counters{};
+    const std::uint32_t perDispatch = device.maxComputeWorkGroupCountX;
     {
-        vk::DispatchRecorder recorder(context, std::uint32_t(1 + schedule.size()));
-        push.firstWorkItem = 0;
-        recorder.dispatch("step1", pipeline, regions * groups, &push);
-        push.firstWorkItem = regions * groups;
-        for (const TransferRound& round : schedule) {
-            recorder.dispatch(round.name, pipeline, std::uint32_t(round.pairs.size()) * groups, &push);
-            push.firstWorkItem += std::uint32_t(round.pairs.size()) * groups;
+        // Step 1, then each round; a pass with more work items than one dispatch may hold
+        // takes several.
+        std::vector<std::pair<std::string, std::uint32_t>> passes = {{"step1", slots}};
+        for (const TransferRound& round : schedule) passes.emplace_back(round.name, std::uint32_t(round.pairs.size()) * groups);
+        std::uint32_t dispatchCount = 0;
+        for (const auto& pass : passes) dispatchCount += (pass.second + perDispatch - 1) / perDispatch;
+        vk::DispatchRecorder recorder(context, dispatchCount);
+        std::uint32_t first = 0;
+        for (const auto& [name, count] : passes) {
+            for (std::uint32_t done = 0; done < count; done += perDispatch) {
+                push.firstWorkItem = first + done;
+                recorder.dispatch(name, pipeline, std::min(perDispatch, count - done), &push);
+            }
+            first += count;
         }
         recorder.submitAndWait();
         for (const auto& t : recorder.timingsMs()) report.dispatchMs.push_back(t);
@@ -255,7 +278,6 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
                              "budget of " + std::to_string(loopBudget) + " iterations (" + device.driver +
                              "); use a larger --workgroup-size or more --regions (docs/gpu.md)");
         const std::uint32_t slicesBefore = counters.slices;
-        const std::uint32_t perDispatch = device.maxComputeWorkGroupCountX;
         const std::uint32_t dispatchesPerPass = std::uint32_t((items.size() + perDispatch - 1) / perDispatch);
         vk::DispatchRecorder recorder(context, kContinuationsPerSubmit * dispatchesPerPass);
         for (std::uint32_t c = 0; c < kContinuationsPerSubmit; ++c)
@@ -288,7 +310,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     std::uint64_t finished = 0;
     for (const Region& r : after) finished += r.terminated - r.rayBegin;
     report.raysFinished = finished;  // one command buffer: no per-round readback
-    result.counters.transferWorkItems = items.size() - std::size_t(regions) * groups;
+    result.counters.transferWorkItems = (items.size() - slots) / groups;  // pairs, as on the cpu backend
     report.dispatches = std::uint32_t(report.dispatchMs.size());
     report.slices = counters.slices;
     report.workItemsRun = counters.workItemsRun;

@@ -40,16 +40,15 @@ std::uint32_t loopBudgetOf(const vk::DeviceInfo& device);
 std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t largestRegionRays,
                                    std::uint32_t largestRegionTriangles);
 
-// Each region's rays split into `groups` consecutive runs (rays are in pixel order, so
-// these are bands of the image), each with its own copy of the region's triangle ids: the
-// groups of a region are separate work items that run at once and finish at different
-// times, which evens out the load of the workgroups. Region k's group g is slot
-// k * groups + g; the ray ids are unchanged.
-struct RayGroups {
-    std::vector<Region> regions;
-    std::vector<std::uint32_t> triIds;
-};
-RayGroups groupRays(const Division& division, std::uint32_t groups);
+// Ray groups: each region's rays split into `groups` consecutive runs (rays are in pixel
+// order, so these are bands of the image), each with its own copy of the region's triangle
+// ids, so that the groups of a region are separate work items that run at once and finish
+// at different times, which evens out the load of the workgroups. Region k's group g is
+// slot k * groups + g; the ray ids are unchanged. groupRegions gives the slots' table
+// (InputError if the triangle ids would overflow 32 bits), groupTriangleIds the copies in
+// slot order; they are apart so that the plan is checked before the copies are made.
+std::vector<Region> groupRegions(const Division& division, std::uint32_t groups);
+std::vector<std::uint32_t> groupTriangleIds(const Division& division, std::uint32_t groups);
 
 // Whether every ray has the first ray's origin and tmin, bit for bit (primary rays do): the
 // kernel then takes them from push constants instead of loading them per ray.

@@ -129,7 +129,7 @@ struct GpuReport {
     std::string driver;
     std::uint32_t workgroupSize = 0;
     std::uint32_t subgroupSize = 0;
-    std::uint32_t rayGroups = 0;       // work items per region and round (RayGroups)
+    std::uint32_t rayGroups = 0;       // work items per region and round (groupRegions)
     std::vector<std::pair<std::string, double>> dispatchMs;  // GPU timestamps, per dispatch
     std::uint32_t dispatches = 0;
     std::uint32_t workItemsRun = 0;

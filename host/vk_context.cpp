@@ -122,6 +122,20 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     info.subgroupOperations = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
                               (subgroup.supportedOperations & needed) == needed;
     info.timestamps = l.timestampComputeAndGraphics && l.timestampPeriod > 0.0f;
+    std::uint32_t extensionCount = 0;
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, nullptr));
+    std::vector<VkExtensionProperties> extensions(extensionCount);
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, extensions.data()));
+    const bool sizeControl = std::any_of(extensions.begin(), extensions.end(), [](const VkExtensionProperties& e) {
+        return std::strcmp(e.extensionName, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME) == 0;
+    });
+    if (sizeControl) {
+        VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT};
+        VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+        features.pNext = &control;
+        vkGetPhysicalDeviceFeatures2(d, &features);
+        info.fullSubgroups = control.computeFullSubgroups == VK_TRUE;
+    }
     return info;
 }
 
@@ -149,6 +163,7 @@ std::string DeviceInfo::describe() const {
       << ", count x " << maxComputeWorkGroupCountX << "\n"
       << "   storage buffers per stage: " << maxPerStageStorageBuffers << "\n"
       << "   subgroup size: " << subgroupSize << (subgroupOperations ? " (arithmetic and shuffles in compute)" : " (no compute arithmetic or shuffles)")
+      << "\n   full subgroups on request: " << (fullSubgroups ? "yes" : "no")
       << "\n   timestamps: " << (timestamps ? "yes" : "no") << "\n";
     return s.str();
 }
@@ -243,6 +258,17 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
         VkDeviceCreateInfo deviceInfo{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
         deviceInfo.queueCreateInfoCount = 1;
         deviceInfo.pQueueCreateInfos = &queueInfo;
+        // The kernel's subgroups must be full (leaves shuffle triangles across all lanes):
+        // requested where the device can promise it; elsewhere the workgroup size stays a
+        // multiple of the subgroup size, which every driver known to us fills.
+        VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT};
+        const char* sizeControl = VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME;
+        if (info_.fullSubgroups) {
+            control.computeFullSubgroups = VK_TRUE;
+            deviceInfo.pNext = &control;
+            deviceInfo.enabledExtensionCount = 1;
+            deviceInfo.ppEnabledExtensionNames = &sizeControl;
+        }
         VK_CHECK(vkCreateDevice(physical_, &deviceInfo, nullptr, &device_));
         vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 

@@ -25,6 +25,7 @@ struct DeviceInfo {
     std::uint32_t maxPerStageStorageBuffers = 0;
     std::uint32_t subgroupSize = 0;
     bool subgroupOperations = false;  // compute-stage arithmetic and shuffle operations (the kernel's)
+    bool fullSubgroups = false;       // VK_EXT_subgroup_size_control's computeFullSubgroups
     bool timestamps = false;
     std::string describe() const;
 };

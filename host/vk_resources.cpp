@@ -111,6 +111,7 @@ ComputePipeline::ComputePipeline(const Context& context, std::span<const std::ui
         pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
         pipelineInfo.stage.module = module_;
         pipelineInfo.stage.pName = "main";
+        if (context.info().fullSubgroups) pipelineInfo.stage.flags = VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT_EXT;
         pipelineInfo.stage.pSpecializationInfo = specialization.empty() ? nullptr : &spec;
         pipelineInfo.layout = layout_;
         VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_));

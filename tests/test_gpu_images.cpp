@@ -35,7 +35,7 @@ std::uint64_t expectGpuMatchesCpu(vk::Context& context, const Frame& frame, std:
         EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << regions << " regions, " << r.gpu->rayGroups << " ray groups";
         EXPECT_EQ(r.gpu->dispatches, r.gpu->dispatchMs.size());
         if (rayGroups) EXPECT_EQ(r.gpu->rayGroups, rayGroups);
-        EXPECT_EQ(r.gpu->workItemsRun + r.gpu->workItemsEmpty, regions * r.gpu->rayGroups + r.counters.transferWorkItems);
+        EXPECT_EQ(r.gpu->workItemsRun + r.gpu->workItemsEmpty, (regions + r.counters.transferWorkItems) * r.gpu->rayGroups);
         EXPECT_GE(r.gpu->slices, r.gpu->workItemsRun);
         transferWorkItems += r.counters.transferWorkItems;
     }
