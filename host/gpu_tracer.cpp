@@ -21,10 +21,21 @@ std::uint32_t loopBudgetOf(const vk::DeviceInfo& device) {
     return device.driver.find("llvmpipe") != std::string::npos ? 40000u : 0u;
 }
 
+namespace {
+
+// The widest workgroup the kernel takes: the device's limits, and at most as many subgroups
+// as one subgroup has lanes (workgroupExclusiveSum sums the subgroup totals in one subgroup).
+std::uint32_t widestWorkgroup(const vk::DeviceInfo& device) {
+    const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
+    return std::min({device.maxComputeWorkGroupInvocations, device.maxComputeWorkGroupSizeX, subgroup * subgroup});
+}
+
+}  // namespace
+
 std::uint32_t defaultWorkgroupSize(const vk::DeviceInfo& device, std::uint32_t largestRegionRays,
                                    std::uint32_t largestRegionTriangles) {
     const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
-    const std::uint32_t widest = std::min({device.maxComputeWorkGroupInvocations, device.maxComputeWorkGroupSizeX, subgroup * subgroup});
+    const std::uint32_t widest = widestWorkgroup(device);
     std::uint32_t size = device.type == "cpu" ? subgroup : std::max(64u, subgroup);
     if (const std::uint32_t budget = loopBudgetOf(device)) {
         // The largest single step (a split of the biggest region, then its final partition)
@@ -158,7 +169,7 @@ TraceResult traceGpu(const FrameGeometry& g, const TraceOptions& options, const 
     const std::uint32_t workgroupSize =
         tuning.workgroupSize ? tuning.workgroupSize : defaultWorkgroupSize(device, largestRays, largestTris);
     const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
-    const std::uint32_t widest = std::min({device.maxComputeWorkGroupInvocations, device.maxComputeWorkGroupSizeX, subgroup * subgroup});
+    const std::uint32_t widest = widestWorkgroup(device);
     if (workgroupSize % subgroup != 0 || workgroupSize > widest)
         throw InputError("--workgroup-size " + std::to_string(workgroupSize) + " must be a multiple of the subgroup size " +
                          std::to_string(subgroup) + " and at most " + std::to_string(widest) + " on this device");

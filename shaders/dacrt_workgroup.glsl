@@ -56,11 +56,18 @@ const uint kKeepStill = 2u;        // rays with no motion along gAxis
 const uint kKeepStuckHigh = 3u;    // rays moving up gAxis that cannot reach the cell
 const uint kKeepStuckLow = 4u;     // rays moving down gAxis that cannot reach the cell
 
-// The fields of a ray that its filters read: origin, tmin and invDir.
-Ray filterRay(uint id) {
+// A ray with only its origin and tmin read, from push constants where all rays share them
+// (llvmpipe loads a buffer component one invocation at a time, so every field counts).
+Ray rayStart(uint id) {
     Ray ray;
     ray.origin = kSharedStart ? gRayOrigin : rays[id].origin;
     ray.tmin = kSharedStart ? gRayTmin : rays[id].tmin;
+    return ray;
+}
+
+// The fields of a ray that its filters read: origin, tmin and invDir.
+Ray filterRay(uint id) {
+    Ray ray = rayStart(id);
     ray.invDir = rays[id].invDir;
     return ray;
 }
@@ -187,9 +194,7 @@ uint leafLanesPerRay(uint rayCount) {
 
 // The fields of a ray that the triangle test reads: origin, tmin, axes and shear.
 Ray leafRay(uint id) {
-    Ray ray;
-    ray.origin = kSharedStart ? gRayOrigin : rays[id].origin;
-    ray.tmin = kSharedStart ? gRayTmin : rays[id].tmin;
+    Ray ray = rayStart(id);
     ray.axes = rays[id].axes;
     ray.shear = rays[id].shear;
     return ray;
