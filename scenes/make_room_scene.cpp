@@ -2,8 +2,8 @@
 // tessellated objects, with a camera. Run: build/make_room_scene scenes/room.glb
 #include <iostream>
 
-#include "errors.hpp"
-#include "procedural.hpp"
+#include "core/errors.hpp"
+#include "core/procedural.hpp"
 
 int main(int argc, char** argv) {
     using namespace dacrt;

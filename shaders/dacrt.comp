@@ -39,210 +39,286 @@ bool overBudget(uint spent, uint cost) {
     return kLoopBudget != 0u && spent + cost > kLoopBudget;
 }
 
-void main() {
+// The running work item: its node, its stack size and the slice's loop budget spent. Saved to
+// `states` (and the stack to `stacks`) when a slice runs out of budget.
+struct Slice {
+    vec3 lo;
+    vec3 hi;
+    uint terminated;   // rays [rayBegin, terminated) of the ray region have their final hit
+    uint nodeRayEnd;
+    uint triBegin;
+    uint triEnd;
+    uint depth;
+    uint stackSize;
+    uint stalls;
+    uint leafNext;     // a leaf running in slices: its next ray, else 0
+    uint spent;        // loop iterations this slice has used
+    bool progressed;   // this slice did some work (else the work item cannot fit a slice)
+};
+
+// What every stage of one work item reads.
+struct ItemContext {
+    WorkItem item;
+    uint index;
+    uint lane;
+    uint rayEnd;
+    vec3 rootLo;
+    vec3 rootHi;
+    vec3 margin;
+    uint retireCost;   // the final partition and the probe, reserved in every slice
+};
+
+const uint kStepContinue = 0u;
+const uint kStepOutOfBudget = 1u;
+const uint kStepTreeDone = 2u;
+
+void loadFrameParameters() {
     gMargin = push.margin;
     gRayOrigin = push.rayOrigin;
     gRayTmin = push.rayTmin;
     gAxis = push.axis;
     gRayScratchHalf = push.rayScratchHalf;
     gTriScratchHalf = push.triScratchHalf;
-    uint lane = gl_LocalInvocationIndex;
-    uint itemIndex = push.firstWorkItem + gl_WorkGroupID.x;
-    WorkItem item = workItems[itemIndex];
-    TraversalState state = states[itemIndex];
-    if (state.phase == kPhaseFinished) return;
-    // Earlier work items may finish during this very dispatch: one invocation reads the
-    // counters and the whole workgroup follows its answer, so control flow stays uniform.
-    if (lane == 0)
-        sReady = atomicAdd(regions[item.rayRegion].rayItemsDone, 0u) == item.raySeq &&
-                 atomicAdd(regions[item.triRegion].triItemsDone, 0u) == item.triSeq;
+}
+
+// Earlier work items may finish during this very dispatch: one invocation reads the counters
+// and the whole workgroup follows its answer, so control flow stays uniform.
+bool predecessorsFinished(ItemContext c) {
+    if (c.lane == 0)
+        sReady = atomicAdd(regions[c.item.rayRegion].rayItemsDone, 0u) == c.item.raySeq &&
+                 atomicAdd(regions[c.item.triRegion].triItemsDone, 0u) == c.item.triSeq;
     memoryBarrierShared();
     barrier();
     if (!sReady) {
-        if (lane == 0) atomicAdd(counters.notReady, 1u);
-        return;
+        if (c.lane == 0) atomicAdd(counters.notReady, 1u);
+        return false;
     }
     memoryBarrierBuffer();  // see the finished work items' writes (they barrier before counting)
-    if (lane == 0) atomicAdd(counters.slices, 1u);
-    uint terminated = regions[item.rayRegion].terminated;
-    uint rayEnd = regions[item.rayRegion].rayEnd;
-    vec3 rootLo = regions[item.triRegion].lo;
-    vec3 rootHi = regions[item.triRegion].hi;
-    vec3 margin = vec3(gMargin);
-    uint retireCost = partitionCost(rayEnd - terminated) + 4u;  // the final partition and the probe
-    uint spent = 0;
+    return true;
+}
 
-    vec3 lo = state.lo, hi = state.hi;
-    uint nodeRayEnd = state.nodeRayEnd, triBegin = state.triBegin, triEnd = state.triEnd, depth = state.depth;
-    uint stackSize = state.stackSize, stalls = state.stalls, leafNext = state.leafNext;
-    if (state.phase == kPhaseNew && terminated >= rayEnd) {  // nothing to trace: finish at once
-        if (lane == 0) {
+// Marks the work item finished and lets its successors on the same ranges run.
+void markFinished(ItemContext c) {
+    states[c.index].phase = kPhaseFinished;
+    atomicAdd(counters.itemsFinished, 1u);
+    memoryBarrierBuffer();
+    atomicAdd(regions[c.item.rayRegion].rayItemsDone, 1u);
+    atomicAdd(regions[c.item.triRegion].triItemsDone, 1u);
+}
+
+// A new work item: the rays that may cross the triangles' region go first, at the root.
+// Returns false when even that does not fit one slice.
+bool startAtRoot(ItemContext c, inout Slice s) {
+    if (c.lane == 0) atomicAdd(counters.workItemsRun, 1u);
+    s.spent = partitionCost(c.rayEnd - s.terminated);
+    if (overBudget(s.spent, c.retireCost)) {
+        if (c.lane == 0) atomicAdd(counters.tooLarge, 1u);
+        return false;
+    }
+    s.nodeRayEnd = partitionRays(s.terminated, c.rayEnd, kKeepCrossing, c.rootLo - c.margin, c.rootHi + c.margin);
+    s.lo = c.rootLo;
+    s.hi = c.rootHi;
+    s.triBegin = regions[c.item.triRegion].triBegin;
+    s.triEnd = regions[c.item.triRegion].triEnd;
+    s.depth = 0;
+    s.stackSize = 0;
+    s.stalls = 0;
+    s.leafNext = 0;
+    s.progressed = true;
+    return true;
+}
+
+// A work item an earlier slice left off: its node from `states`, its stack from `stacks`.
+void resumeSaved(ItemContext c, TraversalState state, inout Slice s) {
+    s.lo = state.lo;
+    s.hi = state.hi;
+    s.nodeRayEnd = state.nodeRayEnd;
+    s.triBegin = state.triBegin;
+    s.triEnd = state.triEnd;
+    s.depth = state.depth;
+    s.stackSize = state.stackSize;
+    s.stalls = state.stalls;
+    s.leafNext = state.leafNext;
+    s.progressed = false;
+    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) sStack[i] = stacks[c.index * (kMaxDepth + 1u) + i];
+    s.spent = s.stackSize / kWorkgroupSize + 1u;
+    workgroupSync();
+}
+
+// Tests the leaf's rays from leafNext (or the first live one) against its triangles, as many
+// as the budget allows; once all are tested the finished rays are retired from the node.
+uint runLeaf(ItemContext c, inout Slice s, uint rayCount, uint triCount) {
+    uint from = s.leafNext != 0u ? s.leafNext : s.terminated;
+    uint finish = partitionCost(rayCount);
+    uint take = s.nodeRayEnd - from;
+    if (kLoopBudget != 0u) {
+        uint reserved = s.spent + c.retireCost + finish;
+        reserved += kStepOverhead;
+        take = reserved < kLoopBudget ? leafRaysWithin(take, triCount, kLoopBudget - reserved) : 0u;
+        if (take == 0u) return kStepOutOfBudget;
+    }
+    leafTests(from, from + take, s.triBegin, s.triEnd);
+    s.spent += leafTestCost(take, triCount) + kStepOverhead;
+    s.progressed = true;
+    s.leafNext = from + take;
+    if (s.leafNext == s.nodeRayEnd) {
+        s.terminated = finishLeaf(s.lo, s.hi, s.terminated, s.nodeRayEnd);
+        s.spent += finish;
+        s.nodeRayEnd = s.terminated;
+        s.leafNext = 0u;
+    }
+    return kStepContinue;
+}
+
+// Front to back: the child on the rays' origin side first; the other waits on the stack with
+// this node's ranges, which it filters again later.
+uint splitNode(ItemContext c, inout Slice s, int axis, float split, uint rayCount, uint triCount) {
+    uint cost = partitionCost(rayCount) + partitionCost(triCount) + kStepOverhead;
+    if (overBudget(s.spent, cost + c.retireCost)) return kStepOutOfBudget;
+    s.spent += cost;
+    s.progressed = true;
+    vec3 lowHi = s.hi, highLo = s.lo;
+    lowHi[axis] = split;
+    highLo[axis] = split;
+    bool lowFirst = gRayOrigin[axis] <= split;
+    vec3 nearLo = lowFirst ? s.lo : highLo, nearHi = lowFirst ? lowHi : s.hi;
+    if (c.lane == 0) {
+        StackEntry far;
+        far.lo = lowFirst ? highLo : s.lo;
+        far.hi = lowFirst ? s.hi : lowHi;
+        far.rayEnd = s.nodeRayEnd;
+        far.triBegin = s.triBegin;
+        far.triEnd = s.triEnd;
+        far.depth = s.depth + 1u;
+        far.stalls = s.stalls;
+        sStack[s.stackSize] = far;
+    }
+    ++s.stackSize;
+    uint childRayEnd = partitionRays(s.terminated, s.nodeRayEnd, kKeepCrossing, nearLo - c.margin, nearHi + c.margin);
+    uint childTriEnd = s.triEnd;
+    if (childRayEnd > s.terminated)
+        childTriEnd = partitionTriangles(s.triBegin, s.triEnd, nearLo - c.margin, nearHi + c.margin);
+    s.stalls = childRayEnd == s.nodeRayEnd && childTriEnd == s.triEnd ? s.stalls + 1u : 0u;
+    s.triEnd = childTriEnd;
+    s.lo = nearLo;
+    s.hi = nearHi;
+    s.nodeRayEnd = childRayEnd;
+    ++s.depth;
+    return kStepContinue;
+}
+
+// The far child on top of the stack becomes the node, its rays and triangles filtered again.
+uint popFarChild(ItemContext c, inout Slice s) {
+    if (s.stackSize == 0) return kStepTreeDone;
+    workgroupSync();
+    StackEntry far = sStack[s.stackSize - 1u];
+    uint cost = partitionCost(far.rayEnd - s.terminated) + partitionCost(far.triEnd - far.triBegin) + kStepOverhead;
+    if (overBudget(s.spent, cost + c.retireCost)) return kStepOutOfBudget;
+    s.spent += cost;
+    s.progressed = true;
+    --s.stackSize;
+    workgroupSync();  // the slot may be written again before everyone has read it
+    s.lo = far.lo;
+    s.hi = far.hi;
+    s.nodeRayEnd = partitionRays(s.terminated, far.rayEnd, kKeepCrossing, s.lo - c.margin, s.hi + c.margin);
+    s.triBegin = far.triBegin;
+    s.triEnd = s.nodeRayEnd > s.terminated ? partitionTriangles(far.triBegin, far.triEnd, s.lo - c.margin, s.hi + c.margin)
+                                           : far.triBegin;
+    s.depth = far.depth;
+    s.stalls = s.nodeRayEnd == far.rayEnd && s.triEnd == far.triEnd ? far.stalls + 1u : 0u;
+    return kStepContinue;
+}
+
+// One step of the depth-first traversal: a leaf (or a slice of one), a split, or a pop.
+uint stepTraversal(ItemContext c, inout Slice s) {
+    if (!(s.terminated < s.nodeRayEnd && s.triBegin < s.triEnd)) return popFarChild(c, s);
+    uint rayCount = s.nodeRayEnd - s.terminated, triCount = s.triEnd - s.triBegin;
+    int axis = longestAxis(s.lo, s.hi);
+    float split = 0.5 * (s.lo[axis] + s.hi[axis]);
+    bool canSplit = s.depth < kMaxDepth && split > s.lo[axis] && split < s.hi[axis] && s.stalls < DACRT_MAX_STALLED_SPLITS;
+    bool isLeaf = rayCount < kRayLimit || triCount < kTriLimit || !canSplit || s.leafNext != 0u;
+    // Under a loop budget a leaf too large for half a slice splits further instead while
+    // splitting still separates something: another tree, the same hits (every tree gives
+    // brute force's answer). A leaf that must stay one runs in slices.
+    if (isLeaf && canSplit && s.leafNext == 0u && kLoopBudget != 0u && leafCost(rayCount, triCount) > kLoopBudget / 2u)
+        isLeaf = false;
+    return isLeaf ? runLeaf(c, s, rayCount, triCount) : splitNode(c, s, axis, split, rayCount, triCount);
+}
+
+// Out of budget: the node and the stack are saved, and a later dispatch resumes here.
+void saveSlice(ItemContext c, Slice s) {
+    if (!s.progressed && c.lane == 0) atomicAdd(counters.tooLarge, 1u);
+    workgroupSync();
+    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) stacks[c.index * (kMaxDepth + 1u) + i] = sStack[i];
+    bool cutShort = loopLimiterFired(push.loopProbe);
+    if (c.lane == 0) {
+        TraversalState saved;
+        saved.lo = s.lo;
+        saved.hi = s.hi;
+        saved.phase = kPhaseRunning;
+        saved.nodeRayEnd = s.nodeRayEnd;
+        saved.triBegin = s.triBegin;
+        saved.triEnd = s.triEnd;
+        saved.depth = s.depth;
+        saved.stackSize = s.stackSize;
+        saved.stalls = s.stalls;
+        saved.leafNext = s.leafNext;
+        states[c.index] = saved;
+        regions[c.item.rayRegion].terminated = s.terminated;
+        if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
+    }
+}
+
+// The tree is done: rays no later work item can change are finished here (see RetireRule on
+// the CPU side), and the work item is marked finished.
+void retireRays(ItemContext c, Slice s) {
+    uint rule = c.item.retire == 0u ? kKeepStill : (c.item.retire == 1u ? kKeepStuckHigh : kKeepStuckLow);
+    uint before = s.terminated;
+    uint terminated = partitionRays(s.terminated, c.rayEnd, rule, c.rootLo - c.margin, c.rootHi + c.margin);
+    bool cutShort = loopLimiterFired(push.loopProbe);
+    if (c.lane == 0) {
+        atomicAdd(counters.raysRetired, terminated - before);
+        regions[c.item.rayRegion].terminated = terminated;
+        if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
+        markFinished(c);
+    }
+}
+
+void main() {
+    loadFrameParameters();
+    ItemContext c;
+    c.lane = gl_LocalInvocationIndex;
+    c.index = push.firstWorkItem + gl_WorkGroupID.x;
+    c.item = workItems[c.index];
+    TraversalState state = states[c.index];
+    if (state.phase == kPhaseFinished) return;
+    if (!predecessorsFinished(c)) return;
+    if (c.lane == 0) atomicAdd(counters.slices, 1u);
+    Slice s;
+    s.terminated = regions[c.item.rayRegion].terminated;
+    c.rayEnd = regions[c.item.rayRegion].rayEnd;
+    c.rootLo = regions[c.item.triRegion].lo;
+    c.rootHi = regions[c.item.triRegion].hi;
+    c.margin = vec3(gMargin);
+    c.retireCost = partitionCost(c.rayEnd - s.terminated) + 4u;
+
+    if (state.phase == kPhaseNew && s.terminated >= c.rayEnd) {  // nothing to trace: finish at once
+        if (c.lane == 0) {
             atomicAdd(counters.workItemsEmpty, 1u);
-            states[itemIndex].phase = kPhaseFinished;
-            atomicAdd(counters.itemsFinished, 1u);
-            memoryBarrierBuffer();
-            atomicAdd(regions[item.rayRegion].rayItemsDone, 1u);
-            atomicAdd(regions[item.triRegion].triItemsDone, 1u);
+            markFinished(c);
         }
         return;
     }
     if (state.phase == kPhaseNew) {
-        if (lane == 0) atomicAdd(counters.workItemsRun, 1u);
-        // Root: the rays that may cross this region go first.
-        spent = partitionCost(rayEnd - terminated);
-        if (overBudget(spent, retireCost)) {
-            if (lane == 0) atomicAdd(counters.tooLarge, 1u);
-            return;
-        }
-        nodeRayEnd = partitionRays(terminated, rayEnd, kKeepCrossing, rootLo - margin, rootHi + margin);
-        lo = rootLo;
-        hi = rootHi;
-        triBegin = regions[item.triRegion].triBegin;
-        triEnd = regions[item.triRegion].triEnd;
-        depth = 0;
-        stackSize = 0;
-        stalls = 0;
-        leafNext = 0;
+        if (!startAtRoot(c, s)) return;
     } else {
-        for (uint i = lane; i < stackSize; i += kWorkgroupSize) sStack[i] = stacks[itemIndex * (kMaxDepth + 1u) + i];
-        spent = stackSize / kWorkgroupSize + 1u;
-        workgroupSync();
+        resumeSaved(c, state, s);
     }
 
-    bool finished = false;
-    bool progressed = state.phase == kPhaseNew;  // the root partition ran
-    for (;;) {
-        if (terminated < nodeRayEnd && triBegin < triEnd) {
-            uint rayCount = nodeRayEnd - terminated, triCount = triEnd - triBegin;
-            int axis = longestAxis(lo, hi);
-            float split = 0.5 * (lo[axis] + hi[axis]);
-            bool canSplit = depth < kMaxDepth && split > lo[axis] && split < hi[axis] &&
-                            stalls < DACRT_MAX_STALLED_SPLITS;
-            bool isLeaf = rayCount < kRayLimit || triCount < kTriLimit || !canSplit || leafNext != 0u;
-            // Under a loop budget a leaf too large for half a slice splits further instead
-            // while splitting still separates something: another tree, the same hits (every
-            // tree gives brute force's answer). A leaf that must stay one runs in slices.
-            if (isLeaf && canSplit && leafNext == 0u && kLoopBudget != 0u && leafCost(rayCount, triCount) > kLoopBudget / 2u)
-                isLeaf = false;
-            if (isLeaf) {
-                uint from = leafNext != 0u ? leafNext : terminated;
-                uint finish = partitionCost(rayCount);
-                uint take = nodeRayEnd - from;
-                if (kLoopBudget != 0u) {
-                    uint reserved = spent + retireCost + finish;
-                    reserved += kStepOverhead;
-                    take = reserved < kLoopBudget ? leafRaysWithin(take, triCount, kLoopBudget - reserved) : 0u;
-                    if (take == 0u) break;
-                }
-                leafTests(from, from + take, triBegin, triEnd);
-                spent += leafTestCost(take, triCount) + kStepOverhead;
-                progressed = true;
-                leafNext = from + take;
-                if (leafNext == nodeRayEnd) {
-                    terminated = finishLeaf(lo, hi, terminated, nodeRayEnd);
-                    spent += finish;
-                    nodeRayEnd = terminated;
-                    leafNext = 0u;
-                }
-                continue;
-            }
-            uint cost = partitionCost(rayCount) + partitionCost(triCount) + kStepOverhead;
-            if (overBudget(spent, cost + retireCost)) break;
-            spent += cost;
-            progressed = true;
-            {
-                // Front to back: the child on the rays' origin side first; the other waits on
-                // the stack with this node's ranges, which it filters again later.
-                vec3 lowHi = hi, highLo = lo;
-                lowHi[axis] = split;
-                highLo[axis] = split;
-                bool lowFirst = gRayOrigin[axis] <= split;
-                vec3 nearLo = lowFirst ? lo : highLo, nearHi = lowFirst ? lowHi : hi;
-                if (lane == 0) {
-                    StackEntry far;
-                    far.lo = lowFirst ? highLo : lo;
-                    far.hi = lowFirst ? hi : lowHi;
-                    far.rayEnd = nodeRayEnd;
-                    far.triBegin = triBegin;
-                    far.triEnd = triEnd;
-                    far.depth = depth + 1u;
-                    far.stalls = stalls;
-                    sStack[stackSize] = far;
-                }
-                ++stackSize;
-                uint childRayEnd = partitionRays(terminated, nodeRayEnd, kKeepCrossing, nearLo - margin, nearHi + margin);
-                uint childTriEnd = triEnd;
-                if (childRayEnd > terminated)
-                    childTriEnd = partitionTriangles(triBegin, triEnd, nearLo - margin, nearHi + margin);
-                stalls = childRayEnd == nodeRayEnd && childTriEnd == triEnd ? stalls + 1u : 0u;
-                triEnd = childTriEnd;
-                lo = nearLo;
-                hi = nearHi;
-                nodeRayEnd = childRayEnd;
-                ++depth;
-            }
-            continue;
-        }
-        if (stackSize == 0) {
-            finished = true;
-            break;
-        }
-        workgroupSync();
-        StackEntry far = sStack[stackSize - 1u];
-        uint cost = partitionCost(far.rayEnd - terminated) + partitionCost(far.triEnd - far.triBegin) + kStepOverhead;
-        if (overBudget(spent, cost + retireCost)) break;
-        spent += cost;
-        progressed = true;
-        --stackSize;
-        workgroupSync();  // the slot may be written again before everyone has read it
-        lo = far.lo;
-        hi = far.hi;
-        nodeRayEnd = partitionRays(terminated, far.rayEnd, kKeepCrossing, lo - margin, hi + margin);
-        triBegin = far.triBegin;
-        triEnd = nodeRayEnd > terminated ? partitionTriangles(far.triBegin, far.triEnd, lo - margin, hi + margin)
-                                         : far.triBegin;
-        depth = far.depth;
-        stalls = nodeRayEnd == far.rayEnd && triEnd == far.triEnd ? far.stalls + 1u : 0u;
-    }
-
-    if (!finished) {
-        // Out of budget: save the node and the stack; a later dispatch resumes here.
-        if (!progressed && lane == 0) atomicAdd(counters.tooLarge, 1u);
-        workgroupSync();
-        for (uint i = lane; i < stackSize; i += kWorkgroupSize) stacks[itemIndex * (kMaxDepth + 1u) + i] = sStack[i];
-        bool cutShort = loopLimiterFired(push.loopProbe);
-        if (lane == 0) {
-            TraversalState saved;
-            saved.lo = lo;
-            saved.hi = hi;
-            saved.phase = kPhaseRunning;
-            saved.nodeRayEnd = nodeRayEnd;
-            saved.triBegin = triBegin;
-            saved.triEnd = triEnd;
-            saved.depth = depth;
-            saved.stackSize = stackSize;
-            saved.stalls = stalls;
-            saved.leafNext = leafNext;
-            states[itemIndex] = saved;
-            regions[item.rayRegion].terminated = terminated;
-            if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
-        }
-        return;
-    }
-
-    // Rays no later work item can change are finished here (see RetireRule on the CPU side).
-    uint rule = item.retire == 0u ? kKeepStill : (item.retire == 1u ? kKeepStuckHigh : kKeepStuckLow);
-    uint before = terminated;
-    terminated = partitionRays(terminated, rayEnd, rule, rootLo - margin, rootHi + margin);
-    bool cutShort = loopLimiterFired(push.loopProbe);
-    if (lane == 0) {
-        atomicAdd(counters.raysRetired, terminated - before);
-        regions[item.rayRegion].terminated = terminated;
-        states[itemIndex].phase = kPhaseFinished;
-        if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
-        atomicAdd(counters.itemsFinished, 1u);
-        memoryBarrierBuffer();
-        atomicAdd(regions[item.rayRegion].rayItemsDone, 1u);
-        atomicAdd(regions[item.triRegion].triItemsDone, 1u);
-    }
+    uint outcome = kStepContinue;
+    while (outcome == kStepContinue) outcome = stepTraversal(c, s);
+    if (outcome == kStepOutOfBudget)
+        saveSlice(c, s);
+    else
+        retireRays(c, s);
 }

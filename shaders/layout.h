@@ -1,5 +1,5 @@
 // Data layouts shared by the C++ host and the GLSL compute shaders (std430).
-// Included verbatim by both: C++ sees glm types through host/shader_compat.hpp,
+// Included verbatim by both: C++ sees glm types through host/core/shader_layout.hpp,
 // GLSL sees its own. Every size and offset is checked at the end of this file.
 #ifndef DACRT_LAYOUT_H
 #define DACRT_LAYOUT_H
@@ -33,6 +33,9 @@ struct Bounds {
     vec3 hi;
     float pad1;
 };
+
+const uint kMissPrim = 0xFFFFFFFFu;
+const float kNoHitT = 3.402823466e+38;          // FLT_MAX: finite, so no inf arithmetic anywhere
 
 // Per-ray result. prim == kMissPrim means no hit; t is then kNoHitT.
 struct Hit {

@@ -1,12 +1,10 @@
 // Geometric predicates shared by every backend. This file is valid GLSL and, through
-// host/shader_compat.hpp, valid C++: a fix here reaches the CPU and the GPU at once.
+// host/dacrt/predicates.hpp, valid C++: a fix here reaches the CPU and the GPU at once.
 // Rules (docs/correctness.md): filters may say "maybe" wrongly but never "no" wrongly;
 // arithmetic is IEEE single precision with no contraction (precise / -ffp-contract=off).
 #ifndef DACRT_PREDICATES_GLSL
 #define DACRT_PREDICATES_GLSL
 
-const uint kMissPrim = 0xFFFFFFFFu;
-const float kNoHitT = 3.402823466e+38;          // FLT_MAX: finite, so no inf arithmetic anywhere
 // 2 * gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (Pharr, Jakob, Humphreys; Ize 2013):
 // the relative error bound of (bound - origin) * invDir, doubled to absorb the rounding of
 // the widening itself.

@@ -1,0 +1,66 @@
+#pragma once
+// The one place where a backend choice becomes a trace, for render, bench and stress: the
+// request checked against the backend, the devices and pipelines opened once per process,
+// the frame traced, and the validation epilogue with its exit code.
+#include <cstdint>
+#include <iosfwd>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/thread_pool.hpp"
+#include "dacrt/frame_geometry.hpp"
+#include "dacrt/memory_plan.hpp"
+#include "dacrt/options.hpp"
+#include "dacrt/trace_result.hpp"
+#include "gpu/context.hpp"
+#include "gpu/gpu_tracer.hpp"
+#include "gpu/pipeline_cache.hpp"
+
+namespace dacrt {
+
+struct BackendRequest {
+    TraceOptions trace;
+    GpuTuning gpuTuning;        // gpu only
+    bool embreeRobust = true;   // embree only
+};
+
+// Throws InputError, naming the command-line options, when the request gives a backend an
+// option it does not take.
+void checkBackendRequest(const BackendRequest& request);
+
+struct DeviceChoice {
+    std::string device;     // gpu: index or part of the name; empty: the best device
+    bool validate = false;  // gpu: Khronos validation layers, errors counted
+};
+
+class BackendDispatcher {
+public:
+    // Opens the Vulkan device now when `backends` includes gpu, so that a missing or
+    // unmatched device fails before any long work.
+    BackendDispatcher(const DeviceChoice& devices, const std::vector<Backend>& backends);
+    ~BackendDispatcher();
+
+    // Threads a request runs on: 1 for cpu-seq, else its own count or every core.
+    static unsigned threadsOf(const TraceOptions& options);
+    ThreadPool& pool(unsigned threads);
+    gpu::Context* gpuContext() { return gpu_.get(); }  // null unless gpu was asked for
+    const gpu::Context* gpuContext() const { return gpu_.get(); }
+
+    // Checks the request (checkBackendRequest), then traces one frame on its backend.
+    TraceResult trace(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan = {});
+
+    std::uint32_t validationErrors() const;
+    // Under --validate: prints every validation message and returns kExitValidation when
+    // there were errors; otherwise returns kExitSuccess.
+    int validationEpilogue(std::ostream& err) const;
+
+private:
+    DeviceChoice devices_;
+    std::map<unsigned, std::unique_ptr<ThreadPool>> pools_;
+    std::unique_ptr<gpu::Context> gpu_;
+    std::unique_ptr<gpu::PipelineCache> pipelines_;
+};
+
+}  // namespace dacrt

@@ -1,0 +1,37 @@
+#pragma once
+// The bench command: frame time against error for every backend and option value, measured
+// against the float64 reference (docs/benchmarks.md).
+#include <string>
+#include <vector>
+
+#include "cmd/backend_dispatcher.hpp"
+
+namespace dacrt {
+
+// sweep: every backend's default, then each option value changed one at a time.
+// table51: the source's Table 5.1 and Figure 5.3 (threads, regions per thread, axes).
+enum class BenchSuite { Sweep, Table51 };
+
+struct BenchCommand {
+    std::vector<std::string> scenes;
+    std::vector<Backend> backends;  // empty: cpu-seq, cpu, gpu (when a device exists), embree
+    BenchSuite suite = BenchSuite::Sweep;
+    int orbit = 1;
+    int width = 640;
+    int height = 480;
+    int repeat = 3;
+    int warmup = 1;
+    // Outputs; an empty path means outDir/bench.csv, outDir/bench.json. tools/bench/plot.py
+    // draws the JSON.
+    std::string outDir = "dacrt-bench";
+    std::string csvPath;
+    std::string jsonPath;
+    std::string cacheDir;      // empty: $XDG_CACHE_HOME/dacrt or ~/.cache/dacrt
+    bool useCache = true;
+    DeviceChoice devices;      // gpu
+};
+
+// Returns the process exit code; throws InputError on bad input.
+int runBenchCommand(const BenchCommand& command);
+
+}  // namespace dacrt

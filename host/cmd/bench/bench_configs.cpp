@@ -1,0 +1,122 @@
+#include "cmd/bench/bench_configs.hpp"
+
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace dacrt {
+
+std::string optionText(const BenchConfig& c) {
+    std::ostringstream s;
+    if (c.backend() == Backend::Embree) {
+        s << "robust=" << (c.request.embreeRobust ? "on" : "off") << " timing=" << (c.embreeStatic ? "static" : "dynamic");
+        return s.str();
+    }
+    const DacrtOptions d = c.request.trace.dacrt.resolvedFor(c.backend());
+    s << "intersector=" << toString(d.intersector) << " triangle_filter=" << toString(d.triangleFilter)
+      << " precision=" << toString(d.precision) << " split=" << toString(d.split) << " ray_limit=" << d.rayLimit
+      << " tri_limit=" << d.triLimit << " axis=" << toString(c.request.trace.axis) << " regions=" << c.request.trace.regions
+      << " threads=" << c.threads();
+    if (c.backend() == Backend::Gpu)
+        s << " ray_groups=" << (c.request.gpuTuning.rayGroups ? std::to_string(c.request.gpuTuning.rayGroups) : "auto");
+    return s.str();
+}
+
+BenchConfig baseConfig(Backend b, unsigned hardwareThreads) {
+    BenchConfig c;
+    c.series = toString(b);
+    c.name = "default";
+    c.request.trace.backend = b;
+    c.request.trace.threads = b == Backend::CpuSeq ? 1u : hardwareThreads;
+    c.isDefault = true;
+    return c;
+}
+
+std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions,
+                                      std::uint32_t gpuDefaultRayGroups) {
+    std::vector<BenchConfig> out;
+    const BenchConfig base = baseConfig(b, hardwareThreads);
+    auto variant = [&](const std::string& name, auto&& change) {
+        BenchConfig c = base;
+        c.name = name;
+        c.isDefault = false;
+        change(c);
+        out.push_back(c);
+    };
+    if (b == Backend::Embree) {
+        out.push_back(base);
+        BenchConfig s = base;
+        s.series = "embree static";
+        s.embreeStatic = true;
+        out.push_back(s);
+        variant("robust=off", [](BenchConfig& c) { c.request.embreeRobust = false; });
+        variant("robust=off", [](BenchConfig& c) {
+            c.request.embreeRobust = false;
+            c.embreeStatic = true;
+            c.series = "embree static";
+        });
+        return out;
+    }
+    out.push_back(base);
+    if (b == Backend::Brute) return out;
+    const bool cpu = b == Backend::Cpu || b == Backend::CpuSeq;
+    if (cpu) {
+        variant("intersector=moller-trumbore", [](BenchConfig& c) { c.request.trace.dacrt.intersector = Intersector::MollerTrumbore; });
+        variant("triangle-filter=sat", [](BenchConfig& c) { c.request.trace.dacrt.triangleFilter = TriangleFilter::Sat; });
+        variant("triangle-filter=mora", [](BenchConfig& c) { c.request.trace.dacrt.triangleFilter = TriangleFilter::Mora; });
+        variant("precision=f64", [](BenchConfig& c) { c.request.trace.dacrt.precision = Precision::F64; });
+        variant("split=centroid-mean", [](BenchConfig& c) { c.request.trace.dacrt.split = SplitMethod::CentroidMean; });
+        variant("split=sampled-mean", [](BenchConfig& c) { c.request.trace.dacrt.split = SplitMethod::SampledMean; });
+    }
+    const std::uint32_t defaultLimit = base.request.trace.dacrt.resolvedFor(b).rayLimit;
+    const std::vector<std::uint32_t> limits = cpu ? std::vector<std::uint32_t>{4, 8, 16, 32, 64} : std::vector<std::uint32_t>{8, 16, 32, 64, 128};
+    for (std::uint32_t l : limits)
+        if (l != defaultLimit)
+            variant("leaf-limits=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = c.request.trace.dacrt.triLimit = l; });
+    if (b == Backend::CpuSeq) return out;
+    const unsigned defaultRegions = b == Backend::Cpu ? hardwareThreads : gpuDefaultRegions;
+    for (unsigned r : {1u, 2u, 4u, 8u, 16u, 64u})
+        if (r != defaultRegions)
+            variant("regions=" + std::to_string(r), [r](BenchConfig& c) { c.request.trace.regions = r; });
+    for (DivisionAxis a : {DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z})
+        variant("axis=" + toString(a), [a](BenchConfig& c) { c.request.trace.axis = a; });
+    if (b == Backend::Gpu)
+        for (std::uint32_t groups : {1u, 2u, 4u})
+            if (groups != gpuDefaultRayGroups)
+                variant("ray-groups=" + std::to_string(groups), [groups](BenchConfig& c) { c.request.gpuTuning.rayGroups = groups; });
+    return out;
+}
+
+// The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
+std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads) {
+    std::vector<BenchConfig> out;
+    if (b == Backend::CpuSeq) {
+        out.push_back(baseConfig(b, hardwareThreads));
+        return out;
+    }
+    auto config = [&](unsigned threads, unsigned regions, DivisionAxis axis) {
+        BenchConfig c = baseConfig(b, hardwareThreads);
+        c.isDefault = false;
+        c.request.trace.threads = b == Backend::Cpu ? threads : hardwareThreads;
+        c.request.trace.regions = regions;
+        c.request.trace.axis = axis;
+        c.name = (b == Backend::Cpu ? "threads=" + std::to_string(threads) + " " : std::string()) +
+                 "regions=" + std::to_string(regions) + " axis=" + toString(axis);
+        out.push_back(c);
+    };
+    const DivisionAxis axes[] = {DivisionAxis::Best, DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z};
+    if (b == Backend::Cpu) {
+        const std::pair<unsigned, unsigned> setups[] = {{1, 1}, {2, 2}, {4, 4}, {1, 2}, {2, 4}, {4, 8}};
+        for (const auto& [threads, regions] : setups)
+            for (DivisionAxis a : axes) config(threads, regions, a);
+    } else if (b == Backend::Gpu) {
+        for (unsigned regions : {1u, 2u, 4u, 8u, 16u})
+            for (DivisionAxis a : axes)
+                if (a == DivisionAxis::Best || regions == 2 || regions == 4) config(0, regions, a);
+    } else {
+        throw InputError("--suite table51 compares the DACRT backends (cpu-seq, cpu, gpu), not " + toString(b));
+    }
+    return out;
+}
+
+}  // namespace dacrt

@@ -1,0 +1,24 @@
+#pragma once
+// The configurations a bench run measures.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cmd/bench/bench_rows.hpp"
+
+namespace dacrt {
+
+// The options of a configuration in full, as the CSV and JSON record them.
+std::string optionText(const BenchConfig& c);
+
+// A backend's default configuration on hardwareThreads threads (cpu-seq: one).
+BenchConfig baseConfig(Backend b, unsigned hardwareThreads);
+
+// sweep: the backend's default, then each option value changed one at a time.
+std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions,
+                                      std::uint32_t gpuDefaultRayGroups);
+
+// The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
+std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads);
+
+}  // namespace dacrt

@@ -1,0 +1,23 @@
+#pragma once
+// What a bench run reports: the Pareto fronts, the table on stdout, the CSV and the JSON.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cmd/bench/bench_rows.hpp"
+
+namespace dacrt {
+
+// A configuration is dominated when another one of its series has no more error and is
+// faster by more than this fraction, or has less error and is no slower. The same
+// configuration measured in two runs on this machine differs by up to about 5%
+// (docs/benchmarks.md), so closer times are a draw.
+constexpr double kParetoTimeMargin = 0.05;
+
+void markPareto(std::vector<BenchRow>& rows);
+nlohmann::ordered_json rowJson(const BenchRow& r);
+void writeCsv(const std::string& path, const std::vector<BenchRow>& rows);
+void printSummary(const std::vector<BenchRow>& rows);
+
+}  // namespace dacrt

@@ -1,0 +1,297 @@
+#include "cmd/cli.hpp"
+
+#include <cmath>
+#include <iostream>
+#include <functional>
+#include <memory>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "cmd/bench/bench.hpp"
+#include "cmd/exit_codes.hpp"
+#include "cmd/render.hpp"
+#include "cmd/stress/stress.hpp"
+#include "core/errors.hpp"
+#include "gpu/context.hpp"
+#include "gpu/vulkan_error.hpp"
+#include "oracle/compare.hpp"
+
+namespace dacrt {
+namespace {
+
+glm::dvec3 parseVec3(const std::string& option, const std::string& text) {
+    std::stringstream s(text);
+    std::string part;
+    std::vector<double> values;
+    while (std::getline(s, part, ',')) {
+        try {
+            std::size_t used = 0;
+            values.push_back(std::stod(part, &used));
+            if (used != part.size()) throw std::invalid_argument(part);
+        } catch (const std::exception&) {
+            throw InputError(option + ": '" + text + "' is not three comma-separated numbers");
+        }
+    }
+    if (values.size() != 3) throw InputError(option + ": '" + text + "' is not three comma-separated numbers");
+    for (double v : values)
+        if (!std::isfinite(v)) throw InputError(option + ": '" + text + "' has a non-finite value");
+    return {values[0], values[1], values[2]};
+}
+
+void parseSize(const std::string& text, int& width, int& height) {
+    const std::size_t x = text.find('x');
+    try {
+        std::size_t usedW = 0, usedH = 0;
+        if (x == std::string::npos) throw std::invalid_argument(text);
+        width = std::stoi(text.substr(0, x), &usedW);
+        height = std::stoi(text.substr(x + 1), &usedH);
+        if (usedW != x || usedH != text.size() - x - 1) throw std::invalid_argument(text);
+    } catch (const std::exception&) {
+        throw InputError("--size: '" + text + "' is not WIDTHxHEIGHT");
+    }
+}
+
+// An option that takes one of an enum's names (its table in EnumNames): the help lists the
+// names, and the value is stored as the enum.
+template <typename E>
+CLI::Option* addEnumOption(CLI::App* cmd, const std::string& flags, E& target, const std::string& help,
+                           const std::vector<std::string>& names = enumNameList<E>()) {
+    return cmd
+        ->add_option_function<std::string>(
+            flags, [&target](const std::string& name) { target = *parseEnum<E>(name); }, help)
+        ->check(CLI::IsMember(names))
+        ->default_str(toString(target));
+}
+
+// A list of backends, each from the Backend name table.
+CLI::Option* addBackendListOption(CLI::App* cmd, const std::string& flags, std::vector<Backend>& target,
+                                  const std::string& help, const std::vector<std::string>& names) {
+    return cmd
+        ->add_option_function<std::vector<std::string>>(
+            flags,
+            [&target](const std::vector<std::string>& list) {
+                target.clear();
+                for (const std::string& name : list) target.push_back(*parseEnum<Backend>(name));
+            },
+            help)
+        ->check(CLI::IsMember(names))
+        ->delimiter(',');
+}
+
+std::vector<std::string> dacrtBackendNames() { return {"brute", "cpu-seq", "cpu", "gpu"}; }
+
+// The DACRT options that render and bench share.
+void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
+    addEnumOption(cmd, "--split", o.split, "DACRT split (cpu, cpu-seq; gpu: spatial-median only)");
+    const std::string limits = std::to_string(kCpuLeafLimit) + " on the cpu backends, " + std::to_string(kGpuLeafLimit) + " on gpu";
+    cmd->add_option("--ray-limit", o.rayLimit, "leaf when fewer live rays")
+        ->check(CLI::Range(1u, 1u << 30))->default_str(limits);
+    cmd->add_option("--tri-limit", o.triLimit, "leaf when fewer triangles")
+        ->check(CLI::Range(1u, 1u << 30))->default_str(limits);
+    addEnumOption(cmd, "--intersector", o.intersector, "leaf ray/triangle test (cpu, cpu-seq)");
+    addEnumOption(cmd, "--triangle-filter", o.triangleFilter,
+                  "triangle/box filter: bounds, sat (exact separating axes) or mora (inexact) (cpu, cpu-seq)");
+    addEnumOption(cmd, "--precision", o.precision, "leaf ray/triangle arithmetic (cpu, cpu-seq)");
+}
+
+// A subcommand: its options parse into state of its own, and run() is called when it is chosen.
+struct Subcommand {
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+
+void addDeviceOptions(CLI::App* cmd, DeviceChoice& devices) {
+    cmd->add_option("--device", devices.device, "gpu: Vulkan device index or part of its name (see 'dacrt devices')");
+    cmd->add_flag("--validate", devices.validate, "gpu: run under the Vulkan validation layers; errors fail the run (exit 3)");
+}
+
+Subcommand addRenderCommand(CLI::App& app) {
+    struct State {
+        RenderOptions render;
+        std::string size = "640x480", eye, target, up;
+        double fov = 0.0;
+        bool embreeFast = false;
+    };
+    auto s = std::make_shared<State>();
+    RenderOptions& render = s->render;
+    CLI::App* cmd = app.add_subcommand("render", "trace primary rays through a glTF scene");
+    cmd->add_option("scene", render.scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
+    cmd->add_option("-o,--output", render.outputPath, "shaded image (PNG or any OpenImageIO format)");
+    cmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id and hit mask");
+    cmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
+    addEnumOption(cmd, "--backend", render.request.trace.backend, "tracer");
+    cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
+    cmd->add_option("--regions", render.request.trace.regions, "sub-scenes of cpu and gpu (default: one per thread)")
+        ->check(CLI::Range(1u, 4096u));
+    cmd->add_option("--threads", render.request.trace.threads, "worker threads (default: every core)")
+        ->check(CLI::Range(1u, 1024u));
+    addEnumOption(cmd, "--axis", render.request.trace.axis, "division axis (cpu, gpu)");
+    addDacrtOptions(cmd, render.request.trace.dacrt);
+    cmd->add_flag("--embree-fast", s->embreeFast, "embree: without RTC_SCENE_FLAG_ROBUST (faster, leaks through edges)");
+    cmd->add_option("--eye", s->eye, "camera position x,y,z");
+    cmd->add_option("--target", s->target, "point the camera looks at x,y,z");
+    cmd->add_option("--up", s->up, "camera up vector x,y,z");
+    cmd->add_option("--fov", s->fov, "vertical field of view in degrees");
+    cmd->add_option("--orbit", render.camera.orbit, "K cameras on a circle about the vertical axis")
+        ->check(CLI::Range(1, 100000));
+    cmd->add_flag("--plan", render.planOnly, "print the memory plan and stop before tracing");
+    addDeviceOptions(cmd, render.devices);
+    cmd->add_option("--workgroup-size", render.request.gpuTuning.workgroupSize,
+                    "gpu: invocations per workgroup (default: per device)")
+        ->check(CLI::Range(1u, 1024u));
+    cmd->add_option("--ray-groups", render.request.gpuTuning.rayGroups,
+                    "gpu: work items per region, each a band of its rays with its own copy of the region's "
+                    "triangle ids (default: per device)")
+        ->check(CLI::Range(1u, 64u));
+    return {cmd, [s, cmd] {
+                RenderOptions& r = s->render;
+                parseSize(s->size, r.width, r.height);
+                if (!s->eye.empty()) r.camera.eye = parseVec3("--eye", s->eye);
+                if (!s->target.empty()) r.camera.target = parseVec3("--target", s->target);
+                if (!s->up.empty()) r.camera.up = parseVec3("--up", s->up);
+                if (cmd->count("--fov")) {
+                    if (!(s->fov > 0.0 && s->fov < 180.0))
+                        throw InputError("--fov: the vertical field of view must lie strictly between 0 and 180 "
+                                         "degrees, got " + std::to_string(s->fov));
+                    r.camera.fovDegrees = s->fov;
+                }
+                r.request.embreeRobust = !s->embreeFast;
+                return runRender(r);
+            }};
+}
+
+Subcommand addDevicesCommand(CLI::App& app) {
+    CLI::App* cmd = app.add_subcommand("devices", "list the Vulkan devices and the limits that matter here");
+    return {cmd, [] {
+                const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
+                if (devices.empty()) std::cout << "no Vulkan devices\n";
+                for (const gpu::DeviceInfo& d : devices) std::cout << d.describe();
+                return int(kExitSuccess);
+            }};
+}
+
+Subcommand addCompareCommand(CLI::App& app) {
+    struct State {
+        std::string a, b;
+        bool json = false;
+        double tieBound = kNearTieRelativeDepth;
+    };
+    auto s = std::make_shared<State>();
+    CLI::App* cmd = app.add_subcommand("compare", "compare two --aov images pixel by pixel");
+    cmd->add_option("a", s->a, "first AOV EXR")->required();
+    cmd->add_option("b", s->b, "second AOV EXR")->required();
+    cmd->add_flag("--json", s->json, "write the report as JSON to stdout");
+    cmd->add_option("--tie-bound", s->tieBound, "relative depth bound of a near tie")->check(CLI::PositiveNumber);
+    return {cmd, [s] {
+                const Aov a = readAov(s->a);  // a before b, so that an error names the first bad file
+                const Aov b = readAov(s->b);
+                const CompareReport report = compareAovs(a, b, s->tieBound);
+                std::cout << (s->json ? report.json() + "\n" : report.text());
+                return int(kExitSuccess);
+            }};
+}
+
+Subcommand addStressCommand(CLI::App& app) {
+    struct State {
+        StressCommand stress;
+        std::string size = "large";
+        bool defaultsOnly = false, noDeterminism = false;
+    };
+    auto s = std::make_shared<State>();
+    StressCommand& stress = s->stress;
+    CLI::App* cmd = app.add_subcommand("stress", "try to break every backend numerically (docs/stability.md)");
+    addBackendListOption(cmd, "--backends", stress.backends, "backends to run (default: brute,cpu-seq,cpu,gpu)",
+                         dacrtBackendNames());
+    cmd->add_option("--families", stress.families, "case families (default: watertight,split-plane,degenerate)")
+        ->check(CLI::IsMember(stressFamilies()))
+        ->delimiter(',');
+    cmd->add_option("--size", s->size, "small (the test suite's cases) or large")
+        ->check(CLI::IsMember({"small", "large"}))->default_str("large");
+    cmd->add_option("--seed", stress.seed, "seed of the random parts of the cases")->default_str("1");
+    cmd->add_flag("--defaults-only", s->defaultsOnly, "run only each backend's default configuration");
+    cmd->add_flag("--no-determinism", s->noDeterminism, "skip the determinism checks");
+    cmd->add_option("--json", stress.jsonPath, "write the table and checks as JSON");
+    addDeviceOptions(cmd, stress.devices);
+    return {cmd, [s] {
+                s->stress.size = s->size == "small" ? StressSize::Small : StressSize::Large;
+                s->stress.withOptions = !s->defaultsOnly;
+                s->stress.determinism = !s->noDeterminism;
+                return runStressCommand(s->stress);
+            }};
+}
+
+Subcommand addBenchCommand(CLI::App& app) {
+    struct State {
+        BenchCommand bench;
+        std::string size = "640x480", suite = "sweep";
+        bool noCache = false;
+    };
+    auto s = std::make_shared<State>();
+    BenchCommand& bench = s->bench;
+    CLI::App* cmd = app.add_subcommand("bench", "frame time against error for every backend and option (docs/benchmarks.md)");
+    cmd->add_option("scenes", bench.scenes, "glTF scenes")->required();
+    addBackendListOption(cmd, "--backends", bench.backends,
+                         "backends (default: cpu-seq,cpu,gpu,embree; gpu only with a device)", enumNameList<Backend>());
+    cmd->add_option("--suite", s->suite, "sweep (every option value) or table51 (the source's Table 5.1 and Figure 5.3)")
+        ->check(CLI::IsMember({"sweep", "table51"}))->default_str("sweep");
+    cmd->add_option("--orbit", bench.orbit, "K cameras on a circle about the vertical axis")->check(CLI::Range(1, 1000))->default_str("1");
+    cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
+    cmd->add_option("--repeat", bench.repeat, "timed frames per camera and configuration")->check(CLI::Range(1, 1000))->default_str("3");
+    cmd->add_option("--warmup", bench.warmup, "untimed frames first")->check(CLI::Range(0, 1000))->default_str("1");
+    cmd->add_option("--out", bench.outDir, "directory of the outputs not named below")->default_str("dacrt-bench");
+    cmd->add_option("--csv", bench.csvPath, "one row per scene and configuration (default OUT/bench.csv)");
+    cmd->add_option("--json", bench.jsonPath,
+                    "the rows with their time parts (default OUT/bench.json); tools/bench/plot.py draws them");
+    cmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
+    cmd->add_flag("--no-cache", s->noCache, "always recompute the float64 reference");
+    addDeviceOptions(cmd, bench.devices);
+    return {cmd, [s] {
+                parseSize(s->size, s->bench.width, s->bench.height);
+                s->bench.suite = s->suite == "table51" ? BenchSuite::Table51 : BenchSuite::Sweep;
+                s->bench.useCache = !s->noCache;
+                return runBenchCommand(s->bench);
+            }};
+}
+
+// Runs the chosen subcommand and maps what it throws to its exit code.
+int runReportingErrors(const std::function<int()>& run) {
+    try {
+        return run();
+    } catch (const InputError& e) {
+        std::cerr << "dacrt: error: " << e.what() << "\n";
+        return kExitBadInput;
+    } catch (const gpu::VulkanError& e) {
+        std::cerr << "dacrt: Vulkan error: " << e.what() << "\n";
+        return kExitDeviceFailure;
+    } catch (const InternalError& e) {
+        std::cerr << "dacrt: internal error: " << e.what() << "\n";
+        return kExitInternalError;
+    } catch (const std::exception& e) {
+        std::cerr << "dacrt: internal error: " << e.what() << " (please report it)\n";
+        return kExitInternalError;
+    }
+}
+
+}  // namespace
+
+int runCli(int argc, char** argv) {
+    CLI::App app{"dacrt: divide-and-conquer ray tracing without an acceleration structure"};
+    app.require_subcommand(1);
+    app.footer(exitCodeHelp());
+    const std::vector<Subcommand> commands = {addRenderCommand(app), addDevicesCommand(app), addCompareCommand(app),
+                                              addStressCommand(app), addBenchCommand(app)};
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return kExitBadInput;
+    }
+    for (const Subcommand& c : commands)
+        if (*c.app) return runReportingErrors(c.run);
+    return kExitBadInput;
+}
+
+}  // namespace dacrt

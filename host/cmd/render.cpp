@@ -1,0 +1,138 @@
+#include "cmd/render.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <unistd.h>
+
+#include "cmd/exit_codes.hpp"
+#include "cmd/render_stats.hpp"
+#include "core/errors.hpp"
+#include "core/gltf_loader.hpp"
+#include "core/image_io.hpp"
+#include "core/shading.hpp"
+#include "core/timing.hpp"
+
+namespace dacrt {
+namespace {
+
+std::uint64_t physicalMemoryBytes() {
+    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && pageSize > 0 ? std::uint64_t(pages) * std::uint64_t(pageSize) : 0;
+}
+
+void checkRenderOptions(const RenderOptions& o) {
+    if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
+        throw InputError("--size: width and height must lie in 1..16384");
+    if (o.request.trace.backend == Backend::Embree && o.planOnly)
+        throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
+    checkBackendRequest(o.request);
+}
+
+// What every camera of the orbit shares: the scene, its bounds and the cameras.
+struct PreparedScene {
+    Scene scene;
+    std::vector<Bounds> triangleBounds;
+    Box box;
+    std::vector<Camera> cameras;
+    double loadMs = 0.0;
+    double prepareMs = 0.0;
+};
+
+PreparedScene loadAndPrepare(const RenderOptions& o) {
+    PreparedScene p;
+    const auto start = Clock::now();
+    p.scene = loadGltf(o.scenePath);
+    p.loadMs = msSince(start);
+    const auto prepareStart = Clock::now();
+    p.triangleBounds = allTriangleBounds(p.scene.triangles);
+    p.box = sceneBounds(p.scene.triangles);
+    p.cameras = makeCameras(p.scene, p.box, o.camera, double(o.width) / double(o.height));
+    p.prepareMs = msSince(prepareStart);
+    return p;
+}
+
+// Prints the plan and stops the frame under --plan; otherwise refuses a plan that exceeds
+// this machine's memory.
+PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t rays, int cameraIndex) {
+    return [&o, &p, rays, cameraIndex](const MemoryPlan& plan) {
+        if (o.planOnly) {
+            std::cout << "memory plan (" << toString(o.request.trace.backend) << ", " << p.scene.triangleCount()
+                      << " triangles, " << rays << " rays"
+                      << (p.cameras.size() > 1 ? ", camera " + std::to_string(cameraIndex) : std::string()) << "):\n"
+                      << plan.describe();
+            return false;
+        }
+        const std::uint64_t limit = physicalMemoryBytes();
+        if (limit && plan.total() > limit)
+            throw InputError("the frame needs " + std::to_string(plan.total()) + " bytes but this machine has " +
+                             std::to_string(limit) + " bytes of memory (over by " +
+                             std::to_string(plan.total() - limit) + " bytes); lower --size or --regions");
+        return true;
+    };
+}
+
+// The shade and write stages of one camera; returns the shaded image's path, if any.
+std::string writeImages(const RenderOptions& o, const PreparedScene& p, int k, const HitImage& image) {
+    const int count = int(p.cameras.size());
+    const std::string out = pathForCamera(o.outputPath, k, count);
+    const std::string aov = pathForCamera(o.aovPath, k, count);
+    if (!out.empty()) writeRgb8(out, image.width, image.height, shadeImage(p.scene, image));
+    if (!aov.empty()) writeAov(aov, p.scene, image);
+    return out;
+}
+
+void writeStats(const RenderOptions& o, int k, int cameraCount, const RenderedFrame& frame) {
+    const std::string path = pathForCamera(o.statsPath, k, cameraCount);
+    if (path.empty()) return;
+    std::ofstream f(path);
+    if (!f) throw InputError(path + ": cannot write the stats file");
+    f << renderStatsJson(o, frame).dump(2) << "\n";
+}
+
+}  // namespace
+
+std::string pathForCamera(const std::string& path, int camera, int cameraCount) {
+    if (path.empty() || cameraCount <= 1) return path;
+    const std::filesystem::path p(path);
+    const int digits = int(std::to_string(cameraCount - 1).size());
+    std::string index = std::to_string(camera);
+    index.insert(0, std::size_t(digits) - index.size(), '0');
+    return (p.parent_path() / (p.stem().string() + "_cam" + index + p.extension().string())).string();
+}
+
+int runRender(const RenderOptions& o) {
+    checkRenderOptions(o);
+    BackendDispatcher backends(o.devices, {o.request.trace.backend});
+    const PreparedScene p = loadAndPrepare(o);
+
+    for (int k = 0; k < int(p.cameras.size()); ++k) {
+        const Camera& camera = p.cameras[std::size_t(k)];
+        const auto frameStart = Clock::now();
+        const std::vector<Ray> rays = primaryRays(camera, o.width, o.height);
+        const FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box);
+        const double prepareMs = p.prepareMs + msSince(frameStart);
+
+        const auto traceStart = Clock::now();
+        const TraceResult result = backends.trace(g, o.request, planCheck(o, p, rays.size(), k));
+        if (o.planOnly) continue;
+        const double traceMs = msSince(traceStart);
+
+        const auto writeStart = Clock::now();
+        const std::string out = writeImages(o, p, k, HitImage{o.width, o.height, &rays, &result.hits});
+        const double writeMs = msSince(writeStart);
+        const double totalMs = (k == 0 ? p.loadMs + p.prepareMs : 0.0) + msSince(frameStart);
+
+        writeStats(o, k, int(p.cameras.size()),
+                   RenderedFrame{p.scene, camera, k, rays.size(), result,
+                                 {{"load", p.loadMs}, {"prepare", prepareMs}, {"trace", traceMs}, {"write", writeMs},
+                                  {"total", totalMs}}});
+        std::cerr << "dacrt: " << toString(o.request.trace.backend) << " camera " << k << ": "
+                  << p.scene.triangleCount() << " triangles, " << rays.size() << " rays, trace " << traceMs << " ms"
+                  << (out.empty() ? "" : ", wrote " + out) << "\n";
+    }
+    return backends.validationEpilogue(std::cerr);
+}
+
+}  // namespace dacrt

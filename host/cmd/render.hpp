@@ -1,0 +1,29 @@
+#pragma once
+// The render command: scene in, one traced frame per camera, images and stats out.
+#include <string>
+
+#include "cmd/backend_dispatcher.hpp"
+#include "core/camera.hpp"
+
+namespace dacrt {
+
+struct RenderOptions {
+    std::string scenePath;
+    std::string outputPath;   // shaded image; empty: none
+    std::string aovPath;      // EXR AOVs; empty: none
+    std::string statsPath;    // JSON; empty: none
+    int width = 640;
+    int height = 480;
+    bool planOnly = false;    // print the memory plan and stop before tracing
+    DeviceChoice devices;     // gpu
+    BackendRequest request;
+    CameraOptions camera;
+};
+
+// With K cameras, each output name gets "_camN" before its extension.
+std::string pathForCamera(const std::string& path, int camera, int cameraCount);
+
+// Returns the exit code (cmd/exit_codes.hpp); throws InputError on bad input.
+int runRender(const RenderOptions& options);
+
+}  // namespace dacrt

@@ -1,0 +1,125 @@
+#include "core/camera.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace dacrt {
+namespace {
+
+bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::string str(const glm::dvec3& v) {
+    std::ostringstream s;
+    s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+    return s.str();
+}
+
+Camera lookAt(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& upHint, double yfov) {
+    if (!finite(eye) || !finite(target) || !finite(upHint))
+        throw InputError("camera: eye, target and up must be finite, got eye " + str(eye) + ", target " +
+                         str(target) + ", up " + str(upHint));
+    for (double c : {eye.x, eye.y, eye.z})
+        if (std::abs(c) > kMaxCoordinate)
+            throw InputError("camera: eye " + str(eye) + " lies outside +-1e9, the coordinate limit");
+    const glm::dvec3 f = target - eye;
+    if (glm::length(f) == 0.0) throw InputError("camera: eye and target coincide at " + str(eye));
+    Camera c;
+    c.eye = eye;
+    c.forward = glm::normalize(f);
+    const glm::dvec3 right = glm::cross(c.forward, upHint);
+    if (!(glm::length(right) > 1e-9 * glm::length(upHint)))
+        throw InputError("camera: up " + str(upHint) + " is parallel to the view direction " + str(c.forward));
+    c.up = glm::normalize(glm::cross(glm::normalize(right), c.forward));
+    c.yfovRadians = yfov;
+    return c;
+}
+
+}  // namespace
+
+std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const CameraOptions& options, double aspect) {
+    const glm::dvec3 centre = glm::dvec3(bounds.center());
+    double yfov = glm::radians(kDefaultFovDegrees);
+    glm::dvec3 eye, target = centre, up{0.0, 1.0, 0.0};
+    if (scene.camera && !options.eye && !options.target) {
+        yfov = scene.camera->yfovRadians;
+        eye = scene.camera->eye;
+        target = eye + scene.camera->forward;
+        up = scene.camera->up;
+    } else {
+        if (options.fovDegrees) yfov = glm::radians(*options.fovDegrees);
+        // Front view: back off along +z until the bounding sphere fits the narrower field of view.
+        const double radius = 0.5 * glm::length(glm::dvec3(bounds.extent()));
+        const double halfFov = 0.5 * std::min(yfov, 2.0 * std::atan(std::tan(0.5 * yfov) * aspect));
+        const double distance = std::max(radius, 1e-6) / std::sin(halfFov) * 1.02;
+        eye = centre + glm::dvec3(0.0, 0.0, distance);
+    }
+    if (options.eye) eye = *options.eye;
+    if (options.target) target = *options.target;
+    if (options.up) up = *options.up;
+    if (options.fovDegrees) {
+        const double deg = *options.fovDegrees;
+        if (!(deg > 0.0 && deg < 180.0))
+            throw InputError("camera: the vertical field of view must lie strictly between 0 and 180 degrees, got " + std::to_string(deg));
+        yfov = glm::radians(deg);
+    }
+    const Camera base = lookAt(eye, target, up, yfov);
+    if (options.orbit < 0) throw InputError("camera: an orbit needs a positive number of cameras");
+    if (options.orbit <= 1) return {base};
+
+    std::vector<Camera> cameras;
+    for (int k = 0; k < options.orbit; ++k) {
+        const double angle = 2.0 * M_PI * double(k) / double(options.orbit);
+        const double c = std::cos(angle), s = std::sin(angle);
+        auto rotate = [&](const glm::dvec3& v) { return glm::dvec3(c * v.x + s * v.z, v.y, -s * v.x + c * v.z); };
+        Camera cam = base;
+        cam.eye = centre + rotate(base.eye - centre);
+        cam.forward = rotate(base.forward);
+        cam.up = rotate(base.up);
+        cameras.push_back(cam);
+    }
+    return cameras;
+}
+
+Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
+    if (!finite(glm::dvec3(origin)) || !finite(direction) || glm::length(direction) == 0.0)
+        throw InputError("ray: origin " + str(glm::dvec3(origin)) + " and direction " + str(direction) +
+                         " must be finite and the direction non-zero");
+    glm::vec3 d = glm::vec3(glm::normalize(direction));
+    for (int a = 0; a < 3; ++a)
+        if (std::abs(d[a]) < 0x1p-64f) d[a] = 0.0f;  // keeps every slab bound finite (predicates.glsl)
+
+    Ray r{};
+    r.origin = origin;
+    r.tmin = tmin;
+    r.dir = d;
+    for (int a = 0; a < 3; ++a) r.invDir[a] = d[a] == 0.0f ? 0.0f : 1.0f / d[a];
+    int kz = 0;
+    for (int a = 1; a < 3; ++a)
+        if (std::abs(d[a]) > std::abs(d[kz])) kz = a;
+    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+    if (d[kz] < 0.0f) std::swap(kx, ky);  // keeps the winding, so the sign of det is the facing
+    r.axes = std::uint32_t(kx) | std::uint32_t(ky) << 2 | std::uint32_t(kz) << 4;
+    r.shear = glm::vec3(d[kx] / d[kz], d[ky] / d[kz], 1.0f / d[kz]);
+    return r;
+}
+
+std::vector<Ray> primaryRays(const Camera& camera, int width, int height) {
+    std::vector<Ray> rays(std::size_t(width) * std::size_t(height));
+    const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
+    const double tanHalf = std::tan(0.5 * camera.yfovRadians);
+    const double aspect = double(width) / double(height);
+    const glm::vec3 origin = glm::vec3(camera.eye);
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const double sx = (2.0 * (x + 0.5) / width - 1.0) * tanHalf * aspect;
+            const double sy = (1.0 - 2.0 * (y + 0.5) / height) * tanHalf;
+            rays[std::size_t(y) * std::size_t(width) + std::size_t(x)] =
+                makeRay(origin, camera.forward + sx * right + sy * camera.up);
+        }
+    }
+    return rays;
+}
+
+}  // namespace dacrt

@@ -1,0 +1,44 @@
+#pragma once
+// Cameras and primary rays. Ray directions are computed once here, in float32, and every
+// backend traces exactly these rays.
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/scene.hpp"
+
+namespace dacrt {
+
+struct Camera {
+    glm::dvec3 eye{0.0};
+    glm::dvec3 forward{0.0, 0.0, -1.0};  // unit
+    glm::dvec3 up{0.0, 1.0, 0.0};        // unit, orthogonal to forward
+    double yfovRadians = 0.0;
+};
+
+struct CameraOptions {
+    std::optional<glm::dvec3> eye;
+    std::optional<glm::dvec3> target;
+    std::optional<glm::dvec3> up;
+    std::optional<double> fovDegrees;  // vertical
+    int orbit = 0;                     // 0: one camera; K > 0: K cameras on a circle
+};
+
+constexpr double kDefaultFovDegrees = 45.0;
+
+// The scene's camera if it has one, else a front view (looking down -z) framing the box;
+// options override it. With orbit K, the K cameras are the base camera rotated about the
+// vertical (y) axis through the box centre by 2 pi k / K. Throws InputError on bad values.
+std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const CameraOptions& options, double aspect);
+
+// Canonical float32 ray from an origin and a direction of any length: normalized in double,
+// rounded to float, components below 2^-64 flushed to zero (so 1/dir <= 2^64), and the
+// watertight-test permutation and shear precomputed. Throws InputError on a zero or
+// non-finite direction or origin.
+Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin = 0.0f);
+
+// One ray per pixel through the pixel centre, row-major from the top-left pixel.
+std::vector<Ray> primaryRays(const Camera& camera, int width, int height);
+
+}  // namespace dacrt

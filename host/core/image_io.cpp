@@ -1,0 +1,78 @@
+#include "core/image_io.hpp"
+
+#include <limits>
+
+#include <OpenImageIO/imageio.h>
+
+#include "core/errors.hpp"
+
+namespace dacrt {
+namespace {
+
+void writePixels(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format, const void* data) {
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw InputError(path + ": cannot write an image here: " + OIIO::geterror());
+    if (!out->open(path, spec) || !out->write_image(format, data) || !out->close())
+        throw InputError(path + ": writing failed: " + out->geterror());
+}
+
+}  // namespace
+
+void writeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
+    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+    writePixels(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+}
+
+void writeAov(const std::string& path, const Scene& scene, const HitImage& image) {
+    struct Pixel {
+        float z, nx, ny, nz;
+        std::uint32_t primId;
+        float hit, u, v;
+    };
+    std::vector<Pixel> pixels(image.hits->size());
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        const Hit& h = (*image.hits)[i];
+        Pixel& p = pixels[i];
+        if (h.prim == kMissPrim) {
+            p = Pixel{std::numeric_limits<float>::infinity(), 0, 0, 0, kMissPrim, 0, 0, 0};
+        } else {
+            const glm::vec3 n = geometricNormal(scene.triangles[h.prim]);
+            p = Pixel{h.t, n.x, n.y, n.z, h.prim, 1.0f, h.u, h.v};
+        }
+    }
+    OIIO::ImageSpec spec(image.width, image.height, 8, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"Z", "N.X", "N.Y", "N.Z", "primId", "hit", "u", "v"};
+    spec.channelformats.assign(8, OIIO::TypeDesc::FLOAT);
+    spec.channelformats[4] = OIIO::TypeDesc::UINT32;
+    spec.z_channel = 0;
+    spec.attribute("compression", "zip");
+    writePixels(path, spec, OIIO::TypeDesc::UNKNOWN, pixels.data());
+}
+
+Aov readAov(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw InputError(path + ": cannot read image: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    Aov aov;
+    aov.width = spec.width;
+    aov.height = spec.height;
+    const std::size_t n = std::size_t(spec.width) * std::size_t(spec.height);
+    auto channel = [&](const char* name) {
+        const int c = spec.channelindex(name);
+        if (c < 0) throw InputError(path + ": no '" + name + "' channel; is it an AOV file written by dacrt?");
+        return c;
+    };
+    aov.depth.resize(n);
+    aov.primId.resize(n);
+    aov.hit.resize(n);
+    const int z = channel("Z"), prim = channel("primId"), hit = channel("hit");
+    if (spec.channelformat(prim) != OIIO::TypeDesc::UINT32)
+        throw InputError(path + ": the primId channel is not unsigned 32-bit");
+    if (!in->read_image(0, 0, z, z + 1, OIIO::TypeDesc::FLOAT, aov.depth.data()) ||
+        !in->read_image(0, 0, prim, prim + 1, OIIO::TypeDesc::UINT32, aov.primId.data()) ||
+        !in->read_image(0, 0, hit, hit + 1, OIIO::TypeDesc::FLOAT, aov.hit.data()))
+        throw InputError(path + ": reading failed: " + in->geterror());
+    return aov;
+}
+
+}  // namespace dacrt

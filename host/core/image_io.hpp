@@ -1,0 +1,32 @@
+#pragma once
+// The write stage (shaded PNG, AOV EXR) and AOVs read back, through OpenImageIO.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/hit_image.hpp"
+#include "core/scene.hpp"
+
+namespace dacrt {
+
+// An 8-bit RGB image, row-major; any format OpenImageIO writes from the extension.
+void writeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb);
+
+// Multi-channel EXR: Z (ray parameter t, +inf on a miss; directions are unit length),
+// N.X N.Y N.Z (unit geometric normal), primId (exact uint32, 0xFFFFFFFF on a miss),
+// hit (1 or 0), u v (barycentric weights of the second and third vertex).
+void writeAov(const std::string& path, const Scene& scene, const HitImage& image);
+
+struct Aov {
+    int width = 0;
+    int height = 0;
+    std::vector<float> depth;
+    std::vector<std::uint32_t> primId;
+    std::vector<float> hit;
+};
+
+// Reads an AOV written by writeAov; throws InputError on a missing file, a non-image, or
+// missing channels.
+Aov readAov(const std::string& path);
+
+}  // namespace dacrt

@@ -1,0 +1,63 @@
+#include "core/scene.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace dacrt {
+
+Bounds triangleBounds(const Triangle& t) {
+    Bounds b{};
+    b.lo = glm::min(t.v0, glm::min(t.v1, t.v2));
+    b.hi = glm::max(t.v0, glm::max(t.v1, t.v2));
+    return b;
+}
+
+glm::vec3 geometricNormal(const Triangle& t) {
+    const glm::dvec3 n = glm::cross(glm::dvec3(t.v1) - glm::dvec3(t.v0), glm::dvec3(t.v2) - glm::dvec3(t.v0));
+    const double len = glm::length(n);
+    return len > 0.0 ? glm::vec3(n / len) : glm::vec3(0.0f);
+}
+
+Box sceneBounds(const std::vector<Triangle>& triangles) {
+    Box box;
+    for (const Triangle& t : triangles) {
+        box.extend(t.v0);
+        box.extend(t.v1);
+        box.extend(t.v2);
+    }
+    return box;
+}
+
+std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles) {
+    std::vector<Bounds> bounds(triangles.size());
+    for (std::size_t i = 0; i < triangles.size(); ++i) bounds[i] = triangleBounds(triangles[i]);
+    return bounds;
+}
+
+void validateScene(const Scene& scene) {
+    if (scene.triangles.empty()) throw InputError(scene.name + ": the scene has no triangles");
+    if (scene.triangles.size() >= kMissPrim)
+        throw InputError(scene.name + ": too many triangles for 32-bit primitive ids");
+    for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
+        const Triangle& t = scene.triangles[i];
+        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) {
+            const bool finite = std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+            if (finite && glm::all(glm::lessThanEqual(glm::abs(v), glm::vec3(kMaxCoordinate)))) continue;
+            std::ostringstream msg;
+            msg << scene.name << ": " << (finite ? "out-of-range" : "non-finite") << " vertex position ("
+                << v.x << ", " << v.y << ", " << v.z << ") in triangle " << i;
+            if (i < scene.sources.size()) {
+                const TriangleSource& s = scene.sources[i];
+                msg << " (node " << s.node << ", mesh " << s.mesh << ", primitive " << s.primitive
+                    << ", triangle " << s.triangle << ")";
+            }
+            if (finite) msg << "; coordinates must lie within +-" << kMaxCoordinate
+                            << " so that every intersection intermediate stays finite";
+            throw InputError(msg.str());
+        }
+    }
+}
+
+}  // namespace dacrt

@@ -1,0 +1,168 @@
+#include "dacrt/cpu_tracers.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include "dacrt/traversal.hpp"
+#include "core/errors.hpp"
+#include "dacrt/scene_division.hpp"
+#include "core/timing.hpp"
+
+namespace dacrt {
+namespace {
+
+void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
+    plan.add("rays", std::uint64_t(g.rays->size()) * sizeof(Ray));
+    plan.add("hits", std::uint64_t(g.rays->size()) * sizeof(Hit));
+    plan.add("triangles", std::uint64_t(g.triangles->size()) * sizeof(Triangle));
+    plan.add("triangle bounds", std::uint64_t(g.triangles->size()) * sizeof(Bounds));
+}
+
+Box regionBox(const Region& r) {
+    Box b;
+    b.lo = r.lo;
+    b.hi = r.hi;
+    return b;
+}
+
+}  // namespace
+
+TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook& onPlan) {
+    TraceResult result;
+    planFrameInputs(g, result.memory);
+    if (onPlan && !onPlan(result.memory)) return result;
+    const std::vector<Ray>& rays = *g.rays;
+    const std::vector<Triangle>& tris = *g.triangles;
+    result.hits.assign(rays.size(), missHit());
+    const std::size_t blocks = (rays.size() + 63) / 64;
+    pool.parallelFor(blocks, [&](std::size_t block, unsigned) {
+        const std::size_t end = std::min(rays.size(), (block + 1) * 64);
+        for (std::size_t i = block * 64; i < end; ++i) {
+            Hit best = missHit();
+            for (std::size_t p = 0; p < tris.size(); ++p) testTriangle(rays[i], tris[p], std::uint32_t(p), best);
+            result.hits[i] = best;
+        }
+    });
+    result.counters.rayTriangleTests = std::uint64_t(rays.size()) * tris.size();
+    result.threads = pool.size();
+    return result;
+}
+
+TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options, const PlanHook& onPlan) {
+    TraceResult result;
+    const std::uint32_t rayCount = std::uint32_t(g.rays->size());
+    const std::uint32_t triCount = std::uint32_t(g.triangles->size());
+    planFrameInputs(g, result.memory);
+    result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
+    result.memory.add("triangle ids", std::uint64_t(triCount) * 4);
+    if (onPlan && !onPlan(result.memory)) return result;
+
+    result.hits.assign(rayCount, missHit());
+    std::vector<std::uint32_t> rayIds(rayCount), triIds(triCount);
+    std::iota(rayIds.begin(), rayIds.end(), 0u);
+    std::iota(triIds.begin(), triIds.end(), 0u);
+    DacrtTraversal traversal(g, options, result.hits.data(), rayIds.data(), triIds.data(), result.counters);
+    std::uint32_t terminated = 0;
+    const std::uint32_t crossing = traversal.trace(g.sceneBox, terminated, rayCount, 0, triCount);
+    result.counters.raysCulled = rayCount - crossing;
+    result.counters.terminatedStep1 = terminated;
+    return result;
+}
+
+TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool,
+                          const PlanHook& onPlan) {
+    TraceResult result;
+    result.threads = pool.size();
+    const unsigned regions = options.regions ? options.regions : pool.size();
+    result.regions = regions;
+    planFrameInputs(g, result.memory);
+
+    auto start = Clock::now();
+    const int axis = options.axis == DivisionAxis::Best ? chooseDivisionAxis(g, regions) : int(options.axis) - 1;
+    result.axis = axis;
+    Division division = divideScene(g, regions, axis, pool, result.memory, onPlan);
+    if (!division.complete) return result;
+    result.hits.assign(g.rays->size(), missHit());
+    const std::vector<TransferRound> schedule = transferSchedule(division);
+    result.phaseMs.emplace_back("divide", msSince(start));
+    result.counters.raysCulled = division.culledRays;
+
+    std::vector<Counters> perWorker(pool.size());
+    std::vector<Region>& table = division.regions;
+    // Step 1 finishes rays that never leave their slab; a transfer finishes the rays that
+    // move toward the triangles' region but cannot reach it (nor, then, any region beyond).
+    auto traceItem = [&](std::uint32_t rayRegion, std::uint32_t triRegion, unsigned worker) {
+        Region& rays = table[rayRegion];
+        const Region& tris = table[triRegion];
+        DacrtTraversal traversal(g, options.dacrt, result.hits.data(), division.rayIds.data(),
+                                 division.triIds.data(), perWorker[worker]);
+        const RetireRule retire{axis, triRegion == rayRegion ? 0 : (triRegion > rayRegion ? 1 : -1)};
+        traversal.trace(regionBox(tris), rays.terminated, rays.rayEnd, tris.triBegin, tris.triEnd, retire);
+    };
+    auto terminatedTotal = [&] {
+        std::uint64_t t = 0;
+        for (const Region& r : table) t += r.terminated - r.rayBegin;
+        return t;
+    };
+
+    // Step 1: biggest regions first, so the dynamic hand-out ends evenly.
+    start = Clock::now();
+    std::vector<std::uint32_t> order(regions);
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return std::uint64_t(table[a].rayEnd - table[a].rayBegin) * (table[a].triEnd - table[a].triBegin) >
+               std::uint64_t(table[b].rayEnd - table[b].rayBegin) * (table[b].triEnd - table[b].triBegin);
+    });
+    result.step1RegionMs.assign(regions, 0.0);
+    pool.parallelFor(regions, [&](std::size_t i, unsigned worker) {
+        const auto itemStart = Clock::now();
+        traceItem(order[i], order[i], worker);
+        result.step1RegionMs[order[i]] = msSince(itemStart);
+    });
+    result.counters.terminatedStep1 = terminatedTotal();
+    result.phaseMs.emplace_back("step1", msSince(start));
+
+    // Transfer rounds, one after another; the pairs of a round in parallel.
+    start = Clock::now();
+    std::uint64_t before = result.counters.terminatedStep1;
+    for (const TransferRound& round : schedule) {
+        std::vector<TransferPair> live;
+        for (const TransferPair& p : round.pairs)
+            if (table[p.rayRegion].terminated < table[p.rayRegion].rayEnd) live.push_back(p);
+        result.counters.transferWorkItems += live.size();
+        result.counters.transferWorkItemsSkipped += round.pairs.size() - live.size();
+        pool.parallelFor(live.size(), [&](std::size_t i, unsigned worker) {
+            traceItem(live[i].rayRegion, live[i].triRegion, worker);
+        });
+        const std::uint64_t now = terminatedTotal();
+        result.counters.roundNames.push_back(round.name);
+        result.counters.terminatedPerRound.push_back(now - before);
+        before = now;
+    }
+    result.phaseMs.emplace_back("transfer", msSince(start));
+    for (const Counters& c : perWorker) result.counters.add(c);
+    return result;
+}
+
+void checkCpuOptions(const TraceOptions& options) {
+    if (options.backend == Backend::Brute && !options.dacrt.exactDefaults())
+        throw InputError("brute force always runs the watertight float32 test; the intersector, triangle filter and "
+                         "precision options are DACRT's (cpu, cpu-seq)");
+    if (options.dacrt.precision == Precision::F64 && options.dacrt.intersector != Intersector::Watertight)
+        throw InputError("precision f64 runs the watertight test in float64; it does not combine with the " +
+                         toString(options.dacrt.intersector) + " intersector");
+}
+
+TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool, const PlanHook& onPlan) {
+    checkCpuOptions(options);
+    switch (options.backend) {
+        case Backend::Brute: return traceBrute(g, pool, onPlan);
+        case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);
+        case Backend::Cpu: return traceParallel(g, options, pool, onPlan);
+        case Backend::Gpu:
+        case Backend::Embree: break;
+    }
+    throw InternalError("traceCpu called for the " + toString(options.backend) + " backend");
+}
+
+}  // namespace dacrt

@@ -1,0 +1,29 @@
+#pragma once
+// The CPU backends: brute force, sequential DACRT, and the parallel scheme.
+#include "core/thread_pool.hpp"
+#include "dacrt/frame_geometry.hpp"
+#include "dacrt/options.hpp"
+#include "dacrt/trace_result.hpp"
+
+namespace dacrt {
+
+// Every ray against every triangle (threads split the rays).
+TraceResult traceBrute(const FrameGeometry& geometry, ThreadPool& pool, const PlanHook& onPlan = {});
+
+// One DACRT over the whole scene on the calling thread.
+TraceResult traceSequential(const FrameGeometry& geometry, const DacrtOptions& options, const PlanHook& onPlan = {});
+
+// The parallel scheme: division into regions, Step 1 (one DACRT per region), then the
+// transfer rounds; work items of a step run on the pool.
+TraceResult traceParallel(const FrameGeometry& geometry, const TraceOptions& options, ThreadPool& pool,
+                          const PlanHook& onPlan = {});
+
+// Throws InputError when the options do not combine (f64 with Moller-Trumbore) or ask brute
+// force for DACRT options. traceCpu checks this.
+void checkCpuOptions(const TraceOptions& options);
+
+// The backend options.backend names: brute, cpu-seq or cpu.
+TraceResult traceCpu(const FrameGeometry& geometry, const TraceOptions& options, ThreadPool& pool,
+                     const PlanHook& onPlan = {});
+
+}  // namespace dacrt

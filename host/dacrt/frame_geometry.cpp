@@ -1,0 +1,27 @@
+#include "dacrt/frame_geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dacrt {
+
+float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin) {
+    float m = 0.0f;
+    for (int a = 0; a < 3; ++a)
+        m = std::max({m, std::abs(sceneBox.lo[a]), std::abs(sceneBox.hi[a]), std::abs(rayOrigin[a])});
+    return std::max(m * 0x1p-18f, 0x1p-100f);
+}
+
+FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
+                            const std::vector<Ray>& rays, const Box& sceneBox) {
+    FrameGeometry g;
+    g.triangles = &triangles;
+    g.triangleBounds = &bounds;
+    g.rays = &rays;
+    g.sceneBox = sceneBox;
+    g.rayOrigin = rays.front().origin;
+    g.margin = filterMargin(sceneBox, g.rayOrigin);
+    return g;
+}
+
+}  // namespace dacrt

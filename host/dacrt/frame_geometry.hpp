@@ -1,0 +1,31 @@
+#pragma once
+// Everything a tracer reads, prepared once per frame and shared by every backend.
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/scene.hpp"
+
+namespace dacrt {
+
+struct FrameGeometry {
+    const std::vector<Triangle>* triangles = nullptr;
+    const std::vector<Bounds>* triangleBounds = nullptr;
+    const std::vector<Ray>* rays = nullptr;
+    Box sceneBox;          // exact bounds of the triangles
+    glm::vec3 rayOrigin{};  // every ray starts here (primary rays)
+    float margin = 0.0f;    // filter widening, see filterMargin()
+};
+
+// Widening applied to every box before a ray or triangle filter, so that rounding in the
+// intersection test can never move a hit out of the cells that test it. See
+// docs/correctness.md for the derivation: 64 units in the last place of the largest
+// coordinate magnitude among the scene bounds and the ray origin.
+float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin);
+
+// The frame every tracer reads: the arrays (which must outlive it), the scene box, the rays'
+// common origin (the first ray's) and the filter margin derived from both.
+FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
+                            const std::vector<Ray>& rays, const Box& sceneBox);
+
+}  // namespace dacrt

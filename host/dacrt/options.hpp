@@ -1,0 +1,97 @@
+#pragma once
+// What a caller chooses: the backend and the DACRT options, with one name table each.
+#include <cstdint>
+
+#include "core/enum_names.hpp"
+
+namespace dacrt {
+
+enum class Backend { Brute, CpuSeq, Cpu, Gpu, Embree };
+enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
+enum class DivisionAxis { Best, X, Y, Z };
+// Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks
+// through shared edges; Moller-Trumbore is the classic faster test without that guarantee.
+enum class Intersector { Watertight, MollerTrumbore };
+// Which triangles a DACRT node keeps for a child cell. Bounds (the default) and Sat are
+// conservative; Mora is deliberately inexact (docs/benchmarks.md measures its price).
+enum class TriangleFilter { Bounds, Sat, Mora };
+// Arithmetic of the leaf's ray/triangle test: the filters stay float32 in both cases (their
+// margin also covers the smaller float64 rounding).
+enum class Precision { F32, F64 };
+
+template <>
+struct EnumNames<Backend> {
+    static constexpr std::array<std::pair<Backend, std::string_view>, 5> table{{{Backend::Brute, "brute"},
+                                                                                 {Backend::CpuSeq, "cpu-seq"},
+                                                                                 {Backend::Cpu, "cpu"},
+                                                                                 {Backend::Gpu, "gpu"},
+                                                                                 {Backend::Embree, "embree"}}};
+};
+template <>
+struct EnumNames<SplitMethod> {
+    static constexpr std::array<std::pair<SplitMethod, std::string_view>, 3> table{
+        {{SplitMethod::SpatialMedian, "spatial-median"},
+         {SplitMethod::CentroidMean, "centroid-mean"},
+         {SplitMethod::SampledMean, "sampled-mean"}}};
+};
+template <>
+struct EnumNames<DivisionAxis> {
+    static constexpr std::array<std::pair<DivisionAxis, std::string_view>, 4> table{
+        {{DivisionAxis::Best, "best"}, {DivisionAxis::X, "x"}, {DivisionAxis::Y, "y"}, {DivisionAxis::Z, "z"}}};
+};
+template <>
+struct EnumNames<Intersector> {
+    static constexpr std::array<std::pair<Intersector, std::string_view>, 2> table{
+        {{Intersector::Watertight, "watertight"}, {Intersector::MollerTrumbore, "moller-trumbore"}}};
+};
+template <>
+struct EnumNames<TriangleFilter> {
+    static constexpr std::array<std::pair<TriangleFilter, std::string_view>, 3> table{
+        {{TriangleFilter::Bounds, "bounds"}, {TriangleFilter::Sat, "sat"}, {TriangleFilter::Mora, "mora"}}};
+};
+template <>
+struct EnumNames<Precision> {
+    static constexpr std::array<std::pair<Precision, std::string_view>, 2> table{
+        {{Precision::F32, "f32"}, {Precision::F64, "f64"}}};
+};
+
+// Leaf limits of each backend when DacrtOptions leaves them 0, chosen by measurement
+// (docs/benchmarks.md): a leaf costs the CPU one test per pair, while on lavapipe a
+// partition costs several times a leaf's test per element (docs/gpu.md), so the gpu stops
+// splitting earlier.
+constexpr std::uint32_t kCpuLeafLimit = 8;
+constexpr std::uint32_t kGpuLeafLimit = 64;
+
+struct DacrtOptions {
+    std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default
+    std::uint32_t triLimit = 0;    // a node with fewer triangles is a leaf; 0: the backend's default
+    std::uint32_t maxDepth = 48;   // guards against coincident triangles that never separate
+    SplitMethod split = SplitMethod::SpatialMedian;
+    Intersector intersector = Intersector::Watertight;
+    TriangleFilter triangleFilter = TriangleFilter::Bounds;
+    Precision precision = Precision::F32;
+
+    // These options with the leaf limits of `backend` filled in where they are 0.
+    DacrtOptions resolvedFor(Backend backend) const {
+        DacrtOptions o = *this;
+        const std::uint32_t limit = backend == Backend::Gpu ? kGpuLeafLimit : kCpuLeafLimit;
+        if (o.rayLimit == 0) o.rayLimit = limit;
+        if (o.triLimit == 0) o.triLimit = limit;
+        return o;
+    }
+
+    bool exactDefaults() const {
+        return intersector == Intersector::Watertight && triangleFilter == TriangleFilter::Bounds &&
+               precision == Precision::F32;
+    }
+};
+
+struct TraceOptions {
+    Backend backend = Backend::Cpu;
+    unsigned regions = 0;   // cpu: sub-scenes; 0 means one per thread (docs/cpu-reference.md)
+    unsigned threads = 0;   // 0 means every core
+    DivisionAxis axis = DivisionAxis::Best;
+    DacrtOptions dacrt;
+};
+
+}  // namespace dacrt

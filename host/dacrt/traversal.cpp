@@ -1,0 +1,183 @@
+#include "dacrt/traversal.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "dacrt/option_predicates.hpp"
+
+namespace dacrt {
+namespace {
+
+Box widen(const Box& b, float margin) {
+    Box w;
+    w.lo = b.lo - glm::vec3(margin);
+    w.hi = b.hi + glm::vec3(margin);
+    return w;
+}
+
+int longestAxis(const Box& b) {
+    const glm::vec3 e = b.extent();
+    return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+}
+
+}  // namespace
+
+DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& options, Hit* hits,
+                               std::uint32_t* rayIds, std::uint32_t* triIds, Counters& counters)
+    : rays_(g.rays->data()),
+      triangles_(g.triangles->data()),
+      triangleBounds_(g.triangleBounds->data()),
+      origin_(g.rayOrigin),
+      margin_(g.margin),
+      options_(options.resolvedFor(Backend::Cpu)),
+      hits_(hits),
+      rayIds_(rayIds),
+      triIds_(triIds),
+      counters_(counters) {}
+
+std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
+                                    std::uint32_t triBegin, std::uint32_t triEnd, const RetireRule& retire) {
+    const std::uint32_t crossing = filterRays(widen(box, margin_), terminated, rayEnd);
+    node(box, terminated, crossing, triBegin, triEnd, 0, 0);
+    if (retire.axis < 0) return crossing;
+    const Box cell = widen(box, margin_);
+    for (std::uint32_t k = terminated; k < rayEnd; ++k) {
+        const std::uint32_t id = rayIds_[k];
+        const float d = rays_[id].dir[retire.axis];
+        const bool done = retire.direction == 0
+                              ? d == 0.0f
+                              : (retire.direction > 0 ? d > 0.0f : d < 0.0f) &&
+                                    !shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
+        if (done) {
+            std::swap(rayIds_[k], rayIds_[terminated]);
+            ++terminated;
+            ++counters_.raysRetired;
+        }
+    }
+    return crossing;
+}
+
+[[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
+    counters_.rayBoxTests += end - begin;
+    std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
+        return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
+    });
+    return std::uint32_t(first - rayIds_);
+}
+
+std::uint32_t DacrtTraversal::filterTriangles(const Box& child, const Box& cell, std::uint32_t begin,
+                                              std::uint32_t end) {
+    std::uint32_t* first = triIds_ + begin;
+    switch (options_.triangleFilter) {
+        case TriangleFilter::Bounds:
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                const Bounds& b = triangleBounds_[id];
+                return shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
+            });
+            break;
+        case TriangleFilter::Sat:
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                return triangleOverlapsBoxSat(triangles_[id], triangleBounds_[id], cell.lo, cell.hi);
+            });
+            break;
+        case TriangleFilter::Mora:
+            // The unwidened child: Mora's test has no rounding margin (that is its price).
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                return triangleOverlapsBoxMora(triangles_[id], triangleBounds_[id], child.lo, child.hi, end - begin);
+            });
+            break;
+    }
+    return std::uint32_t(first - triIds_);
+}
+
+float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const {
+    const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
+    if (options_.split == SplitMethod::SpatialMedian) return mid;
+    // Mora's sampled mean: every 50th triangle centre once the set is large, all of them below.
+    const std::uint32_t count = triEnd - triBegin;
+    const std::uint32_t stride = options_.split == SplitMethod::SampledMean && count > 500 ? 50 : 1;
+    double sum = 0.0;
+    std::uint32_t samples = 0;
+    for (std::uint32_t i = triBegin; i < triEnd; i += stride, ++samples) {
+        const Bounds& b = triangleBounds_[triIds_[i]];
+        sum += 0.5 * (double(b.lo[axis]) + double(b.hi[axis]));
+    }
+    const float s = float(sum / double(std::max(samples, 1u)));
+    return s > box.lo[axis] && s < box.hi[axis] ? s : mid;
+}
+
+void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
+    if (terminated >= rayEnd || triBegin >= triEnd) return;
+    const std::uint32_t rayCount = rayEnd - terminated, triCount = triEnd - triBegin;
+    const int axis = longestAxis(box);
+    const float split = splitPosition(box, axis, triBegin, triEnd);
+    if (rayCount < options_.rayLimit || triCount < options_.triLimit || depth >= options_.maxDepth ||
+        stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis])) {
+        leaf(box, terminated, rayEnd, triBegin, triEnd);
+        return;
+    }
+    Box low = box, high = box;
+    low.hi[axis] = split;
+    high.lo[axis] = split;
+    // Front to back: every ray shares the origin, so the child on its side is crossed first.
+    const bool lowFirst = origin_[axis] <= split;
+    for (const Box* child : {lowFirst ? &low : &high, lowFirst ? &high : &low}) {
+        const Box cell = widen(*child, margin_);
+        const std::uint32_t childRays = filterRays(cell, terminated, rayEnd);
+        if (childRays == terminated) continue;
+        const std::uint32_t childTris = filterTriangles(*child, cell, triBegin, triEnd);
+        const bool stalled = childRays == rayEnd && childTris == triEnd;
+        node(*child, terminated, childRays, triBegin, childTris, depth + 1, stalled ? stalls + 1 : 0);
+    }
+}
+
+void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd) {
+    ++counters_.leaves;
+    counters_.rayTriangleTests += std::uint64_t(rayEnd - terminated) * (triEnd - triBegin);
+    auto same = [](const Ray& ray) -> const Ray& { return ray; };
+    if (options_.precision == Precision::F64)
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, toF64, testTriangleF64);
+    else if (options_.intersector == Intersector::MollerTrumbore)
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, same, testTriangleMollerTrumbore);
+    else
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, same, testTriangle);
+}
+
+template <typename PrepareRay, typename TestTriangle>
+[[gnu::flatten]] void DacrtTraversal::leafWith(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
+                                               std::uint32_t triBegin, std::uint32_t triEnd, PrepareRay prepare,
+                                               TestTriangle test) {
+    for (std::uint32_t k = terminated; k < rayEnd; ++k) {
+        const std::uint32_t rayId = rayIds_[k];
+        const Ray& ray = rays_[rayId];
+        const auto& prepared = prepare(ray);
+        Hit best = hits_[rayId];
+        for (std::uint32_t j = triBegin; j < triEnd; ++j) {
+            const std::uint32_t prim = triIds_[j];
+            test(prepared, triangles_[prim], prim, best);
+        }
+        hits_[rayId] = best;
+        if (best.prim != kMissPrim && shared::hitEndsInBox(ray, box.lo, box.hi, best.t)) {
+            std::swap(rayIds_[k], rayIds_[terminated]);
+            ++terminated;
+        }
+    }
+}
+
+void testTriangleMollerTrumbore(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
+    const shared::TriangleHit h = intersectMollerTrumbore(ray, tri.v0, tri.v1, tri.v2);
+    if (h.hit && h.t > ray.tmin && shared::hitPrecedes(h.t, prim, best.t, best.prim)) best = Hit{h.t, prim, h.u, h.v};
+}
+
+void testTriangleF64(const RayF64& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
+    // The float64 hit is rounded to float32 for the tie rule and the result: hits closer than
+    // half a float32 ulp in depth become ties (lowest id), which the benchmark counts as near ties.
+    const TriangleHitF64 h = intersectWatertightF64(ray, tri.v0, tri.v1, tri.v2);
+    if (!h.hit || !(h.t > ray.tmin)) return;
+    const float t = float(h.t);
+    if (shared::hitPrecedes(t, prim, best.t, best.prim)) best = Hit{t, prim, float(h.u), float(h.v)};
+}
+
+}  // namespace dacrt

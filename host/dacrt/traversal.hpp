@@ -1,0 +1,72 @@
+#pragma once
+// Sequential divide-and-conquer ray tracing (Mora 2011) over in-place id arrays: the
+// building block of both the cpu-seq backend and every work item of the parallel scheme.
+#include <cstdint>
+
+#include "dacrt/predicates.hpp"
+#include "dacrt/frame_geometry.hpp"
+#include "dacrt/options.hpp"
+#include "dacrt/trace_result.hpp"
+
+namespace dacrt {
+
+// Which live rays a work item of the parallel scheme may finish, because no later work item
+// can change their result: along `axis`, rays that do not move (direction 0, after Step 1),
+// or rays moving `direction` that cannot reach the region traced now before their best hit
+// (regions are consecutive slabs, so they cannot reach any further one either). The gpu
+// kernel applies the same rule (kKeepStill, kKeepStuckHigh, kKeepStuckLow).
+struct RetireRule {
+    int axis = -1;      // -1: retire nothing
+    int direction = 0;  // 0: rays with dir[axis] == 0; +1 / -1: non-crossing rays moving that way
+};
+
+class DacrtTraversal {
+public:
+    DacrtTraversal(const FrameGeometry& geometry, const DacrtOptions& options, Hit* hits, std::uint32_t* rayIds,
+                   std::uint32_t* triIds, Counters& counters);
+
+    // Traces the live rays rayIds[terminated, rayEnd) against triIds[triBegin, triEnd)
+    // inside box. Rays whose final hit is found are swapped to position `terminated`, which
+    // advances past them; the others keep their best hit so far (it bounds later work).
+    // Returns the end of the rays that cross the box (the others are moved behind them).
+    // Rays that `retire` selects are finished too (moved before `terminated`).
+    std::uint32_t trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                        std::uint32_t triEnd, const RetireRule& retire = {});
+
+private:
+    void node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+              std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
+    void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+              std::uint32_t triEnd);
+    std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);
+    template <typename PrepareRay, typename TestTriangle>
+    void leafWith(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                  std::uint32_t triEnd, PrepareRay prepare, TestTriangle test);
+    // cell is child widened by the filter margin; the Mora filter reads child itself.
+    std::uint32_t filterTriangles(const Box& child, const Box& cell, std::uint32_t begin, std::uint32_t end);
+    float splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const;
+
+    const Ray* rays_;
+    const Triangle* triangles_;
+    const Bounds* triangleBounds_;
+    glm::vec3 origin_;
+    float margin_;
+    DacrtOptions options_;
+    Hit* hits_;
+    std::uint32_t* rayIds_;
+    std::uint32_t* triIds_;
+    Counters& counters_;
+};
+
+// Tests one ray against one triangle and keeps the better hit under the tie rule.
+inline void testTriangle(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
+    const shared::TriangleHit h = shared::intersectWatertight(ray, tri.v0, tri.v1, tri.v2);
+    if (h.hit && h.t > ray.tmin && shared::hitPrecedes(h.t, prim, best.t, best.prim)) best = Hit{h.t, prim, h.u, h.v};
+}
+
+// The leaf tests of the non-default options (docs/benchmarks.md prices them).
+void testTriangleMollerTrumbore(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best);
+struct RayF64;
+void testTriangleF64(const RayF64& ray, const Triangle& tri, std::uint32_t prim, Hit& best);
+
+}  // namespace dacrt

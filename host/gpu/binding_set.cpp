@@ -1,0 +1,48 @@
+#include "gpu/binding_set.hpp"
+
+#include <string>
+
+#include "core/errors.hpp"
+
+namespace dacrt::gpu {
+
+DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& c) {
+    DacrtBufferPlan p{};
+    p[DACRT_BINDING_RAYS] = {"rays", c.rays * sizeof(Ray)};
+    p[DACRT_BINDING_TRIANGLES] = {"triangles", c.triangles * sizeof(Triangle)};
+    p[DACRT_BINDING_TRIANGLE_BOUNDS] = {"triangle bounds", c.triangles * sizeof(Bounds)};
+    p[DACRT_BINDING_HITS] = {"hits", c.rays * sizeof(Hit)};
+    p[DACRT_BINDING_RAY_IDS] = {"ray ids and scratch", c.rayIds * 8};
+    p[DACRT_BINDING_TRI_IDS] = {"triangle ids and scratch", c.triangleIds * 8};
+    p[DACRT_BINDING_REGIONS] = {"regions", c.regions * sizeof(Region)};
+    p[DACRT_BINDING_WORK_ITEMS] = {"work items", c.workItems * sizeof(WorkItem)};
+    p[DACRT_BINDING_COUNTERS] = {"counters", sizeof(GpuCounters)};
+    p[DACRT_BINDING_STATES] = {"traversal states", c.workItems * sizeof(TraversalState)};
+    p[DACRT_BINDING_STACKS] = {"traversal stacks", c.workItems * (std::uint64_t(c.maxDepth) + 1) * sizeof(StackEntry)};
+    return p;
+}
+
+void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, MemoryPlan& plan) {
+    for (const PlannedBuffer& b : buffers) {
+        plan.add(std::string("device: ") + b.name, b.bytes);
+        if (b.bytes > device.maxStorageBufferRange)
+            throw InputError(std::string("the device buffer of ") + b.name + " needs " + std::to_string(b.bytes) +
+                             " bytes, more than the device's maxStorageBufferRange of " +
+                             std::to_string(device.maxStorageBufferRange) + " bytes (over by " +
+                             std::to_string(b.bytes - device.maxStorageBufferRange) +
+                             "); render fewer pixels or split the scene");
+    }
+}
+
+DacrtBindingSet::DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan) {
+    buffers_.reserve(plan.size());
+    for (const PlannedBuffer& b : plan) buffers_.emplace_back(context, b.bytes, b.name);
+}
+
+void DacrtBindingSet::bindTo(ComputePipeline& pipeline) const {
+    std::vector<const Buffer*> bound;
+    for (const Buffer& b : buffers_) bound.push_back(&b);
+    pipeline.bind(bound);
+}
+
+}  // namespace dacrt::gpu

@@ -1,0 +1,54 @@
+#pragma once
+// The DACRT kernels' one binding set (DACRT_BINDING_* in shaders/layout.h): every storage
+// buffer sized from the frame's counts, planned before anything is allocated, then created
+// and bound. The tracer, the building-block tests and the block benchmark all use it.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/shader_layout.hpp"
+#include "dacrt/memory_plan.hpp"
+#include "gpu/buffer.hpp"
+#include "gpu/compute_pipeline.hpp"
+
+namespace dacrt::gpu {
+
+// Element counts behind every binding.
+struct DacrtBufferCounts {
+    std::uint64_t rays = 0;
+    std::uint64_t triangles = 0;
+    std::uint64_t rayIds = 0;        // the ray id array (its scratch half is as long again)
+    std::uint64_t triangleIds = 0;   // the triangle id array, every ray group's copy (likewise)
+    std::uint64_t regions = 0;       // region slots
+    std::uint64_t workItems = 0;
+    std::uint32_t maxDepth = 0;      // traversal stack depth per work item
+};
+
+struct PlannedBuffer {
+    const char* name;    // for the memory plan and error messages
+    std::uint64_t bytes;
+};
+
+// Index k is binding k.
+using DacrtBufferPlan = std::array<PlannedBuffer, DACRT_BINDING_COUNT>;
+
+DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& counts);
+
+// Appends "device: NAME" entries to plan, and throws InputError naming the first buffer that
+// exceeds the device's maxStorageBufferRange, with the limit and the excess.
+void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, MemoryPlan& plan);
+
+class DacrtBindingSet {
+public:
+    DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan);
+
+    Buffer& operator[](std::uint32_t binding) { return buffers_[binding]; }
+    const Buffer& operator[](std::uint32_t binding) const { return buffers_[binding]; }
+    // Points every binding of the pipeline's set at its buffer.
+    void bindTo(ComputePipeline& pipeline) const;
+
+private:
+    std::vector<Buffer> buffers_;  // index = binding
+};
+
+}  // namespace dacrt::gpu

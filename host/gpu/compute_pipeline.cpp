@@ -1,0 +1,107 @@
+#include "gpu/compute_pipeline.hpp"
+
+#include <stdexcept>
+
+#include "core/errors.hpp"
+#include "gpu/vulkan_error.hpp"
+
+namespace dacrt::gpu {
+
+ComputePipeline::ComputePipeline(const Context& context, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
+                                 std::uint32_t pushConstantBytes, const std::vector<std::uint32_t>& specialization,
+                                 std::string name)
+    : device_(context.device()), bindings_(bindingCount), pushBytes_(pushConstantBytes), name_(std::move(name)) {
+    try {
+        VkShaderModuleCreateInfo moduleInfo{};
+        moduleInfo.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+        moduleInfo.codeSize = spirv.size_bytes();
+        moduleInfo.pCode = spirv.data();
+        VK_CHECK(vkCreateShaderModule(device_, &moduleInfo, nullptr, &module_));
+
+        std::vector<VkDescriptorSetLayoutBinding> bindings(bindingCount);
+        for (std::uint32_t b = 0; b < bindingCount; ++b)
+            bindings[b] = VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+        VkDescriptorSetLayoutCreateInfo setInfo{};
+        setInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+        setInfo.bindingCount = bindingCount;
+        setInfo.pBindings = bindings.data();
+        VK_CHECK(vkCreateDescriptorSetLayout(device_, &setInfo, nullptr, &setLayout_));
+
+        VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes};
+        VkPipelineLayoutCreateInfo layoutInfo{};
+        layoutInfo.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+        layoutInfo.setLayoutCount = 1;
+        layoutInfo.pSetLayouts = &setLayout_;
+        layoutInfo.pushConstantRangeCount = pushConstantBytes ? 1 : 0;
+        layoutInfo.pPushConstantRanges = &push;
+        VK_CHECK(vkCreatePipelineLayout(device_, &layoutInfo, nullptr, &layout_));
+
+        std::vector<VkSpecializationMapEntry> entries(specialization.size());
+        for (std::uint32_t i = 0; i < entries.size(); ++i) entries[i] = VkSpecializationMapEntry{i, i * 4, 4};
+        VkSpecializationInfo spec{std::uint32_t(entries.size()), entries.data(), specialization.size() * 4, specialization.data()};
+        VkComputePipelineCreateInfo pipelineInfo{};
+        pipelineInfo.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+        pipelineInfo.stage = VkPipelineShaderStageCreateInfo{};
+        pipelineInfo.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+        pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+        pipelineInfo.stage.module = module_;
+        pipelineInfo.stage.pName = "main";
+        if (context.info().fullSubgroups) pipelineInfo.stage.flags = VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT_EXT;
+        pipelineInfo.stage.pSpecializationInfo = specialization.empty() ? nullptr : &spec;
+        pipelineInfo.layout = layout_;
+        VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_));
+
+        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindingCount};
+        VkDescriptorPoolCreateInfo poolInfo{};
+        poolInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+        poolInfo.maxSets = 1;
+        poolInfo.poolSizeCount = 1;
+        poolInfo.pPoolSizes = &size;
+        VK_CHECK(vkCreateDescriptorPool(device_, &poolInfo, nullptr, &pool_));
+        VkDescriptorSetAllocateInfo allocInfo{};
+        allocInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+        allocInfo.descriptorPool = pool_;
+        allocInfo.descriptorSetCount = 1;
+        allocInfo.pSetLayouts = &setLayout_;
+        VK_CHECK(vkAllocateDescriptorSets(device_, &allocInfo, &set_));
+    } catch (...) {
+        destroy();
+        throw;
+    }
+}
+
+ComputePipeline::~ComputePipeline() { destroy(); }
+
+void ComputePipeline::destroy() {
+    if (pool_) vkDestroyDescriptorPool(device_, pool_, nullptr);
+    if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
+    if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
+    if (setLayout_) vkDestroyDescriptorSetLayout(device_, setLayout_, nullptr);
+    if (module_) vkDestroyShaderModule(device_, module_, nullptr);
+    pool_ = VK_NULL_HANDLE;
+    pipeline_ = VK_NULL_HANDLE;
+    layout_ = VK_NULL_HANDLE;
+    setLayout_ = VK_NULL_HANDLE;
+    module_ = VK_NULL_HANDLE;
+}
+
+void ComputePipeline::bind(const std::vector<const Buffer*>& buffers) {
+    if (buffers.size() != bindings_)
+        throw std::logic_error("pipeline '" + name_ + "' has " + std::to_string(bindings_) + " bindings, got " +
+                               std::to_string(buffers.size()) + " buffers");
+    std::vector<VkDescriptorBufferInfo> infos(buffers.size());
+    std::vector<VkWriteDescriptorSet> writes(buffers.size());
+    for (std::uint32_t b = 0; b < buffers.size(); ++b) {
+        infos[b] = VkDescriptorBufferInfo{buffers[b]->handle(), 0, VK_WHOLE_SIZE};
+        writes[b] = VkWriteDescriptorSet{};
+        writes[b].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        writes[b].dstSet = set_;
+        writes[b].dstBinding = b;
+        writes[b].descriptorCount = 1;
+        writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[b].pBufferInfo = &infos[b];
+    }
+    vkUpdateDescriptorSets(device_, std::uint32_t(writes.size()), writes.data(), 0, nullptr);
+}
+
+}  // namespace dacrt::gpu

@@ -1,0 +1,309 @@
+#include "gpu/context.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <mutex>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "gpu/vulkan_error.hpp"
+
+namespace dacrt::gpu {
+
+namespace {
+
+std::string apiString(std::uint32_t v) {
+    return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+           std::to_string(VK_API_VERSION_PATCH(v));
+}
+
+int typeRank(VkPhysicalDeviceType t) {  // the default choice: discrete, integrated, then the rest
+    switch (t) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
+        default: return 4;
+    }
+}
+
+VkInstance createInstance(bool validate) {
+    VkApplicationInfo app{};
+    app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+    app.pApplicationName = "dacrt";
+    app.apiVersion = VK_API_VERSION_1_1;
+    VkInstanceCreateInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+    info.pApplicationInfo = &app;
+    const char* layer = "VK_LAYER_KHRONOS_validation";
+    const char* extension = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    if (validate) {
+        std::uint32_t count = 0;
+        VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
+        std::vector<VkLayerProperties> layers(count);
+        VK_CHECK(vkEnumerateInstanceLayerProperties(&count, layers.data()));
+        if (std::none_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, layer) == 0; }))
+            throw InputError("Vulkan validation was asked for, but the Khronos validation layer is not installed (Debian: vulkan-validationlayers)");
+        info.enabledLayerCount = 1;
+        info.ppEnabledLayerNames = &layer;
+        info.enabledExtensionCount = 1;
+        info.ppEnabledExtensionNames = &extension;
+    }
+    VkInstance instance = VK_NULL_HANDLE;
+    const VkResult r = vkCreateInstance(&info, nullptr, &instance);
+    if (r == VK_ERROR_INCOMPATIBLE_DRIVER || r == VK_ERROR_INITIALIZATION_FAILED)
+        throw InputError(std::string("no Vulkan driver is installed (") + resultName(r) +
+                         "); on Debian, mesa-vulkan-drivers provides lavapipe");
+    VK_CHECK(r);
+    return instance;
+}
+
+DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
+    VkPhysicalDeviceDriverProperties driver{};
+    driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
+    VkPhysicalDeviceSubgroupProperties subgroup{};
+    subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    VkPhysicalDeviceMaintenance3Properties maintenance3{};
+    maintenance3.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES;
+    subgroup.pNext = &maintenance3;
+    VkPhysicalDeviceProperties2 props{};
+    props.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    props.pNext = &subgroup;
+    VkPhysicalDeviceProperties basic;
+    vkGetPhysicalDeviceProperties(d, &basic);
+    const bool hasDriverProps = basic.apiVersion >= VK_API_VERSION_1_2;
+    if (hasDriverProps) maintenance3.pNext = &driver;
+    vkGetPhysicalDeviceProperties2(d, &props);
+    const VkPhysicalDeviceLimits& l = props.properties.limits;
+    DeviceInfo info;
+    info.index = index;
+    info.name = props.properties.deviceName;
+    info.type = props.properties.deviceType;
+    info.driver = hasDriverProps ? std::string(driver.driverName) + " " + driver.driverInfo
+                                 : "driver version " + std::to_string(props.properties.driverVersion);
+    info.apiVersion = apiString(props.properties.apiVersion);
+    VkPhysicalDeviceMemoryProperties memory;
+    vkGetPhysicalDeviceMemoryProperties(d, &memory);
+    for (std::uint32_t h = 0; h < memory.memoryHeapCount; ++h)
+        info.heaps.push_back(std::to_string(memory.memoryHeaps[h].size >> 20) + " MiB" +
+                             (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT ? " (device-local)" : ""));
+    info.maxStorageBufferRange = l.maxStorageBufferRange;
+    info.maxMemoryAllocationSize = maintenance3.maxMemoryAllocationSize;
+    info.maxComputeSharedMemorySize = l.maxComputeSharedMemorySize;
+    info.maxComputeWorkGroupInvocations = l.maxComputeWorkGroupInvocations;
+    info.maxComputeWorkGroupSizeX = l.maxComputeWorkGroupSize[0];
+    info.maxComputeWorkGroupCountX = l.maxComputeWorkGroupCount[0];
+    info.maxPerStageStorageBuffers = l.maxPerStageDescriptorStorageBuffers;
+    info.subgroupSize = subgroup.subgroupSize;
+    const VkSubgroupFeatureFlags needed =
+        VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT;
+    info.subgroupOperations = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                              (subgroup.supportedOperations & needed) == needed;
+    info.timestamps = l.timestampComputeAndGraphics && l.timestampPeriod > 0.0f;
+    std::uint32_t extensionCount = 0;
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, nullptr));
+    std::vector<VkExtensionProperties> extensions(extensionCount);
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, extensions.data()));
+    const bool sizeControl = std::any_of(extensions.begin(), extensions.end(), [](const VkExtensionProperties& e) {
+        return std::strcmp(e.extensionName, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME) == 0;
+    });
+    if (sizeControl) {
+        VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
+        control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
+        VkPhysicalDeviceFeatures2 features{};
+        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+        features.pNext = &control;
+        vkGetPhysicalDeviceFeatures2(d, &features);
+        info.fullSubgroups = control.computeFullSubgroups == VK_TRUE;
+    }
+    return info;
+}
+
+std::vector<VkPhysicalDevice> physicalDevices(VkInstance instance) {
+    std::uint32_t count = 0;
+    VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+    std::vector<VkPhysicalDevice> devices(count);
+    VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
+    return devices;
+}
+
+}  // namespace
+
+std::string DeviceInfo::typeName() const { return deviceTypeName(type); }
+
+std::string DeviceInfo::describe() const {
+    std::ostringstream s;
+    s << index << ": " << name << " (" << typeName() << ")\n"
+      << "   driver: " << driver << "\n"
+      << "   Vulkan: " << apiVersion << "\n"
+      << "   memory heaps:";
+    for (const std::string& h : heaps) s << " " << h << ";";
+    s << "\n   max storage buffer range: " << maxStorageBufferRange << " bytes\n"
+      << "   max allocation size: " << maxMemoryAllocationSize << " bytes\n"
+      << "   compute shared memory: " << maxComputeSharedMemorySize << " bytes\n"
+      << "   workgroup: " << maxComputeWorkGroupInvocations << " invocations, size x " << maxComputeWorkGroupSizeX
+      << ", count x " << maxComputeWorkGroupCountX << "\n"
+      << "   storage buffers per stage: " << maxPerStageStorageBuffers << "\n"
+      << "   subgroup size: " << subgroupSize << (subgroupOperations ? " (arithmetic and shuffles in compute)" : " (no compute arithmetic or shuffles)")
+      << "\n   full subgroups on request: " << (fullSubgroups ? "yes" : "no")
+      << "\n   timestamps: " << (timestamps ? "yes" : "no") << "\n";
+    return s.str();
+}
+
+std::vector<DeviceInfo> listDevices() {
+    VkInstance instance = createInstance(false);
+    std::vector<DeviceInfo> infos;
+    try {
+        const std::vector<VkPhysicalDevice> devices = physicalDevices(instance);
+        for (std::uint32_t i = 0; i < devices.size(); ++i) infos.push_back(describeDevice(devices[i], i));
+    } catch (...) {
+        vkDestroyInstance(instance, nullptr);
+        throw;
+    }
+    vkDestroyInstance(instance, nullptr);
+    return infos;
+}
+
+struct Context::Messages {
+    std::mutex mutex;
+    std::uint32_t errors = 0;
+    std::vector<std::string> text;
+};
+
+Context::Context(const ContextOptions& options) : messages_(std::make_unique<Messages>()) {
+    instance_ = createInstance(options.validate);
+    try {
+        if (options.validate) {
+            auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+                vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+            if (!create) throw InputError("Vulkan validation was asked for, but VK_EXT_debug_utils is unavailable");
+            VkDebugUtilsMessengerCreateInfoEXT info{};
+            info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+            info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+            info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                               VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+            info.pfnUserCallback = [](VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) -> VkBool32 {
+                auto* m = static_cast<Messages*>(user);
+                std::lock_guard<std::mutex> lock(m->mutex);
+                const bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+                if (error) ++m->errors;
+                m->text.push_back(std::string(error ? "error: " : "warning: ") + (data->pMessage ? data->pMessage : ""));
+                return VK_FALSE;
+            };
+            info.pUserData = messages_.get();
+            VK_CHECK(create(instance_, &info, nullptr, &messenger_));
+        }
+
+        const std::vector<VkPhysicalDevice> devices = physicalDevices(instance_);
+        if (devices.empty()) throw InputError("no Vulkan device found (on Debian, mesa-vulkan-drivers provides lavapipe)");
+        std::vector<DeviceInfo> infos;
+        for (std::uint32_t i = 0; i < devices.size(); ++i) infos.push_back(describeDevice(devices[i], i));
+        std::int64_t chosen = -1;
+        if (options.device.empty()) {
+            int bestRank = 99;
+            for (std::uint32_t i = 0; i < devices.size(); ++i) {
+                VkPhysicalDeviceProperties p;
+                vkGetPhysicalDeviceProperties(devices[i], &p);
+                if (typeRank(p.deviceType) < bestRank) bestRank = typeRank(p.deviceType), chosen = i;
+            }
+        } else {
+            const bool numeric = std::all_of(options.device.begin(), options.device.end(), ::isdigit);
+            for (std::uint32_t i = 0; i < devices.size() && chosen < 0; ++i) {
+                if (numeric ? std::to_string(i) == options.device
+                            : infos[i].name.find(options.device) != std::string::npos)
+                    chosen = i;
+            }
+            if (chosen < 0) {
+                std::string choices;
+                for (const DeviceInfo& d : infos) choices += "\n  " + std::to_string(d.index) + ": " + d.name + " (" + d.typeName() + ")";
+                throw InputError("the device '" + options.device + "' matches no Vulkan device; the choices are:" + choices);
+            }
+        }
+        physical_ = devices[std::size_t(chosen)];
+        info_ = infos[std::size_t(chosen)];
+
+        std::uint32_t familyCount = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, nullptr);
+        std::vector<VkQueueFamilyProperties> families(familyCount);
+        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, families.data());
+        bool found = false;
+        for (std::uint32_t f = 0; f < familyCount && !found; ++f)
+            if (families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) queueFamily_ = f, found = true;
+        if (!found) throw InputError("device '" + info_.name + "' has no compute queue");
+        if (families[queueFamily_].timestampValidBits == 0) info_.timestamps = false;
+
+        const float priority = 1.0f;
+        VkDeviceQueueCreateInfo queueInfo{};
+        queueInfo.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+        queueInfo.queueFamilyIndex = queueFamily_;
+        queueInfo.queueCount = 1;
+        queueInfo.pQueuePriorities = &priority;
+        VkDeviceCreateInfo deviceInfo{};
+        deviceInfo.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+        deviceInfo.queueCreateInfoCount = 1;
+        deviceInfo.pQueueCreateInfos = &queueInfo;
+        // The kernel's subgroups must be full (leaves shuffle triangles across all lanes):
+        // requested where the device can promise it; elsewhere the workgroup size stays a
+        // multiple of the subgroup size, which every driver known to us fills.
+        VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
+        control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
+        const char* sizeControl = VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME;
+        if (info_.fullSubgroups) {
+            control.computeFullSubgroups = VK_TRUE;
+            deviceInfo.pNext = &control;
+            deviceInfo.enabledExtensionCount = 1;
+            deviceInfo.ppEnabledExtensionNames = &sizeControl;
+        }
+        VK_CHECK(vkCreateDevice(physical_, &deviceInfo, nullptr, &device_));
+        vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+
+        VkCommandPoolCreateInfo poolInfo{};
+
+        poolInfo.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+        poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+        poolInfo.queueFamilyIndex = queueFamily_;
+        VK_CHECK(vkCreateCommandPool(device_, &poolInfo, nullptr, &commandPool_));
+
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(physical_, &p);
+        timestampPeriodNs_ = p.limits.timestampPeriod;
+    } catch (...) {
+        destroy();
+        throw;
+    }
+}
+
+Context::~Context() { destroy(); }
+
+void Context::destroy() {
+    if (commandPool_) vkDestroyCommandPool(device_, commandPool_, nullptr);
+    if (device_) vkDestroyDevice(device_, nullptr);
+    if (messenger_) {
+        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+        if (destroy) destroy(instance_, messenger_, nullptr);
+    }
+    if (instance_) vkDestroyInstance(instance_, nullptr);
+    commandPool_ = VK_NULL_HANDLE;
+    device_ = VK_NULL_HANDLE;
+    messenger_ = VK_NULL_HANDLE;
+    instance_ = VK_NULL_HANDLE;
+}
+
+std::uint32_t Context::memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags wanted) const {
+    VkPhysicalDeviceMemoryProperties memory;
+    vkGetPhysicalDeviceMemoryProperties(physical_, &memory);
+    for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i)
+        if ((typeBits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+    return UINT32_MAX;
+}
+
+std::uint32_t Context::validationErrors() const {
+    std::lock_guard<std::mutex> lock(messages_->mutex);
+    return messages_->errors;
+}
+
+const std::vector<std::string>& Context::validationMessages() const { return messages_->text; }
+
+}  // namespace dacrt::gpu

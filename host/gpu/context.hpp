@@ -1,0 +1,80 @@
+#pragma once
+// Instance, device choice and the logical device: the root of the small Vulkan layer.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+namespace dacrt::gpu {
+
+struct DeviceInfo {
+    std::uint32_t index = 0;
+    std::string name;
+    VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+    std::string driver;         // driver name and info
+    std::string apiVersion;
+    std::vector<std::string> heaps;  // "N MiB (device-local)"
+    std::uint64_t maxStorageBufferRange = 0;
+    std::uint64_t maxMemoryAllocationSize = 0;
+    std::uint32_t maxComputeSharedMemorySize = 0;
+    std::uint32_t maxComputeWorkGroupInvocations = 0;
+    std::uint32_t maxComputeWorkGroupSizeX = 0;
+    std::uint32_t maxComputeWorkGroupCountX = 0;
+    std::uint32_t maxPerStageStorageBuffers = 0;
+    std::uint32_t subgroupSize = 0;
+    bool subgroupOperations = false;  // compute-stage arithmetic and shuffle operations (the kernel's)
+    bool fullSubgroups = false;       // VK_EXT_subgroup_size_control's computeFullSubgroups
+    bool timestamps = false;
+    bool isCpu() const { return type == VK_PHYSICAL_DEVICE_TYPE_CPU; }  // lavapipe, SwiftShader
+    std::string typeName() const;  // as vulkan.hpp names it: DiscreteGpu, Cpu, ...
+    std::string describe() const;
+};
+
+struct ContextOptions {
+    std::string device;    // index or part of the name; empty: best available
+    bool validate = false; // enable VK_LAYER_KHRONOS_validation and count its errors
+};
+
+class Context {
+public:
+    explicit Context(const ContextOptions& options);
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    VkInstance instance() const { return instance_; }
+    VkPhysicalDevice physicalDevice() const { return physical_; }
+    VkDevice device() const { return device_; }
+    VkQueue queue() const { return queue_; }
+    std::uint32_t queueFamily() const { return queueFamily_; }
+    VkCommandPool commandPool() const { return commandPool_; }
+    const DeviceInfo& info() const { return info_; }
+    double timestampPeriodNs() const { return timestampPeriodNs_; }
+    std::uint32_t memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags wanted) const;
+
+    // Validation messages of error severity seen so far (0 unless validate was set).
+    std::uint32_t validationErrors() const;
+    const std::vector<std::string>& validationMessages() const;
+
+private:
+    void destroy();  // releases the Vulkan handles; safe on a partly built context
+    struct Messages;
+    VkInstance instance_ = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    std::uint32_t queueFamily_ = 0;
+    VkCommandPool commandPool_ = VK_NULL_HANDLE;
+    DeviceInfo info_;
+    double timestampPeriodNs_ = 1.0;
+    std::unique_ptr<Messages> messages_;
+};
+
+// Every device of every installed driver, in enumeration order. Throws InputError if there
+// is no Vulkan driver at all.
+std::vector<DeviceInfo> listDevices();
+
+}  // namespace dacrt::gpu

@@ -1,0 +1,14 @@
+#include "gpu/embedded_shaders.hpp"
+
+#include "dacrt.spv.h"
+#include "workgroup_test.spv.h"
+
+namespace dacrt::gpu {
+
+std::span<const std::uint32_t> dacrtKernelSpirv() { return {dacrt_spv, sizeof(dacrt_spv) / sizeof(dacrt_spv[0])}; }
+
+std::span<const std::uint32_t> workgroupTestSpirv() {
+    return {workgroup_test_spv, sizeof(workgroup_test_spv) / sizeof(workgroup_test_spv[0])};
+}
+
+}  // namespace dacrt::gpu

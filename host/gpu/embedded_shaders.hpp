@@ -1,0 +1,11 @@
+#pragma once
+// The SPIR-V of shaders/*.comp, compiled by glslang at build time and linked into the binary.
+#include <cstdint>
+#include <span>
+
+namespace dacrt::gpu {
+
+std::span<const std::uint32_t> dacrtKernelSpirv();    // shaders/dacrt.comp
+std::span<const std::uint32_t> workgroupTestSpirv();  // shaders/workgroup_test.comp
+
+}  // namespace dacrt::gpu

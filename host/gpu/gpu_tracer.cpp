@@ -1,0 +1,276 @@
+#include "gpu/gpu_tracer.hpp"
+
+#include <algorithm>
+
+#include "core/errors.hpp"
+#include "core/timing.hpp"
+#include "dacrt/scene_division.hpp"
+#include "gpu/binding_set.hpp"
+#include "gpu/device_defaults.hpp"
+#include "gpu/dispatch_recorder.hpp"
+#include "gpu/work_plan.hpp"
+
+namespace dacrt {
+namespace {
+
+// What the frame's stages hand each other.
+struct GpuFrame {
+    const FrameGeometry& geometry;
+    Division division;
+    std::vector<TransferRound> schedule;
+    gpu::WorkPlan work;
+    std::uint32_t workgroupSize = 0;
+    gpu::DacrtBufferPlan buffers{};
+};
+
+void describeDevice(const gpu::DeviceInfo& device, TraceResult& result) {
+    result.gpu = GpuReport{};
+    result.gpu->device = device.name;
+    result.gpu->driver = device.driver;
+    result.gpu->subgroupSize = device.subgroupSize;
+}
+
+// The same division as the cpu backend, then the work items over the region slots.
+void planWorkItems(GpuFrame& frame, const TraceOptions& options, const GpuTuning& tuning,
+                   const gpu::DeviceInfo& device, ThreadPool& pool, MemoryPlan& hostPlan, TraceResult& result) {
+    const auto start = Clock::now();
+    const unsigned regions = options.regions ? options.regions : gpu::defaultGpuRegions(device);
+    const int axis =
+        options.axis == DivisionAxis::Best ? chooseDivisionAxis(frame.geometry, regions) : int(options.axis) - 1;
+    frame.division = divideScene(frame.geometry, regions, axis, pool, hostPlan);
+    frame.schedule = transferSchedule(frame.division);
+    const std::uint32_t groups = tuning.rayGroups ? tuning.rayGroups : gpu::defaultRayGroups(device, regions);
+    frame.work = gpu::planWorkItems(frame.division, frame.schedule, groups);
+    result.regions = regions;
+    result.axis = axis;
+    result.counters.raysCulled = frame.division.culledRays;
+    result.gpu->rayGroups = groups;
+    result.phaseMs.emplace_back("divide", msSince(start));
+}
+
+void chooseWorkgroupSize(GpuFrame& frame, const GpuTuning& tuning, const gpu::DeviceInfo& device, TraceResult& result) {
+    const std::uint32_t size =
+        tuning.workgroupSize ? tuning.workgroupSize
+                             : gpu::defaultWorkgroupSize(device, frame.work.largestSlotRays, frame.work.largestSlotTriangles);
+    const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
+    const std::uint32_t widest = gpu::widestWorkgroup(device);
+    if (size % subgroup != 0 || size > widest)
+        throw InputError("a workgroup size of " + std::to_string(size) + " does not suit this device: it must be a " +
+                         "multiple of the subgroup size " + std::to_string(subgroup) + " and at most " +
+                         std::to_string(widest));
+    frame.workgroupSize = size;
+    result.gpu->workgroupSize = size;
+}
+
+// Every buffer, host and device, from the counts; checked against the device's limits.
+void planMemory(GpuFrame& frame, const gpu::DeviceInfo& device, const MemoryPlan& hostPlan, const DacrtOptions& options,
+                TraceResult& result) {
+    const std::uint64_t triIdCount = std::uint64_t(frame.division.triIds.size()) * frame.work.groups;
+    frame.buffers = gpu::planDacrtBuffers(gpu::DacrtBufferCounts{
+        .rays = frame.geometry.rays->size(),
+        .triangles = frame.geometry.triangles->size(),
+        .rayIds = frame.division.rayIds.size(),
+        .triangleIds = triIdCount,
+        .regions = frame.work.slots.size(),
+        .workItems = frame.work.items.size(),
+        .maxDepth = options.maxDepth,
+    });
+    for (const auto& [name, bytes] : hostPlan.buffers) result.memory.add("host: " + name, bytes);
+    result.memory.add("host: triangle ids per ray group", triIdCount * 4);
+    gpu::addToMemoryPlan(frame.buffers, device, result.memory);
+}
+
+// Creates the frame's buffers and fills them.
+gpu::DacrtBindingSet uploadFrame(const GpuFrame& frame, const gpu::Context& context, TraceResult& result) {
+    const auto start = Clock::now();
+    gpu::DacrtBindingSet set(context, frame.buffers);
+    const FrameGeometry& g = frame.geometry;
+    const std::vector<std::uint32_t> slotTriIds = gpu::groupTriangleIds(frame.division, frame.work.groups);
+    const std::vector<Hit> misses(g.rays->size(), missHit());
+    const GpuCounters zero{};
+    const std::vector<TraversalState> fresh(frame.work.items.size(), TraversalState{});
+    auto upload = [&](std::uint32_t binding, const auto& v) { set[binding].upload(v.data(), v.size() * sizeof(v[0])); };
+    upload(DACRT_BINDING_RAYS, *g.rays);
+    upload(DACRT_BINDING_TRIANGLES, *g.triangles);
+    upload(DACRT_BINDING_TRIANGLE_BOUNDS, *g.triangleBounds);
+    upload(DACRT_BINDING_HITS, misses);
+    upload(DACRT_BINDING_RAY_IDS, frame.division.rayIds);
+    upload(DACRT_BINDING_TRI_IDS, slotTriIds);
+    upload(DACRT_BINDING_REGIONS, frame.work.slots);
+    upload(DACRT_BINDING_WORK_ITEMS, frame.work.items);
+    set[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
+    upload(DACRT_BINDING_STATES, fresh);
+    result.phaseMs.emplace_back("upload", msSince(start));
+    return set;
+}
+
+gpu::ComputePipeline& preparePipeline(const GpuFrame& frame, const DacrtOptions& options, const gpu::DeviceInfo& device,
+                                      gpu::PipelineCache& pipelines, const gpu::DacrtBindingSet& set,
+                                      TraceResult& result) {
+    const auto start = Clock::now();
+    const DacrtOptions leafLimits = options.resolvedFor(Backend::Gpu);
+    gpu::ComputePipeline& pipeline = pipelines.kernel(gpu::KernelSpecialization{
+        .workgroupSize = frame.workgroupSize,
+        .rayLimit = leafLimits.rayLimit,
+        .triLimit = leafLimits.triLimit,
+        .maxDepth = options.maxDepth,
+        .loopBudget = gpu::loopBudgetOf(device),
+        .sharedStart = gpu::raysShareStart(*frame.geometry.rays),
+    });
+    set.bindTo(pipeline);
+    result.phaseMs.emplace_back("pipeline", msSince(start));
+    return pipeline;
+}
+
+DacrtPush framePush(const GpuFrame& frame) {
+    DacrtPush push{};
+    push.rayOrigin = frame.geometry.rayOrigin;
+    push.margin = frame.geometry.margin;
+    push.axis = std::uint32_t(frame.division.axis);
+    push.rayScratchHalf = std::uint32_t(frame.division.rayIds.size());
+    push.triScratchHalf = std::uint32_t(frame.division.triIds.size() * frame.work.groups);
+    push.loopProbe = 2;
+    push.rayTmin = frame.geometry.rays->front().tmin;
+    return push;
+}
+
+// A slice cut short by the loop limiter has left its work item in an unknown state, so this
+// is checked first, after every submission.
+void checkLoopLimit(const GpuCounters& counters, std::size_t items, const gpu::DeviceInfo& device) {
+    if (counters.loopLimitHits > 0)
+        throw InternalError(std::to_string(counters.loopLimitHits) + " of " + std::to_string(items) +
+                            " work item slices were cut short by the driver's loop limit (" + device.driver +
+                            " ends every shader invocation after 65535 loop iterations in all); the kernel's cost " +
+                            "estimates undercount this scene: please report it (docs/gpu.md)");
+}
+
+// Records `count` work items from `first` as dispatches of at most maxComputeWorkGroupCountX.
+void recordPass(gpu::DispatchRecorder& recorder, const std::string& name, gpu::ComputePipeline& pipeline,
+                DacrtPush& push, std::uint32_t first, std::uint32_t count, std::uint32_t perDispatch) {
+    for (std::uint32_t done = 0; done < count; done += perDispatch) {
+        push.firstWorkItem = first + done;
+        recorder.dispatch(name, pipeline, std::min(perDispatch, count - done), &push);
+    }
+}
+
+std::uint32_t dispatchesFor(std::uint32_t count, std::uint32_t perDispatch) { return (count + perDispatch - 1) / perDispatch; }
+
+void submit(gpu::DispatchRecorder& recorder, const gpu::DacrtBindingSet& set, GpuCounters& counters, GpuReport& report) {
+    recorder.submitAndWait();
+    for (const auto& t : recorder.timingsMs()) report.dispatchMs.push_back(t);
+    set[DACRT_BINDING_COUNTERS].download(&counters, sizeof(counters));
+}
+
+// One command buffer: Step 1, then each transfer round, one pass each.
+GpuCounters dispatchSchedule(const GpuFrame& frame, gpu::Context& context, gpu::ComputePipeline& pipeline,
+                             const gpu::DacrtBindingSet& set, DacrtPush& push, GpuReport& report) {
+    const std::uint32_t perDispatch = context.info().maxComputeWorkGroupCountX;
+    std::uint32_t dispatchCount = 0;
+    for (const auto& pass : frame.work.passes) dispatchCount += dispatchesFor(pass.second, perDispatch);
+    gpu::DispatchRecorder recorder(context, dispatchCount);
+    std::uint32_t first = 0;
+    for (const auto& [name, count] : frame.work.passes) {
+        recordPass(recorder, name, pipeline, push, first, count, perDispatch);
+        first += count;
+    }
+    GpuCounters counters{};
+    submit(recorder, set, counters, report);
+    return counters;
+}
+
+// A work item that ran out of loop budget (llvmpipe) is finished by continuation dispatches
+// over all work items, submitted until every one is done.
+void dispatchContinuations(const GpuFrame& frame, gpu::Context& context, gpu::ComputePipeline& pipeline,
+                           const gpu::DacrtBindingSet& set, DacrtPush& push, GpuCounters& counters, GpuReport& report) {
+    constexpr std::uint32_t kContinuationsPerSubmit = 8;
+    const gpu::DeviceInfo& device = context.info();
+    const std::uint32_t items = std::uint32_t(frame.work.items.size());
+    const std::uint32_t perDispatch = device.maxComputeWorkGroupCountX;
+    while (counters.itemsFinished < items) {
+        checkLoopLimit(counters, items, device);
+        if (counters.tooLarge > 0)
+            throw InputError(std::to_string(counters.tooLarge) + " work items have a single step larger than the loop " +
+                             "budget of " + std::to_string(gpu::loopBudgetOf(device)) + " iterations (" + device.driver +
+                             "); use a larger workgroup size or more regions (docs/gpu.md)");
+        const std::uint32_t slicesBefore = counters.slices;
+        gpu::DispatchRecorder recorder(context, kContinuationsPerSubmit * dispatchesFor(items, perDispatch));
+        for (std::uint32_t c = 0; c < kContinuationsPerSubmit; ++c)
+            recordPass(recorder, "continuation", pipeline, push, 0, items, perDispatch);
+        submit(recorder, set, counters, report);
+        if (counters.slices == slicesBefore)
+            throw InternalError("gpu work items stopped making progress (" + std::to_string(counters.itemsFinished) +
+                                " of " + std::to_string(items) + " finished): please report it");
+    }
+}
+
+void readBack(const GpuFrame& frame, const gpu::DacrtBindingSet& set, const GpuCounters& counters,
+              const gpu::Context& context, TraceResult& result) {
+    const auto start = Clock::now();
+    result.hits.resize(frame.geometry.rays->size());
+    set[DACRT_BINDING_HITS].download(result.hits.data(), result.hits.size() * sizeof(Hit));
+    std::vector<Region> after(frame.work.slots.size());
+    set[DACRT_BINDING_REGIONS].download(after.data(), after.size() * sizeof(Region));
+    result.phaseMs.emplace_back("readback", msSince(start));
+
+    checkLoopLimit(counters, frame.work.items.size(), context.info());
+    result.counters.rayBoxTests = counters.rayBoxTests;
+    result.counters.rayTriangleTests = counters.rayTriangleTests;
+    result.counters.leaves = counters.leaves;
+    result.counters.raysRetired = counters.raysRetired;
+    result.counters.transferWorkItems = frame.work.transferPairs;
+    GpuReport& report = *result.gpu;
+    report.raysFinished = 0;  // one command buffer: no per-round readback
+    for (const Region& r : after) report.raysFinished += r.terminated - r.rayBegin;
+    report.dispatches = std::uint32_t(report.dispatchMs.size());
+    report.slices = counters.slices;
+    report.workItemsRun = counters.workItemsRun;
+    report.workItemsEmpty = counters.workItemsEmpty;
+    report.validationErrors = context.validationErrors();
+}
+
+}  // namespace
+
+void checkGpuOptions(const TraceOptions& options) {
+    if (options.dacrt.split != SplitMethod::SpatialMedian)
+        throw InputError("the gpu backend splits at the spatial median only, not by " + toString(options.dacrt.split));
+    if (!options.dacrt.exactDefaults())
+        throw InputError("the gpu backend runs only the exact defaults (watertight intersector, bounds filter, f32), "
+                         "not intersector " + toString(options.dacrt.intersector) + ", triangle filter " +
+                         toString(options.dacrt.triangleFilter) + ", precision " + toString(options.dacrt.precision) +
+                         "; those are options of cpu and cpu-seq");
+}
+
+TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
+                     gpu::Context& context, ThreadPool& pool, const PlanHook& onPlan, gpu::PipelineCache* pipelines) {
+    const gpu::DeviceInfo& device = context.info();
+    checkGpuOptions(options);
+    if (!device.subgroupOperations)
+        throw InputError("device '" + device.name +
+                         "' lacks subgroup arithmetic or shuffles in compute shaders, which the gpu backend needs");
+    TraceResult result;
+    result.threads = pool.size();
+    describeDevice(device, result);
+
+    GpuFrame frame{geometry, {}, {}, {}, 0, {}};
+    MemoryPlan hostPlan;
+    planWorkItems(frame, options, tuning, device, pool, hostPlan, result);
+    chooseWorkgroupSize(frame, tuning, device, result);
+    planMemory(frame, device, hostPlan, options.dacrt, result);
+    if (onPlan && !onPlan(result.memory)) return result;
+
+    gpu::DacrtBindingSet set = uploadFrame(frame, context, result);
+    gpu::PipelineCache frameOnly(context);
+    gpu::ComputePipeline& pipeline =
+        preparePipeline(frame, options.dacrt, device, pipelines ? *pipelines : frameOnly, set, result);
+
+    const auto start = Clock::now();
+    DacrtPush push = framePush(frame);
+    GpuCounters counters = dispatchSchedule(frame, context, pipeline, set, push, *result.gpu);
+    dispatchContinuations(frame, context, pipeline, set, push, counters, *result.gpu);
+    result.phaseMs.emplace_back("dispatch", msSince(start));
+
+    readBack(frame, set, counters, context, result);
+    return result;
+}
+
+}  // namespace dacrt

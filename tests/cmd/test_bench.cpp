@@ -1,0 +1,151 @@
+// `dacrt bench` end to end, at sizes that keep it fast: the rows, the outputs, the cache, and
+// the promise that every backend's default has no real error against the float64 reference.
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "support/cli_support.hpp"
+#include "support/gpu_support.hpp"
+#include "support/frames.hpp"
+
+namespace dacrt {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string roomScene() { return std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb"; }
+
+struct BenchOutputs {
+    fs::path dir;
+    explicit BenchOutputs(const std::string& name) : dir(fs::temp_directory_path() / ("dacrt_bench_" + name)) {
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+    }
+    std::string args() const {
+        return " --csv " + (dir / "b.csv").string() + " --json " + (dir / "b.json").string() + " --cache " +
+               (dir / "cache").string();
+    }
+    nlohmann::json json() const {
+        std::ifstream f(dir / "b.json");
+        return nlohmann::json::parse(f);
+    }
+};
+
+std::size_t lines(const fs::path& p) {
+    std::ifstream f(p);
+    std::size_t n = 0;
+    for (std::string line; std::getline(f, line);) ++n;
+    return n;
+}
+
+void expectDefaultsExact(const nlohmann::json& j, std::set<std::string> backends) {
+    for (const auto& row : j["rows"]) {
+        if (!row["default"].get<bool>()) continue;
+        EXPECT_EQ(row["real_errors"].get<std::uint64_t>(), 0u) << row["series"] << " " << row["config"];
+        EXPECT_GT(row["frame_ms_min"].get<double>(), 0.0);
+        EXPECT_LE(row["frame_ms_min"].get<double>(), row["frame_ms_median"].get<double>());
+        backends.erase(row["backend"].get<std::string>());
+    }
+    EXPECT_TRUE(backends.empty()) << "backends without a default row: " << backends.size();
+}
+
+TEST(Bench, SweepWritesRowsAndCacheAndDefaultsAreExact) {
+    const BenchOutputs out("sweep");
+    const test::CommandResult r = test::runDacrt("bench " + roomScene() +
+                                                 " --backends cpu-seq,cpu,embree --size 48x36 --orbit 2 --repeat 2 --warmup 0" +
+                                                 out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json j = out.json();
+    const std::size_t rows = j["rows"].size();
+    EXPECT_GE(rows, 30u);  // every option value of cpu-seq and cpu, four embree rows
+    EXPECT_EQ(lines(out.dir / "b.csv"), rows + 1);
+    expectDefaultsExact(j, {"cpu-seq", "cpu", "embree"});
+    std::set<std::string> configs;
+    for (const auto& row : j["rows"]) {
+        configs.insert(row["series"].get<std::string>() + " " + row["config"].get<std::string>());
+        EXPECT_EQ(row["pixels"].get<std::uint64_t>(), 2u * 48u * 36u);
+        EXPECT_TRUE(row["parts_ms"].contains("tracer"));
+        // What tools/bench/plot.py draws (its test runs on tests/scenes/bench_sample.json).
+        for (const char* field : {"scene", "series", "config", "default", "frame_ms_min", "real_error_fraction", "pareto"})
+            EXPECT_TRUE(row.contains(field)) << field;
+    }
+    for (const char* expected : {"cpu-seq intersector=moller-trumbore", "cpu-seq triangle-filter=sat",
+                                 "cpu-seq triangle-filter=mora", "cpu-seq precision=f64", "cpu-seq split=sampled-mean",
+                                 "cpu regions=64", "cpu axis=z", "embree static default", "embree robust=off"})
+        EXPECT_TRUE(configs.count(expected)) << expected;
+
+    std::size_t cached = 0;
+    for (const auto& e : fs::directory_iterator(out.dir / "cache")) cached += e.path().extension() == ".ref";
+    EXPECT_EQ(cached, 2u);  // one reference per camera, reused below
+    const auto written = fs::last_write_time(fs::directory_iterator(out.dir / "cache")->path());
+    const test::CommandResult again =
+        test::runDacrt("bench " + roomScene() + " --backends cpu-seq --size 48x36 --orbit 2 --repeat 1 --warmup 0" + out.args());
+    ASSERT_EQ(again.code, 0) << again.output;
+    EXPECT_EQ(fs::last_write_time(fs::directory_iterator(out.dir / "cache")->path()), written);
+}
+
+TEST(Bench, GpuDefaultIsExactUnderValidation) {
+    DACRT_REQUIRE_GPU(gpu);
+    const BenchOutputs out("gpu");
+    const test::CommandResult r = test::runDacrt("bench " + roomScene() +
+                                                 " --backends gpu --size 40x30 --orbit 2 --repeat 1 --warmup 0 --validate" +
+                                                 out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json j = out.json();
+    EXPECT_EQ(j["validation_errors"].get<int>(), 0);
+    expectDefaultsExact(j, {"gpu"});
+    for (const auto& row : j["rows"]) {
+        EXPECT_EQ(row["real_errors"].get<std::uint64_t>(), 0u) << row["config"];  // every gpu option is exact
+        EXPECT_TRUE(row["parts_ms"].contains("gpu timestamps"));
+    }
+}
+
+TEST(Bench, Table51SuiteReportsSpeedupsOverSequential) {
+    const BenchOutputs out("table51");
+    const test::CommandResult r = test::runDacrt("bench " + roomScene() +
+                                                 " --suite table51 --backends cpu-seq,cpu --size 32x24 --repeat 1 --warmup 0" +
+                                                 out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json j = out.json();
+    EXPECT_EQ(j["rows"].size(), 1u + 6u * 4u);  // sequential, then six thread/region setups by four axes
+    for (const auto& row : j["rows"]) EXPECT_TRUE(row["speedup_over_cpu_seq"].is_number());
+}
+
+TEST(Bench, OutputsDefaultToOneDirectoryAndAreCheckedFirst) {
+    const BenchOutputs out("defaults");
+    const std::string cache = " --cache " + (out.dir / "cache").string();
+    test::CommandResult r = test::runDacrt("bench " + roomScene() + " --backends cpu-seq --size 16x12 --repeat 1 --warmup 0 --out " +
+                                           (out.dir / "results").string() + cache);
+    ASSERT_EQ(r.code, 0) << r.output;
+    for (const char* name : {"bench.csv", "bench.json"})
+        EXPECT_GT(fs::file_size(out.dir / "results" / name), 100u) << name;
+    // A path that cannot be written fails at once, before the reference or any frame.
+    r = test::runDacrt("bench " + roomScene() + " --backends cpu-seq --size 16x12 --csv /proc/version/x.csv" + cache);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("/proc/version/x.csv"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("series"), std::string::npos) << "it ran before failing: " << r.output;
+}
+
+TEST(Bench, BadInputGetsAClearError) {
+    test::CommandResult r = test::runDacrt("bench /nonexistent.glb --backends cpu-seq");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("nonexistent.glb"), std::string::npos) << r.output;
+    r = test::runDacrt("bench " + roomScene() + " --backends warp-drive");
+    EXPECT_EQ(r.code, 2);
+    r = test::runDacrt("bench " + roomScene() + " --suite table51 --backends embree");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("table51"), std::string::npos) << r.output;
+    r = test::runDacrt("render " + roomScene() + " --backend gpu --intersector moller-trumbore");
+    EXPECT_NE(r.code, 0);
+    r = test::runDacrt("render " + roomScene() + " --backend cpu-seq --size 8x6 --precision f64 --intersector moller-trumbore");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("f64"), std::string::npos) << r.output;
+    r = test::runDacrt("render " + roomScene() + " --backend embree --plan");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("embree"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace dacrt

@@ -1,0 +1,168 @@
+// The dacrt command line, run as a user would run it.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "support/cli_support.hpp"
+#include "support/frames.hpp"
+
+namespace {
+
+using dacrt::test::CommandResult;
+
+CommandResult run(const std::string& args) { return dacrt::test::runDacrt(args); }
+
+std::string temp(const std::string& name) { return ::testing::TempDir() + "/cli_" + name; }
+
+}  // namespace
+
+TEST(Cli, RenderWritesImageAovAndStats) {
+    const std::string png = temp("quad.png"), exr = temp("quad.exr"), stats = temp("quad.json");
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 32x24 --backend cpu --regions 3 -o " +
+                      png + " --aov " + exr + " --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_TRUE(std::filesystem::file_size(png) > 0);
+    EXPECT_TRUE(std::filesystem::file_size(exr) > 0);
+    std::ifstream f(stats);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    for (const char* key : {"backend", "triangles", "rays", "regions", "threads", "timings_ms", "memory_plan_bytes", "counters"})
+        EXPECT_TRUE(j.contains(key)) << key;
+    for (const char* key : {"load", "prepare", "trace", "write", "total"}) EXPECT_TRUE(j["timings_ms"].contains(key)) << key;
+    EXPECT_TRUE(j["memory_plan_bytes"].contains("total"));
+    for (const char* key : {"ray_box_tests", "ray_triangle_tests", "rays_terminated_step1", "rays_terminated_per_round"})
+        EXPECT_TRUE(j["counters"].contains(key)) << key;
+    EXPECT_EQ(j["rays"], 32 * 24);
+    EXPECT_EQ(j["regions"], 3);
+    EXPECT_GT(j["hits"].get<int>(), 0);
+
+    const CommandResult same = run("compare " + exr + " " + exr + " --json");
+    ASSERT_EQ(same.code, 0) << same.output;
+    const nlohmann::json c = nlohmann::json::parse(same.output);
+    EXPECT_EQ(c["pixels"], 32 * 24);
+    EXPECT_EQ(c["differing_prim_id"], 0);
+    for (const char* key : {"differing_depth", "near_ties", "max_rel_depth_diff", "rms_rel_depth_diff"})
+        EXPECT_TRUE(c.contains(key)) << key;
+}
+
+TEST(Cli, CompareCountsDifferences) {
+    const std::string a = temp("cmp_a.exr"), b = temp("cmp_b.exr");
+    const std::string scene = dacrt::test::fixture("quad_u8_camera.gltf");
+    ASSERT_EQ(run("render " + scene + " --size 16x16 --aov " + a).code, 0);
+    ASSERT_EQ(run("render " + scene + " --size 16x16 --eye 0.5,0,4 --aov " + b).code, 0);
+    const CommandResult r = run("compare " + a + " " + b + " --json");
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json c = nlohmann::json::parse(r.output);
+    EXPECT_GT(c["differing_depth"].get<int>(), 0);
+}
+
+TEST(Cli, OrbitWritesOneImagePerCamera) {
+    const std::string base = temp("orbit.png");
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_strip_u16_matrix.gltf") + " --size 8x8 --orbit 3 -o " + base);
+    ASSERT_EQ(r.code, 0) << r.output;
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::filesystem::exists(temp("orbit_cam" + std::to_string(k) + ".png"))) << k;
+}
+
+TEST(Cli, PlanPrintsEveryBufferAndTracesNothing) {
+    const std::string png = temp("plan.png");
+    std::filesystem::remove(png);
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 16x8 --regions 2 --plan -o " + png);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("memory plan"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("triangle ids (with straddlers)"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("total"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(png));
+}
+
+struct BadCommand {
+    const char* name;
+    std::string args;
+    const char* expected;
+};
+
+void PrintTo(const BadCommand& c, std::ostream* os) { *os << c.name; }
+
+class CliRejects : public ::testing::TestWithParam<BadCommand> {};
+
+TEST_P(CliRejects, WithExitCode2AndAMessage) {
+    const CommandResult r = run(GetParam().args);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find(GetParam().expected), std::string::npos) << r.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    BadCommands, CliRejects,
+    ::testing::Values(
+        BadCommand{"UnknownBackend", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend warp", "warp"},
+        BadCommand{"BadSize", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 64by48", "--size"},
+        BadCommand{"ZeroSize", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 0x48", "--size"},
+        BadCommand{"UnknownOption", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --frobnicate", "frobnicate"},
+        BadCommand{"BadEye", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --eye 1,2", "--eye"},
+        BadCommand{"NanEye", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --eye nan,0,1", "--eye"},
+        BadCommand{"EyeOnTarget", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --eye 0,0,0 --target 0,0,0", "coincide"},
+        BadCommand{"BadFov", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --fov 180", "--fov"},
+        BadCommand{"ZeroRegions", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --regions 0", "--regions"},
+        BadCommand{"ZeroRayGroups", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend gpu --ray-groups 0", "--ray-groups"},
+        BadCommand{"RayGroupsOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu --ray-groups 2",
+                   "tune the gpu backend"},
+        BadCommand{"TruncatedFile", "render " + dacrt::test::fixture("bad_truncated.glb"), "bad_truncated.glb"},
+        BadCommand{"NanVertex", "render " + dacrt::test::fixture("bad_nan_position.gltf"), "non-finite"},
+        BadCommand{"NoSubcommand", "", "subcommand"},
+        BadCommand{"CompareMissingFile", "compare /nonexistent/a.exr /nonexistent/b.exr", "a.exr"},
+        BadCommand{"GpuSplitOption", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend gpu --split centroid-mean",
+                   "spatial median"},
+        BadCommand{"BruteWithDacrtOption", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend brute --triangle-filter sat",
+                   "--triangle-filter"},
+        BadCommand{"EmbreeFastOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --embree-fast", "--embree-fast"},
+        BadCommand{"CompareNotAnAov", "compare " + dacrt::test::fixture("bad_not_gltf.gltf") + " x.exr", "bad_not_gltf.gltf"}),
+    [](const ::testing::TestParamInfo<BadCommand>& info) { return std::string(info.param.name); });
+
+TEST(Cli, HelpNamesChoicesAndExitCodes) {
+    const dacrt::test::CommandResult r = dacrt::test::runDacrt("render --help");
+    EXPECT_EQ(r.code, 0) << r.output;
+    // Choices by name, from the enum's one name table, not CLI11's numbering.
+    EXPECT_NE(r.output.find("brute,cpu-seq,cpu,gpu,embree"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("->"), std::string::npos) << r.output;
+    const dacrt::test::CommandResult top = dacrt::test::runDacrt("--help");
+    EXPECT_NE(top.output.find("Exit codes"), std::string::npos) << top.output;
+    EXPECT_NE(top.output.find("5 an internal error"), std::string::npos) << top.output;
+}
+
+TEST(Cli, DevicesListsTheLimitsThatMatter) {
+    const CommandResult r = run("devices");
+    if (r.code == 2 && r.output.find("no Vulkan") != std::string::npos) GTEST_SKIP() << r.output;
+    ASSERT_EQ(r.code, 0) << r.output;
+    for (const char* key : {"0: ", "driver:", "Vulkan:", "memory heaps:", "max storage buffer range:", "max allocation size:",
+                            "compute shared memory:", "workgroup:", "subgroup size:"})
+        EXPECT_NE(r.output.find(key), std::string::npos) << key << "\n" << r.output;
+}
+
+TEST(Cli, GpuRenderUnderValidationMatchesCpuSeq) {
+    if (run("devices").code != 0) GTEST_SKIP() << "no Vulkan device";
+    const std::string scene = dacrt::test::fixture("quad_u8_camera.gltf");
+    const std::string gpu = temp("gpu.exr"), cpu = temp("gpu_ref.exr"), stats = temp("gpu.json");
+    const CommandResult r = run("render " + scene + " --size 24x16 --backend gpu --regions 2 --validate --aov " + gpu +
+                                " --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.output;
+    ASSERT_EQ(run("render " + scene + " --size 24x16 --backend cpu-seq --aov " + cpu).code, 0);
+    const nlohmann::json c = nlohmann::json::parse(run("compare " + cpu + " " + gpu + " --json").output);
+    EXPECT_EQ(c["differing_prim_id"], 0);
+    EXPECT_EQ(c["differing_depth"], 0);
+    std::ifstream f(stats);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    ASSERT_TRUE(j.contains("gpu"));
+    for (const char* key : {"device", "driver", "dispatches", "dispatch_times", "work_items_run", "work_items_empty"})
+        EXPECT_TRUE(j["gpu"].contains(key)) << key;
+    EXPECT_EQ(j["gpu"]["validation_errors"], 0);
+}
+
+TEST(Cli, UnknownDeviceIsAnErrorListingTheChoices) {
+    if (run("devices").code != 0) GTEST_SKIP() << "no Vulkan device";
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") +
+                                " --size 8x8 --backend gpu --device warp-drive-9000");
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("matches no Vulkan device; the choices are"), std::string::npos) << r.output;
+}

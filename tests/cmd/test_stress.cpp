@@ -1,0 +1,307 @@
+// The stress suite (CTest label `stress`; docs/stability.md): the generators of `dacrt
+// stress` at their small size, run through every backend and every non-default option.
+// Each configuration must have 0 leaks, agree with brute force bit for bit and keep the tie
+// rule; every determinism check must hold; bad input must be refused with a message.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "support/cli_support.hpp"
+#include "core/errors.hpp"
+#include "support/dispatcher_support.hpp"
+#include "support/reference_support.hpp"
+#include "support/gpu_support.hpp"
+#include "core/procedural.hpp"
+#include "cmd/stress/stress.hpp"
+#include "support/frames.hpp"
+
+using namespace dacrt;
+
+namespace {
+
+constexpr std::uint64_t kSeed = 1;
+
+struct FamilyData {
+    std::vector<StressCase> cases;
+    std::vector<std::vector<Hit>> brute;
+};
+
+// Cases and their brute-force hits, made once per family for the whole binary.
+const FamilyData& family(const std::string& name) {
+    static std::map<std::string, std::unique_ptr<FamilyData>> cache;
+    std::unique_ptr<FamilyData>& slot = cache[name];
+    if (!slot) {
+        slot = std::make_unique<FamilyData>();
+        slot->cases = stressCases({name}, StressSize::Small, kSeed);
+        StressConfig brute = defaultStressConfig(Backend::Brute);
+        brute.request.trace.threads = 2;
+        for (const StressCase& c : slot->cases) slot->brute.push_back(traceStressCase(c, brute, test::testDispatcher()));
+    }
+    return *slot;
+}
+
+// Skips a gpu test where there is no Vulkan device.
+#define DACRT_REQUIRE_GPU_DISPATCHER(backend, gpu)                                                  \
+    std::string gpu##Why;                                                                         \
+    BackendDispatcher& dispatcher = test::testDispatcher(&gpu##Why);                              \
+    gpu::Context* gpu = (backend) == Backend::Gpu ? dispatcher.gpuContext() : nullptr;            \
+    if ((backend) == Backend::Gpu && !gpu) GTEST_SKIP() << "no Vulkan device with validation layers: " << gpu##Why
+
+std::string describe(const StressTally& t) {
+    std::string text = std::to_string(t.leaks) + " leaks of " + std::to_string(t.mustHit) + " must-hit rays, " +
+                       std::to_string(t.mismatches) + " differences from brute force, " +
+                       std::to_string(t.tieViolations) + " tie-rule violations, " + std::to_string(t.errors) +
+                       " errors in " + std::to_string(t.cases) + " cases;";
+    for (const std::string& e : t.examples) text += "\n  " + e;
+    return text;
+}
+
+struct Param {
+    std::string family;
+    Backend backend;
+};
+
+void PrintTo(const Param& p, std::ostream* os) { *os << p.family << " with " << toString(p.backend); }
+
+std::string paramName(const ::testing::TestParamInfo<Param>& info) {
+    std::string name = info.param.family + "_" + toString(info.param.backend);
+    for (char& ch : name)
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+    return name;
+}
+
+std::vector<Param> allParams() {
+    std::vector<Param> out;
+    for (const std::string& f : stressFamilies())
+        for (Backend b : {Backend::Brute, Backend::CpuSeq, Backend::Cpu, Backend::Gpu}) out.push_back({f, b});
+    return out;
+}
+
+}  // namespace
+
+class Stress : public ::testing::TestWithParam<Param> {};
+
+// The backend's default configuration and every non-default option value alike: each option
+// here only changes which cells a ray and a triangle meet in, never the answer, so none may
+// leak or differ. (One test per backend and family, so that brute force runs once.)
+TEST_P(Stress, NoLeaksAndBruteForceBitForBit) {
+    const Param& p = GetParam();
+    DACRT_REQUIRE_GPU_DISPATCHER(p.backend, gpu);
+    const FamilyData& data = family(p.family);
+    int configurations = 0;
+    for (StressConfig config : stressConfigs({p.backend}, true)) {
+        if (!config.request.trace.threads) config.request.trace.threads = 2;
+        StressTally total;
+        // Defaults see every case; each non-default option value every fourth (the suite's
+        // time limit), which `dacrt stress` lifts.
+        const std::size_t stride = config.isDefault ? 1 : 4;
+        for (std::size_t i = 0; i < data.cases.size(); i += stride) {
+            const std::vector<Hit> hits = traceStressCase(data.cases[i], config, dispatcher);
+            total.add(tallyStressCase(data.cases[i], hits, p.backend == Backend::Brute ? nullptr : &data.brute[i]));
+        }
+        EXPECT_TRUE(total.clean()) << config.name << " on " << p.family << ": " << describe(total);
+        EXPECT_GT(total.mustHit, 0u);
+        ++configurations;
+    }
+    EXPECT_GE(configurations, 1);
+    if (gpu) {
+        EXPECT_TRUE(test::noValidationErrors(*gpu));
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Configurations, Stress, ::testing::ValuesIn(allParams()), paramName);
+
+TEST(StressCases, WatertightnessCoversAMillionRaysOverEveryScaleAndOffset) {
+    const FamilyData& data = family("watertight");
+    std::uint64_t rays = 0, mustHit = 0;
+    std::map<std::string, int> shapes;
+    for (const StressCase& c : data.cases) {
+        rays += c.rays.size();
+        mustHit += c.mustHitCount();
+        ++shapes[c.name.substr(0, c.name.find(' '))];
+    }
+    EXPECT_GE(rays, 1000000u);
+    EXPECT_GE(mustHit, 500000u);
+    for (const char* s : {"icosphere", "perturbed-sphere", "torus", "cube", "flat-box", "thin-cylinder"})
+        EXPECT_GT(shapes[s], 0) << s;
+    // Scales 1e-4 to 1e6 and offsets up to 1e6 appear, where float32 resolves the mesh.
+    for (const char* label : {"scale 0.0001 offset 0", "scale 1e+06 offset 1e+06", "scale 10000 offset 1e+06",
+                              "scale 100 offset 10000"}) {
+        bool found = false;
+        for (const StressCase& c : data.cases) found = found || c.name.find(label) != std::string::npos;
+        EXPECT_TRUE(found) << label;
+    }
+}
+
+// The marks are right: brute force, whose watertight test has no cells to get wrong, hits
+// every must-hit ray, and a tracer that drops one triangle of a closed mesh is caught.
+TEST(StressCases, LeakCountingCatchesAHole) {
+    const FamilyData& data = family("watertight");
+    const StressCase* sphere = nullptr;
+    for (const StressCase& c : data.cases)
+        if (c.name == "icosphere scale 1 offset 0 inside#0") sphere = &c;
+    ASSERT_NE(sphere, nullptr);
+    StressCase holed = *sphere;
+    holed.triangles[0].v1 = holed.triangles[0].v0;  // zero area: never hit
+    const StressConfig brute = defaultStressConfig(Backend::Brute);
+    const StressTally t = tallyStressCase(holed, traceStressCase(holed, brute, test::testDispatcher()), nullptr);
+    EXPECT_GT(t.leaks, 0u);
+    EXPECT_EQ(tallyStressCase(*sphere, traceStressCase(*sphere, brute, test::testDispatcher()), nullptr).leaks, 0u);
+}
+
+TEST(StressCases, CoincidentGroupsAreAnsweredByTheirLowestId) {
+    const FamilyData& data = family("degenerate");
+    std::size_t hitsOnGroups = 0;
+    for (std::size_t i = 0; i < data.cases.size(); ++i) {
+        for (const std::vector<std::uint32_t>& g : data.cases[i].coincidentGroups)
+            for (const Hit& h : data.brute[i]) hitsOnGroups += h.prim == g.front();
+    }
+    EXPECT_GT(hitsOnGroups, 100u);  // the groups are actually hit, so the tie rule is exercised
+}
+
+// Stress cases: cameras inside closed meshes, rays in split planes, degenerate triangles,
+// coincident groups (the tie rule), scales from 1e-4 to 1e6.
+TEST(StressCases, TheReferenceMatchesFloat64BruteForceOnThem) {
+    ThreadPool pool(2);
+    std::size_t cases = 0;
+    for (const std::string& family : stressFamilies()) {
+        std::vector<StressCase> all = stressCases({family}, StressSize::Small, 1);
+        for (std::size_t i = 0; i < all.size(); i += std::max<std::size_t>(1, all.size() / 6)) {
+            StressCase& c = all[i];
+            if (c.rays.size() > 3000) c.rays.resize(3000);
+            EXPECT_TRUE(test::sameReference(traceReference(c.triangles, c.rays, pool),
+                                      traceReferenceBrute(c.triangles, c.rays, pool)))
+                << family << " / " << c.name;
+            ++cases;
+        }
+    }
+    EXPECT_GE(cases, 12u);
+}
+
+class StressDeterminism : public ::testing::TestWithParam<Backend> {};
+
+TEST_P(StressDeterminism, SameHitsAcrossRunsThreadsAndRegions) {
+    DACRT_REQUIRE_GPU_DISPATCHER(GetParam(), gpu);
+    const std::vector<DeterminismResult> results = determinismChecks({GetParam()}, dispatcher, StressSize::Small);
+    EXPECT_FALSE(results.empty());
+    for (const DeterminismResult& r : results) EXPECT_TRUE(r.holds) << r.name << ": " << r.detail;
+    if (gpu) {
+        EXPECT_TRUE(test::noValidationErrors(*gpu));
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, StressDeterminism,
+                         ::testing::Values(Backend::Brute, Backend::CpuSeq, Backend::Cpu, Backend::Gpu),
+                         [](const ::testing::TestParamInfo<Backend>& info) {
+                             std::string n = toString(info.param);
+                             for (char& ch : n)
+                                 if (ch == '-') ch = '_';
+                             return n;
+                         });
+
+// ---- rejected input -------------------------------------------------------------------
+
+namespace {
+constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+template <typename F>
+::testing::AssertionResult refused(F&& f, const std::string& expected) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        if (std::string(e.what()).find(expected) != std::string::npos) return ::testing::AssertionSuccess();
+        return ::testing::AssertionFailure() << "message '" << e.what() << "' lacks '" << expected << "'";
+    }
+    return ::testing::AssertionFailure() << "accepted";
+}
+}  // namespace
+
+TEST(StressRejects, NonFiniteOrOutOfRangeVertices) {
+    for (const glm::vec3 bad : {glm::vec3(kNan, 0, 0), glm::vec3(0, kInf, 0), glm::vec3(0, 0, -kInf)}) {
+        Scene s = sceneFromMeshes({box({-1, -1, -1}, {1, 1, 1})});
+        s.triangles[5].v2 = bad;
+        EXPECT_TRUE(refused([&] { validateScene(s); }, "non-finite vertex position")) << bad.x << bad.y << bad.z;
+        EXPECT_TRUE(refused([&] { validateScene(s); }, "triangle 5"));
+    }
+    Scene far = sceneFromMeshes({box({-1, -1, -1}, {1, 1, 1})});
+    far.triangles[2].v0.x = 2e9f;
+    EXPECT_TRUE(refused([&] { validateScene(far); }, "out-of-range"));
+}
+
+TEST(StressRejects, NonFiniteOrZeroRayDirectionsAndOrigins) {
+    const double nan = std::nan(""), inf = HUGE_VAL;
+    EXPECT_TRUE(refused([&] { makeRay({0, 0, 0}, {nan, 0, 1}); }, "finite"));
+    EXPECT_TRUE(refused([&] { makeRay({0, 0, 0}, {0, inf, 1}); }, "finite"));
+    EXPECT_TRUE(refused([&] { makeRay({0, 0, 0}, {0, 0, 0}); }, "non-zero"));
+    EXPECT_TRUE(refused([&] { makeRay({kNan, 0, 0}, {0, 0, 1}); }, "finite"));
+    EXPECT_TRUE(refused([&] { makeRay({0, kInf, 0}, {0, 0, 1}); }, "finite"));
+}
+
+TEST(StressRejects, NonFiniteCameraParameters) {
+    const Scene s = sceneFromMeshes({box({-1, -1, -1}, {1, 1, 1})});
+    const Box b = sceneBounds(s.triangles);
+    const double nan = std::nan(""), inf = HUGE_VAL;
+    auto with = [&](auto set) {
+        CameraOptions o;
+        set(o);
+        return [o, &s, &b] { makeCameras(s, b, o, 1.0); };
+    };
+    EXPECT_TRUE(refused(with([&](CameraOptions& o) { o.eye = glm::dvec3(inf, 0, 5); }), "finite"));
+    EXPECT_TRUE(refused(with([&](CameraOptions& o) { o.target = glm::dvec3(0, nan, 0); }), "finite"));
+    EXPECT_TRUE(refused(with([&](CameraOptions& o) { o.up = glm::dvec3(nan, 1, 0); }), "finite"));
+    EXPECT_TRUE(refused(with([&](CameraOptions& o) { o.up = glm::dvec3(0, 0, 0); }), "parallel"));
+    EXPECT_TRUE(refused(with([&](CameraOptions& o) { o.fovDegrees = nan; }), "field of view"));
+    EXPECT_TRUE(refused(with([&](CameraOptions& o) { o.fovDegrees = inf; }), "field of view"));
+    EXPECT_TRUE(refused(with([&](CameraOptions& o) { o.eye = glm::dvec3(1e12, 0, 5); }), "coordinate limit"));
+    // A scene camera read from a file goes through the same checks.
+    Scene withCamera = s;
+    withCamera.camera = SceneCamera{{0, 0, 5}, {nan, 0, -1}, {0, 1, 0}, 0.8};
+    EXPECT_TRUE(refused([&] { makeCameras(withCamera, b, {}, 1.0); }, "finite"));
+}
+
+TEST(StressRejects, NonFiniteInputOnTheCommandLine) {
+    const std::string scene = test::fixture("quad_u8_camera.gltf");
+    for (const char* args : {" --fov nan", " --fov inf", " --eye inf,0,1", " --target 0,nan,0", " --up 0,-inf,0",
+                             " --eye 1e300,0,0"}) {
+        const test::CommandResult r = test::runDacrt("render " + scene + " --size 8x8 -o /dev/null" + args);
+        EXPECT_EQ(r.code, 2) << args << ": " << r.output;
+        EXPECT_NE(r.output.find("error"), std::string::npos) << args << ": " << r.output;
+    }
+    // A binary glTF whose buffer holds an infinite coordinate (JSON cannot spell one).
+    Mesh m = box({-1, -1, -1}, {1, 1, 1});
+    m.positions[3].y = kInf;
+    const std::string path = ::testing::TempDir() + "/stress_inf_vertex.glb";
+    writeGltf(path, {m}, std::nullopt);
+    const test::CommandResult r = test::runDacrt("render " + path + " --size 8x8 -o /dev/null");
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("non-finite"), std::string::npos) << r.output;
+    std::filesystem::remove(path);
+}
+
+TEST(StressCommand, PrintsTheTableAndWritesJson) {
+    const std::string json = ::testing::TempDir() + "/stress.json";
+    const test::CommandResult r = test::runDacrt(
+        "stress --size small --families split-plane --backends brute,cpu-seq,cpu --no-determinism --json " + json);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("cpu-seq --split centroid-mean"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("every default configuration is clean"), std::string::npos) << r.output;
+    std::ifstream f(json);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    ASSERT_TRUE(j.contains("rows"));
+    for (const nlohmann::json& row : j["rows"]) {
+        EXPECT_EQ(row["leaks"], 0) << row.dump();
+        EXPECT_EQ(row["differ_from_brute"], 0) << row.dump();
+        EXPECT_GT(row["rays"].get<int>(), 0) << row.dump();
+    }
+    std::filesystem::remove(json);
+    const test::CommandResult bad = test::runDacrt("stress --families wobbly");
+    EXPECT_EQ(bad.code, 2) << bad.output;
+    EXPECT_NE(bad.output.find("wobbly"), std::string::npos) << bad.output;
+}

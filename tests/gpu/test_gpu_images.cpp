@@ -1,0 +1,160 @@
+// Whole images: the gpu backend against cpu-seq, bit for bit, under the validation layers.
+#include <gtest/gtest.h>
+
+#include "core/errors.hpp"
+#include "core/gltf_loader.hpp"
+#include "support/gpu_support.hpp"
+#include "gpu/device_defaults.hpp"
+#include "gpu/gpu_tracer.hpp"
+#include "core/procedural.hpp"
+#include "support/frames.hpp"
+
+using namespace dacrt;
+using namespace dacrt::test;
+
+namespace {
+
+Scene shapes() {
+    return sceneFromMeshes({icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 3), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 40, 16),
+                            box({-0.3f, -1.0f, -1.2f}, {0.4f, 0.6f, -0.6f}), grid({-2, -1, 2}, {4, 0, 0}, {0, 0, -4}, 12, 12)},
+                           "shapes");
+}
+
+// gpu == cpu-seq, bit for bit, for every region count (work items too large for llvmpipe's
+// loop limiter run in several slices; none may be cut short). Returns the transfer work
+// items of all the frames traced.
+std::uint64_t expectGpuMatchesCpu(gpu::Context& context, const Frame& frame, std::initializer_list<unsigned> regionCounts,
+                        std::uint32_t workgroupSize = 0, std::uint32_t rayGroups = 0) {
+    const TraceResult reference = frame.trace(Backend::CpuSeq);
+    std::uint64_t transferWorkItems = 0;
+    for (unsigned regions : regionCounts) {
+        TraceOptions o;
+        o.backend = Backend::Gpu;
+        o.regions = regions;
+        ThreadPool pool(2);
+        const TraceResult r = traceGpu(frame.geometry, o, GpuTuning{workgroupSize, rayGroups}, context, pool);
+        EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << regions << " regions, " << r.gpu->rayGroups << " ray groups";
+        EXPECT_EQ(r.gpu->dispatches, r.gpu->dispatchMs.size());
+        if (rayGroups) {
+            EXPECT_EQ(r.gpu->rayGroups, rayGroups);
+        }
+        EXPECT_EQ(r.gpu->workItemsRun + r.gpu->workItemsEmpty, (regions + r.counters.transferWorkItems) * r.gpu->rayGroups);
+        EXPECT_GE(r.gpu->slices, r.gpu->workItemsRun);
+        transferWorkItems += r.counters.transferWorkItems;
+    }
+    EXPECT_TRUE(noValidationErrors(context));
+    return transferWorkItems;
+}
+
+// A frame seen from inside the scene through a 100-degree camera.
+Frame insideView(const std::vector<Mesh>& meshes, glm::dvec3 eye, glm::dvec3 target, int width, int height) {
+    CameraOptions o;
+    o.eye = eye;
+    o.target = target;
+    o.fovDegrees = 100.0;
+    const Scene s = sceneFromMeshes(meshes);
+    return Frame(sceneFromMeshes(meshes), defaultCamera(s, width, height, o), width, height);
+}
+
+}  // namespace
+
+TEST(GpuImages, ProceduralShapes) {
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 96, 72), 96, 72);
+    expectGpuMatchesCpu(*context, frame, {1, 2, 3, 4, 8, 16});
+    expectGpuMatchesCpu(*context, frame, {1, 4}, 32);
+}
+
+TEST(GpuImages, RayGroupsGiveTheSameHits) {
+    // Groups split each region's rays into bands with private triangle ids; with transfer
+    // rounds (camera inside, 4 regions) and with more groups than some regions have rays.
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
+    for (std::uint32_t groups : {1u, 3u, 5u}) expectGpuMatchesCpu(*context, frame, {1, 2, 4}, 0, groups);
+    const Frame inside = insideView({box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)},
+                                    {0.1, 0.0, 0.2}, {0.3, 0.0, -1.0}, 40, 30);
+    EXPECT_GT(expectGpuMatchesCpu(*context, inside, {4}, 0, 64), 0u) << "expected transfer rounds";
+}
+
+TEST(GpuImages, CameraInsideTheSceneAndOnSplitPlanes) {
+    DACRT_REQUIRE_GPU(context);
+    // The eye is inside, and on the x = 0 and y = 0 planes.
+    const Frame frame = insideView({box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2),
+                                    torus({-1.0f, -0.5f, 1.5f}, 0.6f, 0.2f, 24, 12)},
+                                   {0.0, 0.0, 0.2}, {0.3, 0.0, -1.0}, 64, 48);
+    expectGpuMatchesCpu(*context, frame, {1, 2, 4, 8});
+}
+
+TEST(GpuImages, NearlyCoincidentWallsAcrossASplitPlane) {
+    DACRT_REQUIRE_GPU(context);
+    const float below = std::nextafter(1.0f, 0.0f), above = std::nextafter(1.0f, 2.0f);
+    const Frame frame = insideView({grid({below, -4, -4}, {0, 8, 0}, {0, 0, 8}, 9, 7),
+                                    grid({above, -4, -4}, {0, 8, 0}, {0, 0, 8}, 7, 9),
+                                    grid({0, -4, -4}, {0, 0.1f, 0}, {0, 0, 0.1f}, 1, 1),
+                                    grid({2, 3.9f, 3.9f}, {0, 0.1f, 0}, {0, 0, 0.1f}, 1, 1)},
+                                   {0.3, 0.1, 0.2}, {1.0, 1.5, -2.0}, 96, 72);
+    expectGpuMatchesCpu(*context, frame, {1, 2, 4, 8, 16});
+}
+
+TEST(GpuImages, StanfordBunny) {
+    DACRT_REQUIRE_GPU(context);
+    DACRT_REQUIRE_SHARED_SCENE(path, "bunny.glb");
+    Scene s = loadGltf(path);
+    const Camera cam = defaultCamera(s, 160, 120);
+    const Frame frame(std::move(s), cam, 160, 120);
+    expectGpuMatchesCpu(*context, frame, {1, 2, 4, 8, 16, 64});
+}
+
+TEST(GpuImages, SlicedWorkItemsMatchTheUnslicedOnes) {
+    // A tiny workgroup on one region forces many slices on llvmpipe (and none elsewhere):
+    // resuming from saved state must give the same hits.
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 128, 96), 128, 96);
+    TraceOptions o;
+    o.backend = Backend::Gpu;
+    o.regions = 1;
+    ThreadPool pool(1);
+    const TraceResult r = traceGpu(frame.geometry, o, GpuTuning{context->info().subgroupSize}, *context, pool);
+    EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, r.hits));
+    if (gpu::loopBudgetOf(context->info()) > 0) {
+        EXPECT_GT(r.gpu->slices, 1u) << "expected the work item to need several slices";
+    }
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
+TEST(GpuImages, UnknownDeviceListsTheChoices) {
+    DACRT_REQUIRE_GPU(context);
+    try {
+        gpu::Context other(gpu::ContextOptions{"no such device 42", false});
+        FAIL() << "accepted an unknown device";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("matches no Vulkan device"), std::string::npos) << what;
+        EXPECT_NE(what.find(context->info().name), std::string::npos) << what;
+    }
+}
+
+TEST(GpuImages, ABufferOverTheDeviceLimitIsAClearError) {
+    DACRT_REQUIRE_GPU(context);
+    const std::uint64_t limit = context->info().maxStorageBufferRange;
+    if (limit > (256ull << 20)) GTEST_SKIP() << "the device's storage buffer range is too large to exceed cheaply";
+    const int width = 2048, height = int(limit / sizeof(Ray) / width) + 1;  // one row more than the ray buffer allows
+    const Scene s = sceneFromMeshes({grid({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 1, 1)});
+    const Frame frame(sceneFromMeshes({grid({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 1, 1)}), defaultCamera(s, width, height),
+                      width, height);
+    TraceOptions o;
+    o.backend = Backend::Gpu;
+    o.regions = 2;
+    ThreadPool pool(2);
+    try {
+        traceGpu(frame.geometry, o, GpuTuning{}, *context, pool);
+        FAIL() << "a " << frame.rays.size() * sizeof(Ray) << "-byte ray buffer was accepted";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("maxStorageBufferRange of " + std::to_string(limit)), std::string::npos) << what;
+        EXPECT_NE(what.find("over by"), std::string::npos) << what;
+    }
+}

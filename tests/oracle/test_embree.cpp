@@ -1,0 +1,260 @@
+// Embree as a peer backend: agreement with brute force (up to ties between triangles at the
+// same point, which Embree breaks its own way), empty scenes, timings, thread counts.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include "oracle/embree_tracer.hpp"
+#include "core/procedural.hpp"
+#include "support/frames.hpp"
+
+using namespace dacrt;
+using namespace dacrt::test;
+
+namespace {
+
+// Two hits at different primitives this close in depth are the same point on two triangles
+// (a shared edge or vertex, or coincident triangles): either answer is right.
+constexpr float kTieRelative = 1e-5f;
+// The same primitive hit by two different intersection tests: t and the barycentrics differ
+// only by the tests' rounding, far below these bounds unless the ray grazes the triangle.
+constexpr float kDepthRelative = 1e-4f;
+constexpr float kBarycentricAbsolute = 1e-3f;
+
+bool closeRelative(float a, float b, float relative) {
+    return std::fabs(a - b) <= relative * std::max(std::fabs(a), std::fabs(b));
+}
+
+struct Agreement {
+    std::size_t rays = 0;
+    std::size_t bruteHits = 0;
+    std::size_t samePrim = 0;
+    std::size_t nearTies = 0;        // different prims at the same depth
+    std::size_t wrongPrim = 0;       // different prims at different depths
+    std::size_t leaks = 0;           // brute hits, embree misses
+    std::size_t phantoms = 0;        // brute misses, embree hits
+    std::size_t depthOrUvOff = 0;    // same prim, but t, u or v beyond rounding
+    std::size_t edgeRays = 0;        // brute's hit lies on a triangle edge (what the test is after)
+    std::string examples;
+
+    void example(std::size_t ray, const Hit& b, const Hit& e) {
+        if (examples.size() > 400) return;
+        examples += " [ray " + std::to_string(ray) + ": brute prim " + std::to_string(b.prim) + " t " +
+                    std::to_string(b.t) + ", embree prim " + std::to_string(e.prim) + " t " + std::to_string(e.t) + "]";
+    }
+
+    std::string describe() const {
+        return std::to_string(rays) + " rays, " + std::to_string(bruteHits) + " brute hits, " +
+               std::to_string(edgeRays) + " on edges, " + std::to_string(nearTies) + " near ties, " +
+               std::to_string(wrongPrim) + " wrong prims, " + std::to_string(leaks) + " leaks, " +
+               std::to_string(phantoms) + " phantom hits, " + std::to_string(depthOrUvOff) + " t/u/v off;" + examples;
+    }
+};
+
+Agreement compare(const std::vector<Hit>& brute, const std::vector<Hit>& embree) {
+    Agreement a;
+    a.rays = brute.size();
+    for (std::size_t i = 0; i < brute.size(); ++i) {
+        const Hit& b = brute[i];
+        const Hit& e = embree[i];
+        const bool bruteHit = b.prim != kMissPrim, embreeHit = e.prim != kMissPrim;
+        a.bruteHits += bruteHit;
+        if (bruteHit && std::min({b.u, b.v, 1.0f - b.u - b.v}) < 1e-6f) ++a.edgeRays;
+        if (!bruteHit && !embreeHit) {
+            if (e.t != kNoHitT || e.u != 0.0f || e.v != 0.0f) ++a.depthOrUvOff, a.example(i, b, e);
+        } else if (bruteHit && !embreeHit) {
+            ++a.leaks, a.example(i, b, e);
+        } else if (!bruteHit) {
+            ++a.phantoms, a.example(i, b, e);
+        } else if (b.prim == e.prim) {
+            ++a.samePrim;
+            if (!closeRelative(b.t, e.t, kDepthRelative) || std::fabs(b.u - e.u) > kBarycentricAbsolute ||
+                std::fabs(b.v - e.v) > kBarycentricAbsolute)
+                ++a.depthOrUvOff, a.example(i, b, e);
+        } else if (closeRelative(b.t, e.t, kTieRelative)) {
+            ++a.nearTies;
+        } else {
+            ++a.wrongPrim, a.example(i, b, e);
+        }
+    }
+    return a;
+}
+
+Agreement traceAndCompare(const Frame& frame, bool robust) {
+    ThreadPool pool(2);
+    const TraceResult brute = traceBrute(frame.geometry, pool);
+    EmbreeOptions options;
+    options.robust = robust;
+    const TraceResult embree = traceEmbree(frame.geometry, options, pool);
+    EXPECT_EQ(embree.hits.size(), frame.rays.size());
+    return compare(brute.hits, embree.hits);
+}
+
+// Robust Embree must agree with brute force everywhere but at ties. Non-robust Embree is only
+// reported: leaking through shared edges is what that mode trades for speed.
+Agreement expectAgreesWithBrute(const Frame& frame, const std::string& name) {
+    const Agreement robust = traceAndCompare(frame, true);
+    std::cout << "[ embree  ] " << name << ", robust: " << robust.describe() << "\n";
+    EXPECT_GT(robust.bruteHits, frame.rays.size() / 20) << name << ": the view should show the scene";
+    EXPECT_EQ(robust.leaks, 0u) << name << ": " << robust.describe();
+    EXPECT_EQ(robust.phantoms, 0u) << name << ": " << robust.describe();
+    EXPECT_EQ(robust.wrongPrim, 0u) << name << ": " << robust.describe();
+    EXPECT_EQ(robust.depthOrUvOff, 0u) << name << ": " << robust.describe();
+    const Agreement fast = traceAndCompare(frame, false);
+    std::cout << "[ embree  ] " << name << ", not robust: " << fast.describe() << "\n";
+    return robust;
+}
+
+CameraOptions lookAt(const glm::dvec3& eye, const glm::dvec3& target, double fovDegrees) {
+    CameraOptions o;
+    o.eye = eye;
+    o.target = target;
+    o.fovDegrees = fovDegrees;
+    return o;
+}
+
+bool bitIdentical(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit)) == 0; }
+
+}  // namespace
+
+TEST(EmbreeAgreesWithBrute, ProceduralShapes) {
+    const Scene s = test::shapesScene();
+    const Frame front(test::shapesScene(), defaultCamera(s, 96, 72), 96, 72);
+    expectAgreesWithBrute(front, "shapes, front");
+    CameraOptions o;
+    o.orbit = 3;
+    const std::vector<Camera> cams = makeCameras(s, sceneBounds(s.triangles), o, 4.0 / 3.0);
+    for (std::size_t k = 1; k < cams.size(); ++k) {
+        const Frame frame(test::shapesScene(), cams[k], 64, 48);
+        expectAgreesWithBrute(frame, "shapes, orbit " + std::to_string(k));
+    }
+}
+
+TEST(EmbreeAgreesWithBrute, PixelCentresOnSharedEdges) {
+    // A grid of quads 1/8 wide seen head-on from z = 3 with a pixel pitch of 1/16 on the
+    // plane: every pixel centre lands (up to the rounding of the ray direction) on an edge, a
+    // quad's diagonal or a vertex of six triangles. A 65 x 65 image puts the centre row and
+    // column exactly on x = 0 and y = 0. The grid reaches past the image, because on the
+    // grid's outer boundary a hit or a miss are both right (there is no neighbour to leak to).
+    const int size = 65;
+    const double fov = 2.0 * std::atan(double(size) / (16.0 * 2.0 * 3.0)) * 180.0 / M_PI;
+    std::vector<Mesh> meshes = {grid({-2.5f, -2.5f, 0}, {5, 0, 0}, {0, 5, 0}, 40, 40)};
+    const Scene s = sceneFromMeshes(meshes);
+    const Frame frame(sceneFromMeshes(meshes), defaultCamera(s, size, size, lookAt({0, 0, 3}, {0, 0, 0}, fov)),
+                      size, size);
+    const Agreement a = expectAgreesWithBrute(frame, "grid, edges head-on");
+    EXPECT_EQ(a.bruteHits, frame.rays.size());
+    EXPECT_GT(a.edgeRays, frame.rays.size() / 2) << "the camera should look at edges: " << a.describe();
+}
+
+TEST(EmbreeAgreesWithBrute, InsideClosedMeshesLookingAtEdgesAndCorners) {
+    // From inside a closed mesh every ray must hit: a miss is a leak through an edge or vertex.
+    std::vector<Mesh> meshes = {box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)};
+    const Scene s = sceneFromMeshes(meshes);
+    // Towards a corner of the box (where three faces meet) and the middles of two of its edges.
+    for (const glm::dvec3& target : {glm::dvec3(3, 2, 4), glm::dvec3(-3, 0, -4), glm::dvec3(0, -2, 4)}) {
+        const Frame frame(sceneFromMeshes(meshes), defaultCamera(s, 63, 47, lookAt({0, 0, 0}, target, 90.0)), 63, 47);
+        const Agreement a = expectAgreesWithBrute(frame, "inside box, towards " + std::to_string(target.x) + "," +
+                                                             std::to_string(target.y) + "," + std::to_string(target.z));
+        EXPECT_EQ(a.bruteHits, frame.rays.size());
+    }
+    // A closed curved mesh from its centre, the centre ray aimed at one of the icosahedron's
+    // original vertices, where five triangles meet.
+    const std::vector<Mesh> sphere = {icosphere({0, 0, 0}, 1.0f, 4)};
+    const Scene sphereScene = sceneFromMeshes(sphere);
+    const double golden = (1.0 + std::sqrt(5.0)) / 2.0;
+    const Frame inside(sceneFromMeshes(sphere),
+                       defaultCamera(sphereScene, 81, 61, lookAt({0, 0, 0}, {-1, golden, 0}, 110.0)), 81, 61);
+    const Agreement a = expectAgreesWithBrute(inside, "inside icosphere");
+    EXPECT_EQ(a.bruteHits, inside.rays.size());
+}
+
+TEST(EmbreeAgreesWithBrute, CoincidentAndZeroAreaTriangles) {
+    // Five coincident quads (every hit a tie), a nearer half quad, and a zero-area sliver in
+    // front of everything that must never be hit.
+    std::vector<Mesh> meshes(5, grid({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 1, 1));
+    meshes[3] = grid({-1, -1, 0.5f}, {2, 0, 0}, {0, 2, 0}, 1, 1);
+    meshes[3].positions[1].x = 0.0f;
+    meshes[3].positions[3].x = 0.0f;
+    Mesh sliver;
+    sliver.positions = {{-2, -2, 1}, {2, 2, 1}, {0, 0, 1}};
+    sliver.indices = {0, 1, 2};
+    meshes.push_back(sliver);
+    const Scene s = sceneFromMeshes(meshes);
+    const Frame frame(sceneFromMeshes(meshes), defaultCamera(s, 16, 16, lookAt({0, 0, 5}, {0, 0, 0}, 20.0)), 16, 16);
+    const Agreement a = expectAgreesWithBrute(frame, "coincident and zero-area");
+    EXPECT_EQ(a.bruteHits, frame.rays.size());
+    // Stated on its own because a sliver hit could also hide among the ties above.
+    EmbreeOptions options;
+    ThreadPool pool(1);
+    for (const Hit& h : traceEmbree(frame.geometry, options, pool).hits) EXPECT_NE(h.prim, 10u);
+}
+
+TEST(EmbreeScene, EmptyTriangleListMissesEveryRay) {
+    const Scene s = test::shapesScene();
+    const std::vector<Ray> rays = primaryRays(defaultCamera(s, 32, 24), 32, 24);
+    const std::vector<Triangle> none;
+    ThreadPool pool(2);
+    const EmbreeScene scene(none, EmbreeOptions{});
+    const TraceResult r = scene.trace(rays, pool);
+    ASSERT_EQ(r.hits.size(), rays.size());
+    for (const Hit& h : r.hits) {
+        EXPECT_EQ(h.prim, kMissPrim);
+        EXPECT_EQ(h.t, kNoHitT);
+        EXPECT_EQ(h.u, 0.0f);
+        EXPECT_EQ(h.v, 0.0f);
+    }
+}
+
+TEST(EmbreeScene, ReportsBuildAndTraceTimes) {
+    const Scene s = test::shapesScene();
+    const Frame frame(test::shapesScene(), defaultCamera(s, 48, 36), 48, 36);
+    ThreadPool pool(2);
+    const EmbreeScene scene(frame.scene.triangles, EmbreeOptions{});
+    EXPECT_GE(scene.buildMs(), 0.0);
+    const TraceResult traced = scene.trace(frame.rays, pool);
+    ASSERT_EQ(traced.phaseMs.size(), 1u);
+    EXPECT_EQ(traced.phaseMs[0].first, "trace");
+    EXPECT_EQ(traced.threads, 2u);
+
+    const TraceResult r = traceEmbree(frame.geometry, EmbreeOptions{}, pool);
+    ASSERT_EQ(r.phaseMs.size(), 2u);
+    EXPECT_EQ(r.phaseMs[0].first, "build");
+    EXPECT_EQ(r.phaseMs[1].first, "trace");
+    for (const auto& [phase, ms] : r.phaseMs) EXPECT_GE(ms, 0.0) << phase;
+    EXPECT_EQ(r.threads, 2u);
+    EXPECT_EQ(r.regions, 1u);
+    EXPECT_EQ(r.axis, -1);
+    EXPECT_EQ(r.hits.size(), frame.rays.size());
+    EXPECT_GT(hitCount(r.hits), frame.rays.size() / 20);
+}
+
+TEST(EmbreeScene, OneAndTwoThreadsGiveIdenticalHits) {
+    // Large enough (about 25k triangles) that Embree's builder splits the work between threads.
+    std::vector<Mesh> meshes = {icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 5), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 80, 32),
+                                grid({-2, -1, 2}, {4, 0, 0}, {0, 0, -4}, 24, 24)};
+    const Scene s = sceneFromMeshes(meshes);
+    const Frame frame(sceneFromMeshes(meshes), defaultCamera(s, 128, 96), 128, 96);
+    for (bool robust : {true, false}) {
+        std::vector<Hit> hits[2];
+        for (unsigned threads : {1u, 2u}) {
+            EmbreeOptions options;
+            options.robust = robust;
+            options.threads = threads;
+            ThreadPool pool(threads);
+            const TraceResult r = traceEmbree(frame.geometry, options, pool);
+            EXPECT_EQ(r.threads, threads);
+            hits[threads - 1] = r.hits;
+        }
+        ASSERT_EQ(hits[0].size(), frame.rays.size());
+        ASSERT_EQ(hits[1].size(), frame.rays.size());
+        EXPECT_GT(hitCount(hits[0]), frame.rays.size() / 20);
+        std::size_t differing = 0;
+        for (std::size_t i = 0; i < hits[0].size(); ++i) differing += !bitIdentical(hits[0][i], hits[1][i]);
+        EXPECT_EQ(differing, 0u) << (robust ? "robust" : "not robust");
+    }
+}

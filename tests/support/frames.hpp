@@ -1,0 +1,76 @@
+#pragma once
+// Frames built from scenes for the tracer tests, and hit comparison.
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/camera.hpp"
+#include "core/scene.hpp"
+#include "dacrt/cpu_tracers.hpp"
+#include "support/fixtures.hpp"
+
+namespace dacrt::test {
+
+// A scene, its bounds and one camera's rays: everything a tracer reads.
+struct Frame {
+    Scene scene;
+    std::vector<Bounds> bounds;
+    std::vector<Ray> rays;
+    FrameGeometry geometry;
+    int width = 0, height = 0;
+
+    Frame(Scene s, const Camera& camera, int w, int h) : scene(std::move(s)), width(w), height(h) { prepare(camera); }
+    // The scene's own default camera with `options` applied, made after the scene is moved in.
+    Frame(Scene s, int w, int h, const CameraOptions& options) : scene(std::move(s)), width(w), height(h) {
+        prepare(makeCameras(scene, sceneBounds(scene.triangles), options, double(w) / double(h)).front());
+    }
+    Frame(const Frame&) = delete;
+
+    TraceResult trace(Backend backend, unsigned regions = 0, unsigned threads = 1,
+                      DivisionAxis axis = DivisionAxis::Best) const {
+        TraceOptions o;
+        o.backend = backend;
+        o.regions = regions;
+        o.threads = threads;
+        o.axis = axis;
+        ThreadPool pool(threads);
+        return traceCpu(geometry, o, pool);
+    }
+
+private:
+    void prepare(const Camera& camera) {
+        bounds = allTriangleBounds(scene.triangles);
+        rays = primaryRays(camera, width, height);
+        geometry = frameGeometry(scene.triangles, bounds, rays, sceneBounds(scene.triangles));
+    }
+};
+
+inline Camera defaultCamera(const Scene& scene, int w, int h, CameraOptions options = {}) {
+    return makeCameras(scene, sceneBounds(scene.triangles), options, double(w) / double(h)).front();
+}
+
+// Primitive id and depth identical bit for bit; reports the first few differing pixels.
+inline ::testing::AssertionResult identicalHits(const std::vector<Hit>& a, const std::vector<Hit>& b) {
+    if (a.size() != b.size()) return ::testing::AssertionFailure() << "sizes " << a.size() << " and " << b.size();
+    std::size_t differing = 0;
+    std::string examples;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        if (a[i].prim == b[i].prim && std::memcmp(&a[i].t, &b[i].t, sizeof(float)) == 0) continue;
+        if (++differing <= 5)
+            examples += " [pixel " + std::to_string(i) + ": prim " + std::to_string(a[i].prim) + " t " +
+                        std::to_string(a[i].t) + " vs prim " + std::to_string(b[i].prim) + " t " +
+                        std::to_string(b[i].t) + "]";
+    }
+    if (differing == 0) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << differing << " differing pixels:" << examples;
+}
+
+inline std::size_t hitCount(const std::vector<Hit>& hits) {
+    std::size_t n = 0;
+    for (const Hit& h : hits) n += h.prim != kMissPrim;
+    return n;
+}
+
+}  // namespace dacrt::test

@@ -1,0 +1,104 @@
+#!/usr/bin/env python3
+"""Markdown tables for docs/benchmarks.md from the JSON that `dacrt bench` writes."""
+import json
+import sys
+
+
+def fmt_psnr(v):
+    return "inf" if v == "inf" else f"{v:.1f}"
+
+
+def sweep(path):
+    j = json.load(open(path))
+    print("| series | config | min ms | median ms | Mrays/s | real errors | near ties | leaks (real) | max rel depth | PSNR dB | Pareto |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+    for r in j["rows"]:
+        name = r["config"] + (" **(default)**" if r["default"] else "")
+        print(f"| {r['series']} | {name} | {r['frame_ms_min']:.1f} | {r['frame_ms_median']:.1f} | "
+              f"{r['mrays_per_s']:.2f} | {r['real_errors']} | {r['near_ties']} | {r['leaks']} ({r['real_leaks']}) | "
+              f"{r['depth_rel_max']:.1e} | {fmt_psnr(r['psnr_db'])} | {'yes' if r['pareto'] else 'no'} |")
+
+
+SOURCE = {  # Table 5.1 of the source: speedup over sequential DACRT, 4-core i7-4700MQ at 2.4 GHz
+    "bunny": {"2": "1.49x", "4": "2.42x", "4+4": "2.42x"},
+    "dragon": {"2": "1.21x", "4": "1.84x", "4+4": "1.96x"},
+}
+
+
+def table51(path):
+    j = json.load(open(path))
+    rows = {(r["scene"], r["series"], r["config"]): r for r in j["rows"]}
+    scenes = list(dict.fromkeys(r["scene"] for r in j["rows"]))
+    print("| model | threads, regions | source: speedup (4 cores) | dacrt cpu: speedup (2 cores) | cpu frame ms |")
+    print("|---|---|---:|---:|---:|")
+    setups = [("sequential DACRT", None, "1x"), ("1, 1", "threads=1 regions=1", None),
+              ("2, 2", "threads=2 regions=2", "2"), ("4, 4", "threads=4 regions=4", "4"),
+              ("1, 2 (2 per thread)", "threads=1 regions=2", None),
+              ("2, 4 (2 per thread)", "threads=2 regions=4", None),
+              ("4, 8 (2 per thread; the source's 4+4 is 8 threads on 4 cores)", "threads=4 regions=8", "4+4")]
+    for s in scenes:
+        for label, cpu, src in setups:
+            source = "1x" if src == "1x" else SOURCE.get(s, {}).get(src, "-") if src else "-"
+            c = rows[(s, "cpu-seq", "default")] if cpu is None else rows[(s, "cpu", cpu + " axis=best")]
+            print(f"| {s} | {label} | {source} | {c['speedup_over_cpu_seq']:.2f}x | {c['frame_ms_min']:.1f} |")
+
+
+def table51_gpu(path):
+    j = json.load(open(path))
+    print("| model | regions | gpu speedup over cpu-seq | gpu frame ms | gpu / cpu (2 threads, 2 regions) |")
+    print("|---|---:|---:|---:|---:|")
+    rows = {(r["scene"], r["series"], r["config"]): r for r in j["rows"]}
+    for r in j["rows"]:
+        if r["series"] != "gpu" or not r["config"].endswith("axis=best"):
+            continue
+        cpu = rows[(r["scene"], "cpu", "threads=2 regions=2 axis=best")]
+        print(f"| {r['scene']} | {r['regions']} | {r['speedup_over_cpu_seq']:.2f}x | {r['frame_ms_min']:.1f} | "
+              f"{r['frame_ms_min'] / cpu['frame_ms_min']:.1f}x |")
+
+
+def figure53(path):
+    j = json.load(open(path))
+    print("| model | backend | setup | best | x | y | z (towards the camera) | best over the worse of x, y |")
+    print("|---|---|---|---:|---:|---:|---:|---:|")
+    groups = {}
+    for r in j["rows"]:
+        if r["series"] == "cpu-seq" or "axis=" not in r["config"]:
+            continue
+        setup, axis = r["config"].rsplit(" axis=", 1)
+        groups.setdefault((r["scene"], r["series"], setup), {})[axis] = r
+    for (scene, series, setup), g in groups.items():
+        if len(g) < 4:
+            continue
+        sp = {a: g[a]["speedup_over_cpu_seq"] for a in g}
+        worst_inface = min(sp["x"], sp["y"])
+        print(f"| {scene} | {series} | {setup} | {sp['best']:.2f}x | {sp['x']:.2f}x | {sp['y']:.2f}x | {sp['z']:.2f}x | "
+              f"{(sp['best'] / worst_inface - 1) * 100:+.0f}% |")
+
+
+KINDS = {"sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
+
+
+def update(doc):
+    """Regenerates every block between <!-- bench-table KIND FILE --> and <!-- /bench-table -->."""
+    import contextlib
+    import io
+    import os
+    import re
+    text = open(doc).read()
+    data = os.path.join(os.path.dirname(os.path.abspath(doc)), "bench")  # docs/bench beside docs/benchmarks.md
+
+    def table(match):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            KINDS[match.group(1)](os.path.join(data, match.group(2)))
+        return f"<!-- bench-table {match.group(1)} {match.group(2)} -->\n{out.getvalue()}<!-- /bench-table -->"
+
+    text = re.sub(r"<!-- bench-table (\S+) (\S+) -->\n.*?<!-- /bench-table -->", table, text, flags=re.S)
+    open(doc, "w").write(text)
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "update":
+        update(sys.argv[2])
+    else:
+        KINDS[sys.argv[1]](sys.argv[2])
