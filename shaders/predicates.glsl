@@ -5,6 +5,8 @@
 #ifndef DACRT_PREDICATES_GLSL
 #define DACRT_PREDICATES_GLSL
 
+#include "triangle_rules.glsl"
+
 // 2 * gamma(3), gamma(n) = n u / (1 - n u), u = 2^-24 (Pharr, Jakob, Humphreys; Ize 2013):
 // the relative error bound of (bound - origin) * invDir, doubled to absorb the rounding of
 // the widening itself.
@@ -87,11 +89,20 @@ struct TriangleHit {
     float v;
 };
 
+// 2^-20: sixteen units in the last place. The sheared vertex coordinates are within a few
+// units of their magnitude of the exact ones, so a ray that truly meets the triangle is never
+// farther than this from the box of its projected vertices.
+const float kProjectionSlack = 9.5367431640625e-07;
+
 // Watertight ray/triangle test (Woop, Benthin, Wald 2013) in single precision, without the
 // double-precision fallback so that every backend runs the same arithmetic. Edge values of
 // a shared edge are exact negations of each other (a*b - c*d versus c*d - a*b), and zero
 // counts as inside, so no ray passes between two triangles that share an edge.
-// Degenerate (zero-area or edge-on) triangles give det == 0 and never hit.
+// Never a hit: triangles with no area (triangleHasNoArea), edge-on ones (det == 0), and those
+// whose projection along the ray leaves the ray outside the box of its projected vertices.
+// The last happens only through rounding: for a sliver seen nearly end-on, the edge values
+// are tiny products' differences whose rounding can pass the sign test while the ray passes
+// far from the triangle (docs/correctness.md, "Degenerate and sliver triangles").
 TriangleHit intersectWatertight(IN(Ray) ray, vec3 p0, vec3 p1, vec3 p2) {
     TriangleHit h;
     h.hit = false;
@@ -116,6 +127,13 @@ TriangleHit intersectWatertight(IN(Ray) ray, vec3 p0, vec3 p1, vec3 p2) {
     if ((eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0)) return h;
     precise float det = eu + ev + ew;
     if (det == 0.0) return h;
+    precise float reach = max(max(max(abs(a.x), abs(a.y)), max(abs(a.z), abs(b.x))),
+                              max(max(abs(b.y), abs(b.z)), max(max(abs(c.x), abs(c.y)), abs(c.z))));
+    precise float slack = reach * kProjectionSlack;
+    if (min(ax, min(bx, cx)) > slack || max(ax, max(bx, cx)) < -slack || min(ay, min(by, cy)) > slack ||
+        max(ay, max(by, cy)) < -slack)
+        return h;
+    if (triangleHasNoArea(p0, p1, p2)) return h;
     precise float az = ray.shear.z * a[kz];
     precise float bz = ray.shear.z * b[kz];
     precise float cz = ray.shear.z * c[kz];

@@ -4,23 +4,17 @@
 #include <fstream>
 #include <iostream>
 
-#include <unistd.h>
-
 #include "cmd/exit_codes.hpp"
 #include "cmd/render_stats.hpp"
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
 #include "core/image_io.hpp"
 #include "core/shading.hpp"
+#include "core/system_memory.hpp"
 #include "core/timing.hpp"
 
 namespace dacrt {
 namespace {
-
-std::uint64_t physicalMemoryBytes() {
-    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-    return pages > 0 && pageSize > 0 ? std::uint64_t(pages) * std::uint64_t(pageSize) : 0;
-}
 
 void checkRenderOptions(const RenderOptions& o) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)

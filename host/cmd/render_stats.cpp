@@ -16,6 +16,7 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     j["backend"] = toString(trace.backend);
     j["scene"] = o.scenePath;
     j["triangles"] = scene.triangleCount();
+    j["triangles_dropped_degenerate"] = scene.degenerateTrianglesDropped;
     j["rays"] = frame.rayCount;
     j["width"] = o.width;
     j["height"] = o.height;

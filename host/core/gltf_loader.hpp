@@ -1,12 +1,28 @@
 #pragma once
+// The load stage: a glTF 2.0 file's default scene flattened into world-space triangles.
+#include <cstdint>
+#include <span>
 #include <string>
 
 #include "core/scene.hpp"
 
 namespace dacrt {
 
+struct GltfLimits {
+    std::uint64_t maxBytes = 0;            // memory the flattened scene may take; 0: this machine's memory
+    std::uint32_t maxHierarchyDepth = 1024;  // node levels below a scene's root
+    std::uint32_t maxJsonNesting = 256;      // objects and arrays inside one another, checked before parsing
+};
+
 // Loads the default scene of a glTF 2.0 file (.gltf or .glb) and flattens every triangle
-// primitive into world space. Bad files throw InputError naming the file and the problem.
-Scene loadGltf(const std::string& path);
+// primitive into world space, dropping triangles with no area (counted in
+// Scene::degenerateTrianglesDropped). Bad files throw InputError naming the file and the
+// problem, before anything large is allocated (docs/gltf-input.md lists the rules).
+Scene loadGltf(const std::string& path, const GltfLimits& limits = {});
+
+// The same from bytes in memory (a .glb, or the text of a .gltf); `name` stands for the file in
+// messages. External files (buffers by uri) are never read from memory input: only embedded
+// data URIs and the .glb binary chunk.
+Scene loadGltfFromMemory(std::span<const unsigned char> bytes, const std::string& name, const GltfLimits& limits = {});
 
 }  // namespace dacrt

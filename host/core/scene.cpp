@@ -37,7 +37,12 @@ std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles) {
 }
 
 void validateScene(const Scene& scene) {
-    if (scene.triangles.empty()) throw InputError(scene.name + ": the scene has no triangles");
+    if (scene.triangles.empty())
+        throw InputError(scene.name + ": the scene has no triangles" +
+                         (scene.degenerateTrianglesDropped
+                              ? " that can be hit (all " + std::to_string(scene.degenerateTrianglesDropped) +
+                                    " have no area and were dropped)"
+                              : std::string()));
     if (scene.triangles.size() >= kMissPrim)
         throw InputError(scene.name + ": too many triangles for 32-bit primitive ids");
     for (std::size_t i = 0; i < scene.triangles.size(); ++i) {

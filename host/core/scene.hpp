@@ -41,6 +41,7 @@ struct Scene {
     std::vector<std::uint32_t> materialOfTriangle;  // index into materials
     std::vector<Material> materials;
     std::optional<SceneCamera> camera;              // the first perspective camera found
+    std::uint64_t degenerateTrianglesDropped = 0;   // no area (triangleHasNoArea), dropped at load
 
     std::size_t triangleCount() const { return triangles.size(); }
 };

@@ -20,6 +20,7 @@ namespace dacrt {
 inline shared::TriangleHit intersectMollerTrumbore(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1,
                                                    const glm::vec3& p2) {
     shared::TriangleHit h{false, kNoHitT, 0.0f, 0.0f};
+    if (shared::triangleHasNoArea(p0, p1, p2)) return h;
     const glm::vec3 e1 = p1 - p0, e2 = p2 - p0;
     const glm::vec3 p = glm::cross(ray.dir, e2);
     const float det = glm::dot(e1, p);
@@ -80,6 +81,15 @@ inline TriangleHitF64 intersectWatertightF64(const RayF64& ray, const glm::vec3&
     if ((eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0)) return h;
     const double det = eu + ev + ew;
     if (det == 0.0) return h;
+    // The float32 test's rules, with float64's slack: no area, or the ray outside the box of
+    // the projected vertices (docs/correctness.md).
+    const double reach = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z), std::abs(b.x), std::abs(b.y),
+                                   std::abs(b.z), std::abs(c.x), std::abs(c.y), std::abs(c.z)});
+    const double slack = reach * 0x1p-49;
+    if (std::min({ax, bx, cx}) > slack || std::max({ax, bx, cx}) < -slack || std::min({ay, by, cy}) > slack ||
+        std::max({ay, by, cy}) < -slack)
+        return h;
+    if (shared::triangleHasNoArea(p0, p1, p2)) return h;
     const double tScaled = ray.shear.z * (eu * a[ray.kz] + ev * b[ray.kz] + ew * c[ray.kz]);
     if (det > 0.0 ? tScaled <= 0.0 : tScaled >= 0.0) return h;
     h.hit = true;

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/cli_support.hpp"
+#include "support/hostile_gltf.hpp"
 #include "support/frames.hpp"
 
 namespace {
@@ -166,3 +167,26 @@ TEST(Cli, UnknownDeviceIsAnErrorListingTheChoices) {
     EXPECT_EQ(r.code, 2) << r.output;
     EXPECT_NE(r.output.find("matches no Vulkan device; the choices are"), std::string::npos) << r.output;
 }
+
+namespace {
+
+class CliHostileGltf : public ::testing::TestWithParam<dacrt::test::HostileGltf> {};
+
+}  // namespace
+
+// Every hostile file of the loader's tests, as a user would meet it: exit 2, one line naming the
+// file and the problem, and no output written.
+TEST_P(CliHostileGltf, ExitsWith2AndOneLineAndWritesNothing) {
+    const std::string path = dacrt::test::writeHostileGltf(GetParam());
+    const std::string out = ::testing::TempDir() + "/dacrt_hostile_out_" + GetParam().name + ".png";
+    std::filesystem::remove(out);
+    const CommandResult r = dacrt::test::runDacrt("render " + path + " --backend cpu --size 64x48 -o " + out);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_EQ(r.output.rfind("dacrt: error: " + path + ": ", 0), 0u) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_NE(r.output.find(GetParam().expected), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, CliHostileGltf, ::testing::ValuesIn(dacrt::test::hostileGltfFiles()),
+                         [](const ::testing::TestParamInfo<dacrt::test::HostileGltf>& info) { return info.param.name; });

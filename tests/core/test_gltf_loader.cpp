@@ -73,12 +73,35 @@ TEST(GltfLoader, BinaryFanU32) {
     expectVertex(s.triangles[1].v2, -1, 1, 0);
 }
 
-TEST(GltfLoader, ZeroAreaTrianglesAreKept) {
+TEST(GltfLoader, ZeroAreaTrianglesAreDroppedAndCounted) {
     std::vector<Mesh> meshes = {grid({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1, 1)};
-    meshes[0].indices.insert(meshes[0].indices.end(), {0, 0, 1});
+    meshes[0].indices.insert(meshes[0].indices.end(), {0, 0, 1});  // two equal vertices
+    meshes[0].positions.push_back({2, 2, 0});
+    meshes[0].positions.push_back({3, 3, 0});
+    meshes[0].positions.push_back({4, 4, 0});
+    const std::uint32_t n = std::uint32_t(meshes[0].positions.size());
+    meshes[0].indices.insert(meshes[0].indices.end(), {n - 3, n - 2, n - 1});  // collinear
     const std::string path = ::testing::TempDir() + "/degenerate.gltf";
     writeGltf(path, meshes, std::nullopt);
-    EXPECT_EQ(loadGltf(path).triangleCount(), 3u);
+    const Scene s = loadGltf(path);
+    EXPECT_EQ(s.triangleCount(), 2u);
+    EXPECT_EQ(s.degenerateTrianglesDropped, 2u);
+    // Provenance still names the triangles as the file numbers them.
+    EXPECT_EQ(s.sources[1].triangle, 1u);
+}
+
+TEST(GltfLoader, ASceneOfOnlyDegenerateTrianglesIsRefusedWithTheCount) {
+    Mesh m;
+    m.positions = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
+    m.indices = {0, 1, 2, 0, 0, 1};
+    const std::string path = ::testing::TempDir() + "/all_degenerate.gltf";
+    writeGltf(path, {m}, std::nullopt);
+    try {
+        loadGltf(path);
+        FAIL() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("all 2 have no area"), std::string::npos) << e.what();
+    }
 }
 
 struct BadFile {

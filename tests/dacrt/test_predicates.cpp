@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/camera.hpp"
+#include "core/procedural.hpp"
 #include "core/random.hpp"
 #include "dacrt/frame_geometry.hpp"
 #include "dacrt/predicates.hpp"
@@ -134,6 +135,75 @@ TEST(Watertight, DegenerateTrianglesNeverHitAndNeverGiveNaN) {
     EXPECT_FLOAT_EQ(h.t, 5.0f);
     EXPECT_FLOAT_EQ(h.u, 0.2f);
     EXPECT_FLOAT_EQ(h.v, 0.2f);
+}
+
+// A zero-area triangle (three collinear vertices in float32) on the very line of the ray:
+// the sign test passes on rounding residues, the ray really meets the segment, so only the
+// degenerate-triangle rule keeps it from being hit. Found by a search over random rays aimed
+// at such segments; removing triangleHasNoArea from intersectWatertight makes this fail.
+TEST(Watertight, AZeroAreaTriangleOnTheRaysLineIsNeverHit) {
+    const glm::vec3 origin{0x1.88db66p-4f, 0x1.b89234p-8f, 0x1.4p+2f};
+    const glm::vec3 p0{-0x1.6865dp-2f, -0x1.855a4p-4f, 0x1.83117cp-1f};
+    const glm::vec3 p1{-0x1.7edc1ap-2f, -0x1.99c564p-4f, 0x1.18a442p-1f};
+    const glm::vec3 p2{-0x1.880e0ap-2f, -0x1.a2212cp-4f, 0x1.da265p-2f};
+    const Ray ray = makeRay(origin, glm::dvec3(p0) - glm::dvec3(origin));
+    EXPECT_TRUE(shared::triangleHasNoArea(p0, p1, p2));
+    EXPECT_FALSE(shared::intersectWatertight(ray, p0, p1, p2).hit);
+}
+
+// The defect found on a scanned mesh: a sliver one unit in the last place wide, seen end-on
+// from the default front view, "hit" by a ray that passes about 10 units away (the edge values
+// are tiny multiples of one another and their rounding passes the sign test). It has area, so
+// the degenerate rule does not apply; the projected-box rule rejects it. Brute force reported
+// such hits, and every DACRT backend, which never brings that ray and that triangle together,
+// missed them.
+TEST(Watertight, AnEndOnSliverFarFromTheRayIsNeverHit) {
+    const Scene s = sceneFromMeshes({box({-20, -20, -1}, {20, 20, 1})});
+    CameraOptions view;
+    view.eye = glm::dvec3(0, 16.0109, 60.4142);
+    view.target = glm::dvec3(0, 16.0109, 59.4142);
+    view.fovDegrees = 45;
+    const std::vector<Ray> rays = primaryRays(makeCameras(s, sceneBounds(s.triangles), view, 160.0 / 120.0)[0], 160, 120);
+    const glm::vec3 p0{0x1.91c3p+3f, 0x1.10341p+2f, 0x1.0cdff8p-1f};
+    const glm::vec3 p1{0x1.91c302p+3f, 0x1.10341p+2f, 0x1.1a03fp-3f};
+    const glm::vec3 p2{0x1.91c3p+3f, 0x1.10341p+2f, -0x1.6e537p-4f};
+    EXPECT_FALSE(shared::triangleHasNoArea(p0, p1, p2));
+    EXPECT_FALSE(shared::intersectWatertight(rays[4848], p0, p1, p2).hit);
+}
+
+// The same search at scale: segments along the view axis (x and y shared exactly, zero area)
+// and slivers one unit in the last place off them, across a whole image. A hit is allowed only
+// where the ray passes through the triangle's bounds (up to rounding), never far away.
+TEST(Watertight, EndOnSegmentsAndSliversAreHitOnlyWhereTheRayMeetsThem) {
+    const Scene s = sceneFromMeshes({box({-20, -20, -1}, {20, 20, 1})});
+    CameraOptions view;
+    view.eye = glm::dvec3(0, 16.0109, 60.4142);
+    view.target = glm::dvec3(0, 16.0109, 59.4142);
+    view.fovDegrees = 45;
+    const std::vector<Ray> rays = primaryRays(makeCameras(s, sceneBounds(s.triangles), view, 4.0 / 3.0)[0], 80, 60);
+    Random random(12);
+    std::size_t zeroAreaHits = 0, farHits = 0, slivers = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const float x = random.uniformFloat(-20.0f, 20.0f), y = random.uniformFloat(-20.0f, 20.0f);
+        const glm::vec3 p0{x, y, random.uniformFloat(-1.0f, 1.0f)};
+        glm::vec3 p1{x, y, random.uniformFloat(-1.0f, 1.0f)};
+        const glm::vec3 p2{x, y, random.uniformFloat(-1.0f, 1.0f)};
+        if (i % 2) p1.x = std::nextafter(p1.x, 100.0f);
+        const bool noArea = shared::triangleHasNoArea(p0, p1, p2);
+        slivers += !noArea;
+        const glm::vec3 lo = glm::min(p0, glm::min(p1, p2)), hi = glm::max(p0, glm::max(p1, p2));
+        for (const Ray& r : rays) {
+            const shared::TriangleHit h = shared::intersectWatertight(r, p0, p1, p2);
+            if (!h.hit) continue;
+            zeroAreaHits += noArea;
+            const glm::dvec3 at = glm::dvec3(r.origin) + double(h.t) * glm::dvec3(r.dir);
+            const glm::dvec3 outside = glm::max(glm::max(glm::dvec3(lo) - at, at - glm::dvec3(hi)), glm::dvec3(0.0));
+            farHits += glm::length(outside) > 1e-3;
+        }
+    }
+    EXPECT_GT(slivers, 1000u);
+    EXPECT_EQ(zeroAreaHits, 0u);
+    EXPECT_EQ(farHits, 0u);
 }
 
 TEST(TieRule, SmallerTWinsThenSmallerPrimitive) {

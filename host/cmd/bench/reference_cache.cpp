@@ -8,7 +8,7 @@
 namespace dacrt {
 
 // Bumped whenever the reference tracer's answers could change, so stale caches are ignored.
-constexpr const char* kReferenceVersion = "reference-v1";
+constexpr const char* kReferenceVersion = "reference-v2";
 
 std::uint64_t fnv1a(const void* data, std::size_t bytes) {
     std::uint64_t h = 1469598103934665603ull;

@@ -81,9 +81,9 @@ std::vector<Mesh> roomWithShapes() {
 
 // Pinhole rays of an odd-sized image, so that the centre row and column have exactly zero
 // components: they travel inside the planes through the camera.
-void addPinhole(RayFan& fan, const glm::dvec3& forward, const glm::dvec3& up, int width, int height) {
+void addPinhole(RayFan& fan, const glm::dvec3& forward, const glm::dvec3& up, int width, int height, double fovDegrees) {
     const glm::dvec3 right = glm::normalize(glm::cross(forward, up));
-    const double tanHalf = std::tan(0.5 * glm::radians(70.0));
+    const double tanHalf = std::tan(0.5 * glm::radians(fovDegrees));
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
             const double sx = (2.0 * (x + 0.5) / width - 1.0) * tanHalf * double(width) / height;

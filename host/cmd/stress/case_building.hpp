@@ -51,6 +51,7 @@ std::vector<Mesh> splitPlaneGrids();
 std::vector<Mesh> roomWithShapes();
 // Pinhole rays of an odd-sized image, so that the centre row and column have exactly zero
 // components: they travel inside the planes through the camera.
-void addPinhole(RayFan& fan, const glm::dvec3& forward, const glm::dvec3& up, int width, int height);
+void addPinhole(RayFan& fan, const glm::dvec3& forward, const glm::dvec3& up, int width, int height,
+                double fovDegrees = 70.0);
 
 }  // namespace dacrt::stress

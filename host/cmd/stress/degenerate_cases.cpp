@@ -1,6 +1,7 @@
 // The stress suite's degenerate-geometry family (docs/stability.md).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -137,11 +138,93 @@ std::vector<StressCase> degenerateCasesImpl(StressSize size, Random& random) {
     return out;
 }
 
+// Whether float32 resolves a room of half-size `scale` at `offset`: thousands of units in
+// the last place across it.
+bool resolvable(double scale, const glm::dvec3& offset) {
+    const double magnitude = std::max({std::abs(offset.x), std::abs(offset.y), std::abs(offset.z)}) + 2.0 * scale;
+    return scale >= 4096.0 * std::ldexp(1.0, std::ilogb(magnitude) - 23);
+}
+
+// One step of float32 towards +infinity on one coordinate: a zero-area triangle becomes a
+// sliver whose area is representable.
+glm::vec3 nudged(glm::vec3 p, int axis) {
+    p[axis] = std::nextafter(p[axis], std::numeric_limits<float>::infinity());
+    return p;
+}
+
+// Degenerate and nearly degenerate triangles, and rays that meet their supporting lines far
+// beyond their ends: the shape of the defect found on a scanned mesh (docs/stability.md). For
+// such a ray the exact edge values are tiny multiples of one another, so their rounding
+// decides the sign test; without the predicate's rules the "hit" lands far from the triangle,
+// where no DACRT cell brings the two together. Segments along the rays' directions and across
+// them, points, pairs of equal vertices, and slivers one unit in the last place wide, in a
+// closed room, at every scale and offset of the watertightness family. Rays from inside the
+// room must hit it; rays from outside are compared with brute force only.
+void addEndOnCases(std::vector<StressCase>& out, StressSize size, Random& random) {
+    const bool large = size == StressSize::Large;
+    const int count = large ? 1200 : 120;
+    const glm::dvec3 direction(1.0, -0.7, 0.4);
+    for (double scale : {1e-4, 1e-2, 1.0, 1e2, 1e4, 1e6})
+        for (double offset : {0.0, 1e2, 1e4, 1e6}) {
+            const glm::dvec3 shift = direction * offset;
+            if (!resolvable(scale, shift)) continue;
+            auto at = [&](const glm::dvec3& unit) { return glm::vec3(unit * scale + shift); };
+            // Inside the room, and far outside it (as the scan's default front view was).
+            const std::vector<std::pair<glm::dvec3, bool>> eyes = {{{0.1, 0.2, -0.3}, true}, {{0.05, 0.27, 30.0}, false}};
+            for (std::size_t k = 0; k < eyes.size(); ++k) {
+                const auto& [eye, inside] = eyes[k];
+                StressCase c{"degenerate", "end-on scale " + number(scale) + " offset " + number(offset) + " from " +
+                                               std::to_string(k),
+                             {}, {}, {}, {}};
+                Mesh walls = room();
+                for (glm::vec3& p : walls.positions) p = at(glm::dvec3(p));
+                c.triangles = trianglesOf({walls});
+                const glm::vec3 origin = at(eye);
+                RayFan fan(c, origin, inside);
+                for (int i = 0; i < count; ++i) {
+                    const glm::dvec3 p = random.inBox(-0.9, 0.9);
+                    // Along: nearly the direction from the eye; across: any direction.
+                    glm::dvec3 v = i % 2 == 0 ? glm::normalize(p - eye) + random.onSphere() * 1e-3 : random.onSphere();
+                    v *= random.uniform(0.02, 0.2);
+                    Triangle t{};
+                    switch (i % 8) {
+                        case 0:
+                        case 1: t = {at(p), 0, at(p + v), 0, at(p + 0.4 * v), 0}; break;              // collinear
+                        case 2: t = {at(p), 0, at(p), 0, at(p), 0}; break;                             // a point
+                        case 3: t = {at(p), 0, at(p), 0, at(p + v), 0}; break;                         // two equal
+                        default: t = {at(p), 0, nudged(at(p + v), i % 3), 0, at(p + 0.4 * v), 0};     // sliver
+                    }
+                    c.triangles.push_back(t);
+                    // Rays through the supporting line beyond both ends, and one through the middle.
+                    for (double lambda : {-1.5, -0.3, 0.5, 1.4, 3.0}) fan.towards(p * scale + shift + lambda * scale * v);
+                }
+                // Segments along a coordinate axis (all three vertices share the other two
+                // coordinates exactly, as a scan's vertical "stalactites" do), and slivers one unit
+                // in the last place off them, under a whole pinhole image: where the scanned mesh
+                // failed.
+                for (int i = 0; i < count * 8; ++i) {
+                    const glm::dvec3 p = random.inBox(-0.9, 0.9);
+                    const int axis = i % 4 == 3 ? i % 3 : 2;  // mostly along the view axis
+                    glm::dvec3 step(0.0);
+                    step[axis] = random.uniform(-0.02, 0.02);
+                    const glm::dvec3 step2 = step * random.uniform(-1.0, 1.0);
+                    glm::vec3 middle = at(p + step2);
+                    if (i % 2 == 1) middle = nudged(middle, (axis + 1) % 3);
+                    c.triangles.push_back({at(p), 0, middle, 0, at(p + step), 0});
+                }
+                addPinhole(fan, glm::normalize(-eye), {0, 1, 0}, large ? 161 : 49, large ? 121 : 37, inside ? 70.0 : 4.0);
+                out.push_back(std::move(c));
+            }
+        }
+}
+
 }  // namespace
 
 std::vector<StressCase> degenerateCases(StressSize size, std::uint64_t seed) {
     Random random(seed + 2);
-    return degenerateCasesImpl(size, random);
+    std::vector<StressCase> out = degenerateCasesImpl(size, random);
+    addEndOnCases(out, size, random);
+    return out;
 }
 
 }  // namespace dacrt

@@ -1,0 +1,119 @@
+#pragma once
+// Hostile glTF files, each built from the valid tests/scenes/quad_u8_camera.gltf by one
+// change, with the part of the message that must name its problem. Used by the loader's
+// tests and, through `dacrt render`, by the command-line tests.
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "support/fixtures.hpp"
+
+namespace dacrt::test {
+
+struct HostileGltf {
+    std::string name;
+    std::string expected;                    // part of the error message
+    std::function<std::string()> contents;   // the file's text
+};
+
+inline void PrintTo(const HostileGltf& h, std::ostream* os) { *os << h.name; }
+
+inline nlohmann::json quadGltf() {
+    std::ifstream f(fixture("quad_u8_camera.gltf"));
+    return nlohmann::json::parse(f);
+}
+
+// The quad with one change made to its JSON.
+inline std::function<std::string()> changed(std::function<void(nlohmann::json&)> change) {
+    return [change] {
+        nlohmann::json j = quadGltf();
+        change(j);
+        return j.dump();
+    };
+}
+
+inline std::vector<HostileGltf> hostileGltfFiles() {
+    static constexpr std::uint64_t kNear2To64 = 18446744073709551600ull;  // a multiple of 4
+    static constexpr std::uint64_t k2To62 = 4611686018427387904ull;
+    std::vector<HostileGltf> files = {
+        {"BufferViewOffsetNear2To64", "overflows 64 bits",
+         changed([](nlohmann::json& j) { j["bufferViews"][0]["byteOffset"] = kNear2To64; })},
+        {"AccessorOffsetNear2To64", "overflows 64 bits",
+         changed([](nlohmann::json& j) { j["accessors"][0]["byteOffset"] = kNear2To64; })},
+        {"PositionCountWraps", "overflows 64 bits", changed([](nlohmann::json& j) { j["accessors"][0]["count"] = k2To62 + 1; })},
+        {"IndexCountPastTheBuffer", "runs past the end of buffer view 1",
+         changed([](nlohmann::json& j) { j["accessors"][1]["count"] = std::uint64_t(1) << 40; })},
+        {"CameraZnearZero", "znear", changed([](nlohmann::json& j) { j["cameras"][0]["perspective"]["znear"] = 0.0; })},
+        {"CameraZnearNegative", "znear", changed([](nlohmann::json& j) { j["cameras"][0]["perspective"]["znear"] = -1.0; })},
+        {"CameraZfarBeforeZnear", "zfar",
+         changed([](nlohmann::json& j) {
+             j["cameras"][0]["perspective"]["znear"] = 2.0;
+             j["cameras"][0]["perspective"]["zfar"] = 1.0;
+         })},
+        {"NodeNamesAMissingCamera", "names camera 7, which does not exist",
+         changed([](nlohmann::json& j) { j["nodes"][1]["camera"] = 7; })},
+        {"ByteStrideBelowTheElement", "smaller than the 12-byte elements",
+         changed([](nlohmann::json& j) { j["bufferViews"][0]["byteStride"] = 4; })},
+        {"UnalignedAccessorOffset", "not aligned", changed([](nlohmann::json& j) { j["accessors"][0]["byteOffset"] = 2; })},
+        {"RotationNotUnit", "rotation quaternion has length",
+         changed([](nlohmann::json& j) { j["nodes"][0]["rotation"] = {0, 0, 0, 2}; })},
+        {"RequiredExtension", "KHR_draco_mesh_compression",
+         changed([](nlohmann::json& j) {
+             j["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+             j["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+         })},
+        {"SceneListsANodeTwice", "twice", changed([](nlohmann::json& j) { j["scenes"][0]["nodes"] = {0, 0, 1}; })},
+        {"RootIsAChild", "is a root of scene 0 but a child",
+         changed([](nlohmann::json& j) { j["nodes"][1]["children"] = {0}; })},
+    };
+    // A node chain 100,000 deep, the mesh at its end.
+    files.push_back({"NodeChain100000Deep", "deeper than 1024 levels", changed([](nlohmann::json& j) {
+                         const nlohmann::json camera = j["nodes"][1];
+                         nlohmann::json nodes = nlohmann::json::array();
+                         for (int i = 0; i < 100000; ++i) nodes.push_back({{"children", {i + 1}}});
+                         nodes.push_back({{"mesh", 0}});
+                         nodes.push_back(camera);
+                         j["nodes"] = nodes;
+                         j["scenes"][0]["nodes"] = {0, 100001};
+                     })});
+    // Every node of a level listed as a child of both nodes of the level above: 2^20 instances
+    // from a file of a few kilobytes.
+    files.push_back({"NodesUnderTwoParents", "is a child of both", changed([](nlohmann::json& j) {
+                         nlohmann::json nodes = nlohmann::json::array();
+                         for (int level = 0; level < 20; ++level)
+                             for (int k = 0; k < 2; ++k) nodes.push_back({{"children", {2 * level + 2, 2 * level + 3}}});
+                         nodes.push_back({{"mesh", 0}});
+                         nodes.push_back({{"mesh", 0}});
+                         j["nodes"] = nodes;
+                         j["scenes"][0]["nodes"] = {0, 1};
+                     })});
+    // extras nested 100,000 deep: text, since a JSON library would recurse to build it.
+    files.push_back({"ExtrasNested100000Deep", "more than 256 levels deep", [] {
+                         std::string text = quadGltf().dump();
+                         const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+                         return "{\"extras\":" + deep + "," + text.substr(1);
+                     }});
+    // 100,000 zero-area triangles (all corners the same vertex) and nothing else.
+    files.push_back({"OnlyZeroAreaTriangles", "all 100000 have no area", changed([](nlohmann::json& j) {
+                         j["accessors"][1]["count"] = 300000;
+                         j["bufferViews"][1]["byteLength"] = 300000;
+                         j["buffers"][0]["byteLength"] = 48 + 300000;
+                         j["buffers"][0]["uri"] =
+                             std::string(j["buffers"][0]["uri"]).substr(0, 37 + 64) +  // the positions, whole
+                             std::string(400000, 'A');                                 // zero indices
+                     })});
+    return files;
+}
+
+// Writes the file to the test's temporary folder and returns its path.
+inline std::string writeHostileGltf(const HostileGltf& h) {
+    const std::string path = ::testing::TempDir() + "/dacrt_hostile_" + h.name + ".gltf";
+    std::ofstream(path) << h.contents();
+    return path;
+}
+
+}  // namespace dacrt::test
