@@ -278,6 +278,7 @@ void retireRays(ItemContext c, Slice s) {
     bool cutShort = loopLimiterFired(push.loopProbe);
     if (c.lane == 0) {
         atomicAdd(counters.raysRetired, terminated - before);
+        if (c.item.retire == 0u) atomicAdd(counters.terminatedStep1, terminated - regions[c.item.rayRegion].rayBegin);
         regions[c.item.rayRegion].terminated = terminated;
         if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
         markFinished(c);

@@ -134,6 +134,7 @@ struct GpuCounters {
     uint slices;         // work item slices run (a work item that fits runs in one)
     uint notReady;       // work item launches that found an earlier one still running
     uint tooLarge;       // work items with a single step beyond the loop budget
+    uint terminatedStep1;  // rays finished by Step 1 work items (hit or retired), as the cpu backend counts them
 };
 
 // Push constants of workgroup_test.comp, which runs one building block of the DACRT kernel
@@ -195,7 +196,8 @@ static_assert(offsetof(DacrtPush, rayTmin) == 36);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
-static_assert(sizeof(GpuCounters) == 48 && offsetof(GpuCounters, raysRetired) == 20);
+static_assert(sizeof(GpuCounters) == 52 && offsetof(GpuCounters, raysRetired) == 20);
+static_assert(offsetof(GpuCounters, terminatedStep1) == 48);
 static_assert(offsetof(GpuCounters, itemsFinished) == 32 && offsetof(GpuCounters, tooLarge) == 44);
 static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, loopLimitHits) == 28);
 static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);

@@ -10,8 +10,10 @@
 
 #include "cmd/bench/bench.hpp"
 #include "cmd/exit_codes.hpp"
+#include "cmd/output_paths.hpp"
 #include "cmd/render.hpp"
 #include "cmd/stress/stress.hpp"
+#include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "gpu/context.hpp"
 #include "gpu/vulkan_error.hpp"
@@ -173,22 +175,43 @@ Subcommand addDevicesCommand(CLI::App& app) {
 
 Subcommand addCompareCommand(CLI::App& app) {
     struct State {
-        std::string a, b;
+        std::string a, b, diff, failOn = "never";
         bool json = false;
-        double tieBound = kNearTieRelativeDepth;
+        CompareOptions options;
+        std::uint64_t maxDiffering = 0;
     };
     auto s = std::make_shared<State>();
-    CLI::App* cmd = app.add_subcommand("compare", "compare two --aov images pixel by pixel");
+    CLI::App* cmd = app.add_subcommand("compare", "compare two --aov images pixel by pixel; with --fail-on, a CI gate");
     cmd->add_option("a", s->a, "first AOV EXR")->required();
     cmd->add_option("b", s->b, "second AOV EXR")->required();
     cmd->add_flag("--json", s->json, "write the report as JSON to stdout");
-    cmd->add_option("--tie-bound", s->tieBound, "relative depth bound of a near tie")->check(CLI::PositiveNumber);
+    cmd->add_option("--tie-bound", s->options.nearTieBound,
+                    "relative depth within which a different primitive is a near tie")
+        ->check(CLI::PositiveNumber)->default_str(std::to_string(kNearTieRelativeDepth));
+    cmd->add_option("--depth-tolerance", s->options.depthTolerance,
+                    "relative depth within which the same primitive's depths count as equal (0: bit for bit)")
+        ->check(CLI::NonNegativeNumber)->default_str("0");
+    cmd->add_option("--fail-on", s->failOn,
+                    "exit 1 when the images differ beyond near ties and tolerances (differ), when they are "
+                    "not identical (any), or never")
+        ->check(CLI::IsMember({"differ", "any", "never"}))->default_str("never");
+    cmd->add_option("--max-differing", s->maxDiffering,
+                    "with --fail-on differ: pixels allowed to differ beyond near ties and tolerances")
+        ->default_str("0");
+    cmd->add_option("--diff", s->diff, "PNG of a's surfaces with near ties in yellow and differences in red");
     return {cmd, [s] {
+                checkOutputs({{"--diff", s->diff, OutputFormat::Image}}, {s->a, s->b});
                 const Aov a = readAov(s->a);  // a before b, so that an error names the first bad file
                 const Aov b = readAov(s->b);
-                const CompareReport report = compareAovs(a, b, s->tieBound);
-                std::cout << (s->json ? report.json() + "\n" : report.text());
-                return int(kExitSuccess);
+                const CompareReport report = compareAovs(a, b, s->options);
+                if (!s->diff.empty()) {
+                    writeThrough(s->diff, [&](const std::string& to) { writeRgb8(to, a.width, a.height, differenceImage(a, report)); });
+                }
+                std::cout << (s->json ? report.json() + "\n" : report.text()) << std::flush;
+                if (!s->diff.empty()) std::cerr << "dacrt: wrote " << s->diff << "\n";
+                const bool fails = (s->failOn == "any" && report.verdict() != CompareVerdict::Identical) ||
+                                   (s->failOn == "differ" && report.realDifferences > s->maxDiffering);
+                return int(fails ? kExitCheckFailed : kExitSuccess);
             }};
 }
 

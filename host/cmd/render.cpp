@@ -1,11 +1,13 @@
 #include "cmd/render.hpp"
 
+#include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 
 #include "cmd/exit_codes.hpp"
+#include "cmd/output_paths.hpp"
 #include "cmd/render_stats.hpp"
+#include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
 #include "core/image_io.hpp"
@@ -22,6 +24,11 @@ void checkRenderOptions(const RenderOptions& o) {
     if (o.request.trace.backend == Backend::Embree && o.planOnly)
         throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
     checkBackendRequest(o.request);
+    // With several cameras the files get "_camN" before the extension, in the same folder.
+    checkOutputs({{"-o", o.outputPath, OutputFormat::Image},
+                  {"--aov", o.aovPath, OutputFormat::Exr},
+                  {"--stats", o.statsPath, OutputFormat::Text}},
+                 {o.scenePath});
 }
 
 // What every camera of the orbit shares: the scene, its bounds and the cameras.
@@ -67,22 +74,48 @@ PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t r
     };
 }
 
-// The shade and write stages of one camera; returns the shaded image's path, if any.
-std::string writeImages(const RenderOptions& o, const PreparedScene& p, int k, const HitImage& image) {
+// The shade and write stages of one camera, each file complete or absent. Appends the paths
+// written to `written`.
+void writeImages(const RenderOptions& o, const PreparedScene& p, int k, const HitImage& image,
+                 std::vector<std::string>& written) {
     const int count = int(p.cameras.size());
-    const std::string out = pathForCamera(o.outputPath, k, count);
-    const std::string aov = pathForCamera(o.aovPath, k, count);
-    if (!out.empty()) writeRgb8(out, image.width, image.height, shadeImage(p.scene, image));
-    if (!aov.empty()) writeAov(aov, p.scene, image);
-    return out;
+    if (const std::string out = pathForCamera(o.outputPath, k, count); !out.empty()) {
+        writeThrough(out, [&](const std::string& to) { writeRgb8(to, image.width, image.height, shadeImage(p.scene, image)); });
+        written.push_back(out);
+    }
+    if (const std::string aov = pathForCamera(o.aovPath, k, count); !aov.empty()) {
+        writeThrough(aov, [&](const std::string& to) { writeAov(to, p.scene, image); });
+        written.push_back(aov);
+    }
 }
 
-void writeStats(const RenderOptions& o, int k, int cameraCount, const RenderedFrame& frame) {
+void writeStats(const RenderOptions& o, int k, int cameraCount, const RenderedFrame& frame,
+                std::vector<std::string>& written) {
     const std::string path = pathForCamera(o.statsPath, k, cameraCount);
     if (path.empty()) return;
-    std::ofstream f(path);
-    if (!f) throw InputError(path + ": cannot write the stats file");
-    f << renderStatsJson(o, frame).dump(2) << "\n";
+    writeFileAtomically(path, renderStatsJson(o, frame).dump(2) + "\n");
+    written.push_back(path);
+}
+
+// The last lines: the orbit's frame times, then every file written (or how to write one).
+void reportRender(const RenderOptions& o, const std::vector<double>& traceMs, std::size_t rays,
+                  const std::vector<std::string>& written) {
+    if (traceMs.size() > 1) {
+        double sum = 0.0;
+        for (double t : traceMs) sum += t;
+        std::cerr << "dacrt: " << traceMs.size() << " cameras, trace mean " << sum / double(traceMs.size())
+                  << " ms (min " << *std::min_element(traceMs.begin(), traceMs.end()) << ", max "
+                  << *std::max_element(traceMs.begin(), traceMs.end()) << ")\n";
+    }
+    if (written.empty()) {
+        std::cerr << "dacrt: traced " << rays * traceMs.size() << " rays with " << toString(o.request.trace.backend)
+                  << " and wrote nothing: name a shaded image with -o OUT.png, AOVs with --aov OUT.exr, "
+                     "stats with --stats OUT.json\n";
+        return;
+    }
+    std::cerr << "dacrt: wrote";
+    for (std::size_t i = 0; i < written.size(); ++i) std::cerr << (i ? ", " : " ") << written[i];
+    std::cerr << "\n";
 }
 
 }  // namespace
@@ -101,6 +134,9 @@ int runRender(const RenderOptions& o) {
     BackendDispatcher backends(o.devices, {o.request.trace.backend});
     const PreparedScene p = loadAndPrepare(o);
 
+    std::vector<std::string> written;
+    std::vector<double> traceTimes;
+    std::size_t raysPerFrame = 0;
     for (int k = 0; k < int(p.cameras.size()); ++k) {
         const Camera& camera = p.cameras[std::size_t(k)];
         const auto frameStart = Clock::now();
@@ -114,19 +150,23 @@ int runRender(const RenderOptions& o) {
         const double traceMs = msSince(traceStart);
 
         const auto writeStart = Clock::now();
-        const std::string out = writeImages(o, p, k, HitImage{o.width, o.height, &rays, &result.hits});
+        writeImages(o, p, k, HitImage{o.width, o.height, &rays, &result.hits}, written);
         const double writeMs = msSince(writeStart);
+        traceTimes.push_back(traceMs);
+        raysPerFrame = rays.size();
         const double totalMs = (k == 0 ? p.loadMs + p.prepareMs : 0.0) + msSince(frameStart);
 
         writeStats(o, k, int(p.cameras.size()),
                    RenderedFrame{p.scene, camera, k, rays.size(), result,
                                  {{"load", p.loadMs}, {"prepare", prepareMs}, {"trace", traceMs}, {"write", writeMs},
-                                  {"total", totalMs}}});
+                                  {"total", totalMs}}},
+                   written);
         std::cerr << "dacrt: " << toString(o.request.trace.backend) << " camera " << k << ": "
-                  << p.scene.triangleCount() << " triangles, " << rays.size() << " rays, trace " << traceMs << " ms"
-                  << (out.empty() ? "" : ", wrote " + out) << "\n";
+                  << p.scene.triangleCount() << " triangles, " << rays.size() << " rays, trace " << traceMs << " ms\n";
     }
-    return backends.validationEpilogue(std::cerr);
+    const int code = backends.validationEpilogue(std::cerr);
+    if (!o.planOnly) reportRender(o, traceTimes, raysPerFrame, written);
+    return code;
 }
 
 }  // namespace dacrt

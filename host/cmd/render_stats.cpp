@@ -1,5 +1,7 @@
 #include "cmd/render_stats.hpp"
 
+#include "cmd/json_keys.hpp"
+
 namespace dacrt {
 namespace {
 
@@ -35,12 +37,12 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     nlohmann::ordered_json t;
     for (const auto& [name, ms] : frame.timingsMs) t[name] = ms;
     nlohmann::ordered_json phases;
-    for (const auto& [name, ms] : r.phaseMs) phases[name] = ms;
+    for (const auto& [name, ms] : r.phaseMs) phases[jsonKey(name)] = ms;
     if (!phases.empty()) t["trace_phases"] = phases;
     if (!r.step1RegionMs.empty()) t["step1_region"] = r.step1RegionMs;
     j["timings_ms"] = t;
     nlohmann::ordered_json mem;
-    for (const auto& [name, bytes] : r.memory.buffers) mem[name] = bytes;
+    for (const auto& [name, bytes] : r.memory.buffers) mem[jsonKey(name)] = bytes;
     mem["total"] = r.memory.total();
     j["memory_plan_bytes"] = mem;
     const Counters& c = r.counters;
@@ -52,7 +54,7 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
                      {"leaves", c.leaves},
                      {"rays_retired_without_hit", c.raysRetired},
                      {"rays_culled", c.raysCulled},
-                     {"rays_terminated_step1", r.gpu ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(c.terminatedStep1)},
+                     {"rays_terminated_step1", c.terminatedStep1},
                      {"rays_terminated_per_round", rounds},
                      {"transfer_work_items", c.transferWorkItems},
                      {"transfer_work_items_skipped", c.transferWorkItemsSkipped}};

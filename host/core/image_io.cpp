@@ -18,6 +18,12 @@ void writePixels(const std::string& path, const OIIO::ImageSpec& spec, OIIO::Typ
 
 }  // namespace
 
+std::string imageWriterProblem(const std::string& path) {
+    if (OIIO::ImageOutput::create(path)) return {};
+    const std::string why = OIIO::geterror();
+    return why.empty() ? "no image writer for this extension" : why;
+}
+
 void writeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
     OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
     writePixels(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
@@ -63,12 +69,16 @@ Aov readAov(const std::string& path) {
         return c;
     };
     aov.depth.resize(n);
+    aov.normal.resize(n);
     aov.primId.resize(n);
     aov.hit.resize(n);
-    const int z = channel("Z"), prim = channel("primId"), hit = channel("hit");
+    const int z = channel("Z"), prim = channel("primId"), hit = channel("hit"), nx = channel("N.X");
+    if (channel("N.Y") != nx + 1 || channel("N.Z") != nx + 2)
+        throw InputError(path + ": the N.X, N.Y and N.Z channels are not consecutive");
     if (spec.channelformat(prim) != OIIO::TypeDesc::UINT32)
         throw InputError(path + ": the primId channel is not unsigned 32-bit");
     if (!in->read_image(0, 0, z, z + 1, OIIO::TypeDesc::FLOAT, aov.depth.data()) ||
+        !in->read_image(0, 0, nx, nx + 3, OIIO::TypeDesc::FLOAT, aov.normal.data()) ||
         !in->read_image(0, 0, prim, prim + 1, OIIO::TypeDesc::UINT32, aov.primId.data()) ||
         !in->read_image(0, 0, hit, hit + 1, OIIO::TypeDesc::FLOAT, aov.hit.data()))
         throw InputError(path + ": reading failed: " + in->geterror());

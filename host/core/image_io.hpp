@@ -9,6 +9,9 @@
 
 namespace dacrt {
 
+// Empty when OpenImageIO has a writer for the path's extension, else why not.
+std::string imageWriterProblem(const std::string& path);
+
 // An 8-bit RGB image, row-major; any format OpenImageIO writes from the extension.
 void writeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb);
 
@@ -21,6 +24,7 @@ struct Aov {
     int width = 0;
     int height = 0;
     std::vector<float> depth;
+    std::vector<glm::vec3> normal;
     std::vector<std::uint32_t> primId;
     std::vector<float> hit;
 };

@@ -1,16 +1,35 @@
 #include "dacrt/memory_plan.hpp"
 
+#include <algorithm>
+#include <cstdio>
 #include <sstream>
 
 namespace dacrt {
+namespace {
+
+std::string readableBytes(std::uint64_t bytes) {
+    const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+    double v = double(bytes);
+    int u = 0;
+    while (v >= 1024.0 && u < 4) v /= 1024.0, ++u;
+    char text[32];
+    std::snprintf(text, sizeof text, u == 0 ? "%.0f %s" : "%.1f %s", v, units[u]);
+    return text;
+}
+
+}  // namespace
 
 std::string MemoryPlan::describe() const {
+    std::size_t width = 5;  // "total"
+    for (const auto& b : buffers) width = std::max(width, b.first.size());
     std::ostringstream s;
-    for (const auto& [name, bytes] : buffers)
-        s << "  " << name << std::string(name.size() < 28 ? 28 - name.size() : 1, ' ') << bytes << " bytes ("
-          << std::fixed << double(bytes) / (1024.0 * 1024.0) << " MiB)\n";
-    s << "  total" << std::string(23, ' ') << total() << " bytes (" << std::fixed
-      << double(total()) / (1024.0 * 1024.0) << " MiB)\n";
+    auto line = [&](const std::string& name, std::uint64_t bytes) {
+        char text[64];
+        std::snprintf(text, sizeof text, "%12s  (%llu bytes)", readableBytes(bytes).c_str(), (unsigned long long)bytes);
+        s << "  " << name << std::string(width - name.size() + 2, ' ') << text << "\n";
+    };
+    for (const auto& [name, bytes] : buffers) line(name, bytes);
+    line("total", total());
     return s.str();
 }
 

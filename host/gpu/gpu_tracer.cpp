@@ -217,6 +217,7 @@ void readBack(const GpuFrame& frame, const gpu::DacrtBindingSet& set, const GpuC
     result.counters.rayTriangleTests = counters.rayTriangleTests;
     result.counters.leaves = counters.leaves;
     result.counters.raysRetired = counters.raysRetired;
+    result.counters.terminatedStep1 = counters.terminatedStep1;
     result.counters.transferWorkItems = frame.work.transferPairs;
     GpuReport& report = *result.gpu;
     report.raysFinished = 0;  // one command buffer: no per-round readback

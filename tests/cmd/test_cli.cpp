@@ -190,3 +190,96 @@ TEST_P(CliHostileGltf, ExitsWith2AndOneLineAndWritesNothing) {
 
 INSTANTIATE_TEST_SUITE_P(Files, CliHostileGltf, ::testing::ValuesIn(dacrt::test::hostileGltfFiles()),
                          [](const ::testing::TestParamInfo<dacrt::test::HostileGltf>& info) { return info.param.name; });
+
+// ---- outputs checked before any work ------------------------------------------------------
+
+namespace {
+
+struct BadOutput {
+    const char* name;
+    std::string args;       // after "render SCENE --size 16x12"
+    std::string expected;   // part of the message
+    std::string leftBehind;  // a path that must not exist afterwards
+};
+
+void PrintTo(const BadOutput& b, std::ostream* os) { *os << b.name; }
+
+class CliRefusesOutput : public ::testing::TestWithParam<BadOutput> {};
+
+}  // namespace
+
+TEST_P(CliRefusesOutput, BeforeTracingAndLeavesNoFile) {
+    const BadOutput& b = GetParam();
+    if (!b.leftBehind.empty()) std::filesystem::remove(b.leftBehind);
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 16x12 " + b.args);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find(b.expected), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("trace"), std::string::npos) << "it traced before failing: " << r.output;
+    if (!b.leftBehind.empty()) {
+        EXPECT_FALSE(std::filesystem::exists(b.leftBehind)) << b.leftBehind;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Paths, CliRefusesOutput,
+    ::testing::Values(
+        BadOutput{"MissingFolder", "-o /nonexistent/folder/x.png", "the folder /nonexistent/folder does not exist",
+                  "/nonexistent/folder/x.png"},
+        BadOutput{"PngForAovs", "--aov " + temp("aov.png"), "only OpenEXR holds", temp("aov.png")},
+        BadOutput{"UnwritableFolder", "-o /proc/dacrt_x.png", "cannot be written", "/proc/dacrt_x.png"},
+        BadOutput{"OutputIsAFolder", "-o " + ::testing::TempDir(), "is a folder", ""},
+        BadOutput{"OneFileForTwoOutputs", "-o " + temp("same.exr") + " --aov " + temp("same.exr"), "the same file as -o",
+                  temp("same.exr")},
+        BadOutput{"OutputIsTheScene", "--stats " + dacrt::test::fixture("quad_u8_camera.gltf"), "the same file as the input", ""},
+        BadOutput{"UnknownImageFormat", "-o " + temp("x.nosuchformat"), "cannot write", temp("x.nosuchformat")}),
+    [](const ::testing::TestParamInfo<BadOutput>& info) { return std::string(info.param.name); });
+
+TEST(Cli, RenderWithoutOutputsSaysHowToSave) {
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 8x6");
+    EXPECT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("wrote nothing: name a shaded image with -o"), std::string::npos) << r.output;
+}
+
+TEST(Cli, TheLastLineNamesEveryFileWritten) {
+    const std::string png = temp("last.png"), exr = temp("last.exr");
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 8x6 -o " + png + " --aov " + exr);
+    ASSERT_EQ(r.code, 0) << r.output;
+    const std::string last = r.output.substr(r.output.rfind('\n', r.output.size() - 2) + 1);
+    EXPECT_EQ(last, "dacrt: wrote " + png + ", " + exr + "\n");
+    // No temporary file is left beside them.
+    for (const auto& e : std::filesystem::directory_iterator(::testing::TempDir()))
+        EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
+}
+
+// ---- compare as a CI gate ------------------------------------------------------------------
+
+TEST(Cli, CompareFailsOnDifferenceAndPassesOnIdentity) {
+    const std::string scene = dacrt::test::fixture("quad_u8_camera.gltf");
+    const std::string a = temp("gate_a.exr"), b = temp("gate_b.exr"), diff = temp("gate_diff.png");
+    ASSERT_EQ(run("render " + scene + " --size 16x16 --aov " + a).code, 0);
+    ASSERT_EQ(run("render " + scene + " --size 16x16 --eye 0.5,0,4 --aov " + b).code, 0);
+    const CommandResult differs = run("compare " + a + " " + b + " --fail-on differ --diff " + diff);
+    EXPECT_EQ(differs.code, 1) << differs.output;
+    EXPECT_NE(differs.output.find("compare: differs"), std::string::npos) << differs.output;
+    EXPECT_GT(std::filesystem::file_size(diff), 0u);
+    const CommandResult allowed = run("compare " + a + " " + b + " --fail-on differ --max-differing 256");
+    EXPECT_EQ(allowed.code, 0) << allowed.output;
+    const CommandResult same = run("compare " + a + " " + a + " --fail-on any");
+    EXPECT_EQ(same.code, 0) << same.output;
+    EXPECT_NE(same.output.find("compare: identical"), std::string::npos) << same.output;
+    const CommandResult never = run("compare " + a + " " + b);
+    EXPECT_EQ(never.code, 0) << never.output;
+}
+
+// The README's CI recipe, as written there (with the outputs in the test's folder).
+TEST(Cli, TheReadmeCiRecipeRuns) {
+    const std::string scene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
+    const std::string cpu = temp("ci_cpu.exr"), gpu = temp("ci_gpu.exr"), diff = temp("ci_diff.png");
+    ASSERT_EQ(run("render " + scene + " --size 64x48 --backend cpu --aov " + cpu).code, 0);
+    const CommandResult g = run("render " + scene + " --size 64x48 --backend gpu --aov " + gpu);
+    if (g.code == 2 && g.output.find("Vulkan") != std::string::npos) GTEST_SKIP() << g.output;
+    ASSERT_EQ(g.code, 0) << g.output;
+    const CommandResult r = run("compare " + cpu + " " + gpu + " --fail-on differ --diff " + diff);
+    EXPECT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("compare: identical"), std::string::npos) << r.output;
+}

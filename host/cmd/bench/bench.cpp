@@ -8,14 +8,14 @@
 #include <memory>
 #include <thread>
 
-#include <unistd.h>
-
 #include <nlohmann/json.hpp>
 
 #include "cmd/bench/bench_configs.hpp"
 #include "cmd/bench/bench_report.hpp"
 #include "cmd/bench/reference_cache.hpp"
+#include "cmd/output_paths.hpp"
 #include "cmd/progress.hpp"
+#include "core/atomic_file.hpp"
 #include "core/camera.hpp"
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
@@ -45,20 +45,21 @@ void checkBenchCommand(const BenchCommand& cmd) {
 }
 
 // Resolves the output paths and checks that they can be written before anything is timed:
-// a long run must not fail at its end.
+// a long run must not fail at its end. Only the --out folder itself may be created (for the
+// outputs it holds), never a folder above it or one the user did not name.
 BenchCommand withOutputs(BenchCommand cmd) {
-    auto resolve = [&](std::string& path, const char* name) {
-        if (path.empty()) path = (std::filesystem::path(cmd.outDir) / name).string();
-        const std::filesystem::path file(path), parent = file.parent_path().empty() ? "." : file.parent_path();
-        std::error_code ec;
-        std::filesystem::create_directories(parent, ec);
-        const bool writable = std::filesystem::exists(file) ? access(path.c_str(), W_OK) == 0
-                                                             : access(parent.c_str(), W_OK | X_OK) == 0;
-        if (ec || !writable || std::filesystem::is_directory(file))
-            throw InputError(path + ": cannot write here" + (ec ? " (" + ec.message() + ")" : std::string()));
-    };
-    resolve(cmd.csvPath, "bench.csv");
-    resolve(cmd.jsonPath, "bench.json");
+    const bool outHoldsAny = cmd.csvPath.empty() || cmd.jsonPath.empty();
+    if (cmd.csvPath.empty()) cmd.csvPath = (std::filesystem::path(cmd.outDir) / "bench.csv").string();
+    if (cmd.jsonPath.empty()) cmd.jsonPath = (std::filesystem::path(cmd.outDir) / "bench.json").string();
+    std::error_code ec;
+    if (outHoldsAny && !std::filesystem::is_directory(cmd.outDir, ec)) {
+        const std::filesystem::path parent = std::filesystem::path(cmd.outDir).parent_path();
+        if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+            throw InputError("--out " + cmd.outDir + ": the folder " + parent.string() + " does not exist");
+        if (!std::filesystem::create_directory(cmd.outDir, ec) && ec)
+            throw InputError("--out " + cmd.outDir + ": cannot create the folder (" + ec.message() + ")");
+    }
+    checkOutputs({{"--csv", cmd.csvPath, OutputFormat::Text}, {"--json", cmd.jsonPath, OutputFormat::Text}}, cmd.scenes);
     return cmd;
 }
 
@@ -275,9 +276,7 @@ void writeJson(const BenchCommand& cmd, const std::vector<BenchRow>& rows, const
     j["validation_errors"] = dispatcher.validationErrors();
     j["rows"] = nlohmann::ordered_json::array();
     for (const BenchRow& r : rows) j["rows"].push_back(rowJson(r));
-    std::ofstream f(cmd.jsonPath);
-    f << j.dump(2) << "\n";
-    if (!f.flush()) throw InputError(cmd.jsonPath + ": cannot write the JSON file");
+    writeFileAtomically(cmd.jsonPath, j.dump(2) + "\n");
 }
 
 }  // namespace

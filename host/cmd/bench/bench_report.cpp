@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "cmd/bench/bench_configs.hpp"
+#include "cmd/json_keys.hpp"
+#include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 
 namespace dacrt {
@@ -46,7 +48,7 @@ nlohmann::ordered_json rowJson(const BenchRow& r) {
     j["mrays_per_s"] = double(r.raysPerFrame) / (r.frameMsMedian * 1e3);
     j["speedup_over_cpu_seq"] = r.speedupOverSequential ? nlohmann::ordered_json(*r.speedupOverSequential) : nullptr;
     nlohmann::ordered_json parts;
-    for (const auto& [name, ms] : r.partsMs) parts[name] = ms;
+    for (const auto& [name, ms] : r.partsMs) parts[jsonKey(name)] = ms;
     j["parts_ms"] = parts;
     j["pixels"] = e.pixels;
     j["differing_prim"] = e.differingPrim;
@@ -65,8 +67,7 @@ nlohmann::ordered_json rowJson(const BenchRow& r) {
 }
 
 void writeCsv(const std::string& path, const std::vector<BenchRow>& rows) {
-    std::ofstream f(path);
-    if (!f) throw InputError(path + ": cannot write the CSV file");
+    std::ostringstream f;
     const char* columns[] = {"scene", "triangles", "rays_per_frame", "cameras", "backend", "series", "config",
                              "default", "options", "threads", "regions", "division_axis", "frame_ms_min",
                              "frame_ms_median", "mrays_per_s", "speedup_over_cpu_seq", "pixels", "differing_prim",
@@ -95,7 +96,7 @@ void writeCsv(const std::string& path, const std::vector<BenchRow>& rows) {
         }
         f << "\n";
     }
-    if (!f.flush()) throw InputError(path + ": cannot write the CSV file");
+    writeFileAtomically(path, f.str());
 }
 
 void printSummary(const std::vector<BenchRow>& rows) {
