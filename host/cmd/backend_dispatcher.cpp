@@ -11,19 +11,54 @@
 
 namespace dacrt {
 
-void checkBackendRequest(const BackendRequest& r) {
+namespace {
+
+// The options given, as the command line names them, that `takes` says the backend ignores.
+std::vector<std::string> ignoredOptions(const BackendRequest& r) {
     const Backend b = r.trace.backend;
-    if (b != Backend::Gpu && (r.gpuTuning.workgroupSize || r.gpuTuning.rayGroups))
-        throw InputError("--workgroup-size and --ray-groups tune the gpu backend; --backend " + toString(b) +
-                         " has no workgroups");
-    if ((b == Backend::Embree || b == Backend::Brute) && !r.trace.dacrt.exactDefaults())
-        throw InputError("--intersector, --triangle-filter and --precision are DACRT options of cpu and cpu-seq; " +
-                         toString(b) + (b == Backend::Brute ? " always runs the watertight float32 test"
-                                                            : " has its own test"));
-    if (b != Backend::Embree && !r.embreeRobust)
-        throw InputError("--embree-fast is an option of --backend embree, not " + toString(b));
-    if (b == Backend::Gpu) checkGpuOptions(r.trace);
-    if (b == Backend::Brute || b == Backend::CpuSeq || b == Backend::Cpu) checkCpuOptions(r.trace);
+    const bool dacrt = b == Backend::CpuSeq || b == Backend::Cpu || b == Backend::Gpu;
+    const bool parallel = b == Backend::Cpu || b == Backend::Gpu;
+    const DacrtOptions defaults;
+    const DacrtOptions& d = r.trace.dacrt;
+    std::vector<std::string> out;
+    auto given = [&](bool set, bool taken, const char* flag) {
+        if (set && !taken) out.push_back(flag);
+    };
+    given(r.trace.regions != 0, parallel, "--regions");
+    given(r.trace.axis != DivisionAxis::Best, parallel, "--axis");
+    given(r.trace.threads > 1, b != Backend::CpuSeq, "--threads");
+    given(d.rayLimit != 0, dacrt, "--ray-limit");
+    given(d.triLimit != 0, dacrt, "--tri-limit");
+    given(d.split != defaults.split, b == Backend::CpuSeq || b == Backend::Cpu, "--split");
+    given(d.intersector != defaults.intersector, b == Backend::CpuSeq || b == Backend::Cpu, "--intersector");
+    given(d.triangleFilter != defaults.triangleFilter, b == Backend::CpuSeq || b == Backend::Cpu, "--triangle-filter");
+    given(d.precision != defaults.precision, b == Backend::CpuSeq || b == Backend::Cpu, "--precision");
+    given(r.gpuTuning.workgroupSize != 0, b == Backend::Gpu, "--workgroup-size");
+    given(r.gpuTuning.rayGroups != 0, b == Backend::Gpu, "--ray-groups");
+    given(!r.embreeRobust, b == Backend::Embree, "--embree-fast");
+    return out;
+}
+
+}  // namespace
+
+void checkBackendRequest(const BackendRequest& r) {
+    const std::vector<std::string> ignored = ignoredOptions(r);
+    if (!ignored.empty()) {
+        std::string list;
+        for (std::size_t i = 0; i < ignored.size(); ++i)
+            list += (i == 0 ? "" : i + 1 == ignored.size() ? " and " : ", ") + ignored[i];
+        throw InputError(list + (ignored.size() == 1 ? " is not an option of --backend " : " are not options of --backend ") +
+                         toString(r.trace.backend) + " (see dacrt render --help: each option names its backends)");
+    }
+    if (r.trace.backend == Backend::Gpu) checkGpuOptions(r.trace);
+    if (r.trace.backend != Backend::Gpu && r.trace.backend != Backend::Embree) checkCpuOptions(r.trace);
+}
+
+void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends) {
+    const bool gpu = std::find(backends.begin(), backends.end(), Backend::Gpu) != backends.end();
+    if (gpu) return;
+    if (!devices.device.empty()) throw InputError("--device chooses the gpu backend's Vulkan device; no gpu backend runs here");
+    if (devices.validate) throw InputError("--validate runs the gpu backend under the Vulkan validation layers; no gpu backend runs here");
 }
 
 BackendDispatcher::BackendDispatcher(const DeviceChoice& devices, const std::vector<Backend>& backends)
@@ -48,7 +83,7 @@ ThreadPool& BackendDispatcher::pool(unsigned threads) {
 }
 
 TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const BackendRequest& request,
-                                     const PlanHook& onPlan) {
+                                     const PlanHook& onPlan, const ProgressHook& onProgress) {
     checkBackendRequest(request);
     const unsigned threads = threadsOf(request.trace);
     ThreadPool& threadPool = pool(threads);
@@ -61,7 +96,7 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
             return traceEmbree(geometry, EmbreeOptions{request.embreeRobust, threads}, threadPool);
         case Backend::Brute:
         case Backend::CpuSeq:
-        case Backend::Cpu: return traceCpu(geometry, request.trace, threadPool, onPlan);
+        case Backend::Cpu: return traceCpu(geometry, request.trace, threadPool, onPlan, onProgress);
     }
     throw InternalError("unknown backend");
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/thread_pool.hpp"
+#include "dacrt/cpu_tracers.hpp"
 #include "dacrt/frame_geometry.hpp"
 #include "dacrt/memory_plan.hpp"
 #include "dacrt/options.hpp"
@@ -35,6 +36,9 @@ struct DeviceChoice {
     bool validate = false;  // gpu: Khronos validation layers, errors counted
 };
 
+// Throws InputError when --device or --validate is given but no gpu backend runs.
+void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends);
+
 class BackendDispatcher {
 public:
     // Opens the Vulkan device now when `backends` includes gpu, so that a missing or
@@ -49,7 +53,9 @@ public:
     const gpu::Context* gpuContext() const { return gpu_.get(); }
 
     // Checks the request (checkBackendRequest), then traces one frame on its backend.
-    TraceResult trace(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan = {});
+    // onProgress is called by the backends that report progress (brute force).
+    TraceResult trace(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan = {},
+                      const ProgressHook& onProgress = {});
 
     std::uint32_t validationErrors() const;
     // Under --validate: prints every validation message and returns kExitValidation when

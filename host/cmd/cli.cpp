@@ -85,11 +85,11 @@ std::vector<std::string> dacrtBackendNames() { return {"brute", "cpu-seq", "cpu"
 
 // The DACRT options that render and bench share.
 void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
-    addEnumOption(cmd, "--split", o.split, "DACRT split (cpu, cpu-seq; gpu: spatial-median only)");
+    addEnumOption(cmd, "--split", o.split, "DACRT split (cpu, cpu-seq; gpu always splits at the spatial median)");
     const std::string limits = std::to_string(kCpuLeafLimit) + " on the cpu backends, " + std::to_string(kGpuLeafLimit) + " on gpu";
-    cmd->add_option("--ray-limit", o.rayLimit, "leaf when fewer live rays")
+    cmd->add_option("--ray-limit", o.rayLimit, "leaf when fewer live rays (cpu-seq, cpu, gpu)")
         ->check(CLI::Range(1u, 1u << 30))->default_str(limits);
-    cmd->add_option("--tri-limit", o.triLimit, "leaf when fewer triangles")
+    cmd->add_option("--tri-limit", o.triLimit, "leaf when fewer triangles (cpu-seq, cpu, gpu)")
         ->check(CLI::Range(1u, 1u << 30))->default_str(limits);
     addEnumOption(cmd, "--intersector", o.intersector, "leaf ray/triangle test (cpu, cpu-seq)");
     addEnumOption(cmd, "--triangle-filter", o.triangleFilter,
@@ -104,8 +104,8 @@ struct Subcommand {
 };
 
 void addDeviceOptions(CLI::App* cmd, DeviceChoice& devices) {
-    cmd->add_option("--device", devices.device, "gpu: Vulkan device index or part of its name (see 'dacrt devices')");
-    cmd->add_flag("--validate", devices.validate, "gpu: run under the Vulkan validation layers; errors fail the run (exit 3)");
+    cmd->add_option("--device", devices.device, "Vulkan device index or part of its name, see 'dacrt devices' (gpu; default: discrete, integrated, then the rest)");
+    cmd->add_flag("--validate", devices.validate, "run under the Vulkan validation layers; errors fail the run with exit 3 (gpu)");
 }
 
 Subcommand addRenderCommand(CLI::App& app) {
@@ -124,27 +124,27 @@ Subcommand addRenderCommand(CLI::App& app) {
     cmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
     addEnumOption(cmd, "--backend", render.request.trace.backend, "tracer");
     cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
-    cmd->add_option("--regions", render.request.trace.regions, "sub-scenes of cpu and gpu (default: one per thread)")
+    cmd->add_option("--regions", render.request.trace.regions, "sub-scenes (cpu, gpu; default: one per thread, on gpu one per core of a CPU device, 16 on a GPU)")
         ->check(CLI::Range(1u, 4096u));
-    cmd->add_option("--threads", render.request.trace.threads, "worker threads (default: every core)")
+    cmd->add_option("--threads", render.request.trace.threads, "worker threads (every backend but cpu-seq; default: every core)")
         ->check(CLI::Range(1u, 1024u));
     addEnumOption(cmd, "--axis", render.request.trace.axis, "division axis (cpu, gpu)");
     addDacrtOptions(cmd, render.request.trace.dacrt);
-    cmd->add_flag("--embree-fast", s->embreeFast, "embree: without RTC_SCENE_FLAG_ROBUST (faster, leaks through edges)");
-    cmd->add_option("--eye", s->eye, "camera position x,y,z");
+    cmd->add_flag("--embree-fast", s->embreeFast, "without RTC_SCENE_FLAG_ROBUST: faster, leaks through edges (embree)");
+    cmd->add_option("--eye", s->eye, "camera position x,y,z (default: the scene's camera, else a front view framing the scene)");
     cmd->add_option("--target", s->target, "point the camera looks at x,y,z");
-    cmd->add_option("--up", s->up, "camera up vector x,y,z");
-    cmd->add_option("--fov", s->fov, "vertical field of view in degrees");
-    cmd->add_option("--orbit", render.camera.orbit, "K cameras on a circle about the vertical axis")
-        ->check(CLI::Range(1, 100000));
+    cmd->add_option("--up", s->up, "camera up vector x,y,z (default: the scene camera's, else +y)");
+    cmd->add_option("--fov", s->fov, "vertical field of view in degrees (default: the scene camera's, else 45)");
+    cmd->add_option("--orbit", render.camera.orbit, "K cameras on a circle about the vertical axis through the scene's centre")
+        ->check(CLI::Range(1, 100000))->default_str("1");
     cmd->add_flag("--plan", render.planOnly, "print the memory plan and stop before tracing");
     addDeviceOptions(cmd, render.devices);
     cmd->add_option("--workgroup-size", render.request.gpuTuning.workgroupSize,
-                    "gpu: invocations per workgroup (default: per device)")
+                    "invocations per workgroup (gpu; default: per device)")
         ->check(CLI::Range(1u, 1024u));
     cmd->add_option("--ray-groups", render.request.gpuTuning.rayGroups,
-                    "gpu: work items per region, each a band of its rays with its own copy of the region's "
-                    "triangle ids (default: per device)")
+                    "work items per region, each a band of its rays with its own copy of the region's "
+                    "triangle ids (gpu; default: 2 on a CPU device)")
         ->check(CLI::Range(1u, 64u));
     return {cmd, [s, cmd] {
                 RenderOptions& r = s->render;

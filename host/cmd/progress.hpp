@@ -1,31 +1,37 @@
 #pragma once
-// A progress bar on stderr when it is a terminal; silent otherwise.
-#include <algorithm>
+// Progress on stderr: a bar with the count and an estimate of the time left when stderr is a
+// terminal; otherwise one line per stage (a log stays readable, a terminal stays quiet).
 #include <cstddef>
-#include <iostream>
+#include <mutex>
 #include <string>
 
-#include <unistd.h>
+#include "core/timing.hpp"
 
 namespace dacrt {
 
 class Progress {
 public:
-    Progress(std::size_t total) : total_(total), enabled_(isatty(STDERR_FILENO) != 0) {}
-    void step(const std::string& what) {
-        ++done_;
-        if (!enabled_) return;
-        const int width = 30, filled = int(double(width) * double(done_) / double(std::max<std::size_t>(total_, 1)));
-        std::cerr << "\r[" << std::string(std::size_t(filled), '=') << std::string(std::size_t(width - filled), ' ')
-                  << "] " << done_ << "/" << total_ << " " << what.substr(0, 60) << "\033[K" << std::flush;
-    }
-    void finish() {
-        if (enabled_) std::cerr << "\r\033[K" << std::flush;
-    }
+    // `label` starts every line ("dacrt bench"); `total` steps make the whole.
+    Progress(std::string label, std::size_t total);
+    ~Progress();  // clears the bar
+
+    // A new stage: a line of its own when stderr is not a terminal.
+    void stage(const std::string& what);
+    // One step done (`what` shown beside the bar on a terminal). Safe from several threads.
+    void step(const std::string& what = {});
+    // Fraction done, for work counted in other units (rays, blocks). Safe from several threads.
+    void fraction(double done, const std::string& what = {});
 
 private:
-    std::size_t total_, done_ = 0;
-    bool enabled_;
+    void draw(double done, const std::string& what);
+
+    std::string label_;
+    std::size_t total_;
+    std::size_t done_ = 0;
+    bool terminal_;
+    Clock::time_point start_;
+    Clock::time_point lastDraw_{};
+    std::mutex mutex_;
 };
 
 }  // namespace dacrt

@@ -6,6 +6,7 @@
 
 #include "cmd/exit_codes.hpp"
 #include "cmd/output_paths.hpp"
+#include "cmd/progress.hpp"
 #include "cmd/render_stats.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
@@ -24,6 +25,7 @@ void checkRenderOptions(const RenderOptions& o) {
     if (o.request.trace.backend == Backend::Embree && o.planOnly)
         throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
     checkBackendRequest(o.request);
+    checkDeviceChoice(o.devices, {o.request.trace.backend});
     // With several cameras the files get "_camN" before the extension, in the same folder.
     checkOutputs({{"-o", o.outputPath, OutputFormat::Image},
                   {"--aov", o.aovPath, OutputFormat::Exr},
@@ -97,6 +99,14 @@ void writeStats(const RenderOptions& o, int k, int cameraCount, const RenderedFr
     written.push_back(path);
 }
 
+// Brute force's cost grows with triangles times rays: say so before a long frame.
+void announceBruteForce(std::size_t triangles, std::size_t rays, unsigned threads) {
+    const double seconds = double(triangles) * double(rays) * kBruteNanosecondsPerTest * 1e-9 / double(threads);
+    if (seconds < 3.0) return;
+    std::cerr << "dacrt: brute force tests " << triangles << " triangles x " << rays << " rays, about "
+              << int(seconds + 0.5) << " s on " << threads << " threads (cpu traces the same image exactly)\n";
+}
+
 // The last lines: the orbit's frame times, then every file written (or how to write one).
 void reportRender(const RenderOptions& o, const std::vector<double>& traceMs, std::size_t rays,
                   const std::vector<std::string>& written) {
@@ -145,7 +155,12 @@ int runRender(const RenderOptions& o) {
         const double prepareMs = p.prepareMs + msSince(frameStart);
 
         const auto traceStart = Clock::now();
-        const TraceResult result = backends.trace(g, o.request, planCheck(o, p, rays.size(), k));
+        const bool brute = o.request.trace.backend == Backend::Brute;
+        if (brute && !o.planOnly) announceBruteForce(p.scene.triangleCount(), rays.size(), BackendDispatcher::threadsOf(o.request.trace));
+        Progress progress("dacrt render", 1);
+        const TraceResult result = backends.trace(g, o.request, planCheck(o, p, rays.size(), k),
+                                                  brute ? ProgressHook([&](double f) { progress.fraction(f, "brute force"); })
+                                                        : ProgressHook());
         if (o.planOnly) continue;
         const double traceMs = msSince(traceStart);
 

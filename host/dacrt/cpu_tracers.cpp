@@ -1,6 +1,7 @@
 #include "dacrt/cpu_tracers.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <numeric>
 
 #include "dacrt/traversal.hpp"
@@ -27,7 +28,7 @@ Box regionBox(const Region& r) {
 
 }  // namespace
 
-TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook& onPlan) {
+TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook& onPlan, const ProgressHook& onProgress) {
     TraceResult result;
     planFrameInputs(g, result.memory);
     if (onPlan && !onPlan(result.memory)) return result;
@@ -35,6 +36,7 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
     const std::vector<Triangle>& tris = *g.triangles;
     result.hits.assign(rays.size(), missHit());
     const std::size_t blocks = (rays.size() + 63) / 64;
+    std::atomic<std::size_t> blocksDone{0};
     pool.parallelFor(blocks, [&](std::size_t block, unsigned) {
         const std::size_t end = std::min(rays.size(), (block + 1) * 64);
         for (std::size_t i = block * 64; i < end; ++i) {
@@ -42,6 +44,7 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
             for (std::size_t p = 0; p < tris.size(); ++p) testTriangle(rays[i], tris[p], std::uint32_t(p), best);
             result.hits[i] = best;
         }
+        if (onProgress) onProgress(double(++blocksDone) / double(blocks));
     });
     result.counters.rayTriangleTests = std::uint64_t(rays.size()) * tris.size();
     result.threads = pool.size();
@@ -153,10 +156,11 @@ void checkCpuOptions(const TraceOptions& options) {
                          toString(options.dacrt.intersector) + " intersector");
 }
 
-TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool, const PlanHook& onPlan) {
+TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool, const PlanHook& onPlan,
+                     const ProgressHook& onProgress) {
     checkCpuOptions(options);
     switch (options.backend) {
-        case Backend::Brute: return traceBrute(g, pool, onPlan);
+        case Backend::Brute: return traceBrute(g, pool, onPlan, onProgress);
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);
         case Backend::Cpu: return traceParallel(g, options, pool, onPlan);
         case Backend::Gpu:

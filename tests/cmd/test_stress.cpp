@@ -96,7 +96,7 @@ TEST_P(Stress, NoLeaksAndBruteForceBitForBit) {
     const FamilyData& data = family(p.family);
     int configurations = 0;
     for (StressConfig config : stressConfigs({p.backend}, true)) {
-        if (!config.request.trace.threads) config.request.trace.threads = 2;
+        if (!config.request.trace.threads && p.backend != Backend::CpuSeq) config.request.trace.threads = 2;
         StressTally total;
         // Defaults see every case; each non-default option value every fourth (the suite's
         // time limit), which `dacrt stress` lifts.

@@ -187,6 +187,8 @@ std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd,
 void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, const std::string& cacheDir,
                    std::vector<Accumulator>& acc, BackendDispatcher& dispatcher, unsigned hardwareThreads,
                    Progress& progress) {
+    progress.stage(s.name + ": camera " + std::to_string(k + 1) + " of " + std::to_string(s.cameras.size()) + ", " +
+                   std::to_string(acc.size()) + " configurations");
     progress.step(s.name + " float64 reference, camera " + std::to_string(k));
     const Camera& camera = s.cameras[k];
     const std::vector<Ray> rays = primaryRays(camera, cmd.width, cmd.height);
@@ -241,12 +243,11 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
                   BackendDispatcher& dispatcher, unsigned hardwareThreads, std::vector<BenchRow>& rows) {
     const BenchScene s = loadBenchScene(path, cmd, rows);
     std::vector<Accumulator> acc = startRows(s, cmd, configs);
-    Progress progress(s.cameras.size() * (1 + configs.size() * std::size_t(cmd.warmup + cmd.repeat)));
+    Progress progress("dacrt bench", s.cameras.size() * (1 + configs.size() * std::size_t(cmd.warmup + cmd.repeat)));
     const std::string cacheDir = cmd.cacheDir.empty() ? defaultCacheDir() : cmd.cacheDir;
     for (std::size_t k = 0; k < s.cameras.size(); ++k)
         measureCamera(s, k, cmd, cacheDir, acc, dispatcher, hardwareThreads, progress);
     finishRows(acc, s.cameras.size(), rows);
-    progress.finish();
 }
 
 // ---- reports ----------------------------------------------------------------------------
