@@ -122,6 +122,11 @@ Subcommand addRenderCommand(CLI::App& app) {
     cmd->add_option("-o,--output", render.outputPath, "shaded image (PNG or any OpenImageIO format)");
     cmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id and hit mask");
     cmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
+    cmd->add_option("--spp", render.samplesPerPixel,
+                    "samples per pixel of the shaded image, k x k strata (1, 4, 9, ...); AOVs keep the pixel centre")
+        ->default_str("1");
+    cmd->add_option("--depth-png", render.depthPngPath, "viewable depth: near bright, far dark, misses black");
+    cmd->add_option("--normal-png", render.normalPngPath, "viewable normals: n * 0.5 + 0.5 as RGB, misses black");
     addEnumOption(cmd, "--backend", render.request.trace.backend, "tracer");
     cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
     cmd->add_option("--regions", render.request.trace.regions, "sub-scenes (cpu, gpu; default: one per thread, on gpu one per core of a CPU device, 16 on a GPU)")

@@ -1,6 +1,7 @@
 #include "cmd/render.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 
@@ -29,8 +30,16 @@ void checkRenderOptions(const RenderOptions& o) {
     // With several cameras the files get "_camN" before the extension, in the same folder.
     checkOutputs({{"-o", o.outputPath, OutputFormat::Image},
                   {"--aov", o.aovPath, OutputFormat::Exr},
-                  {"--stats", o.statsPath, OutputFormat::Text}},
+                  {"--stats", o.statsPath, OutputFormat::Text},
+                  {"--depth-png", o.depthPngPath, OutputFormat::Image},
+                  {"--normal-png", o.normalPngPath, OutputFormat::Image}},
                  {o.scenePath});
+    const int strata = int(std::lround(std::sqrt(double(o.samplesPerPixel))));
+    if (o.samplesPerPixel < 1 || strata * strata != o.samplesPerPixel || o.samplesPerPixel > 1024)
+        throw InputError("--spp " + std::to_string(o.samplesPerPixel) +
+                         ": samples per pixel are k x k strata, so a square from 1 to 1024 (1, 4, 9, 16, ...)");
+    if (o.samplesPerPixel > 1 && o.outputPath.empty())
+        throw InputError("--spp antialiases the shaded image; name it with -o (AOVs keep the pixel centre's sample)");
 }
 
 // What every camera of the orbit shares: the scene, its bounds and the cameras.
@@ -76,19 +85,44 @@ PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t r
     };
 }
 
+// The shaded image: the centre sample alone, or the mean of k x k strata per pixel (the extra
+// samples are traced here, by the same backend; their time is returned in `samplesMs`).
+std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScene& p, const Camera& camera,
+                                      const HitImage& centre, BackendDispatcher& backends, double& samplesMs) {
+    samplesMs = 0.0;
+    if (o.samplesPerPixel == 1) return shadeImage(p.scene, centre);
+    const auto start = Clock::now();
+    const int k = int(std::lround(std::sqrt(double(o.samplesPerPixel))));
+    std::vector<glm::vec3> sum;
+    for (int j = 0; j < k; ++j)
+        for (int i = 0; i < k; ++i) {
+            const std::vector<Ray> rays = primaryRays(camera, o.width, o.height, {(i + 0.5) / k, (j + 0.5) / k});
+            const FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box);
+            const TraceResult r = backends.trace(g, o.request);
+            accumulateShading(p.scene, HitImage{o.width, o.height, &rays, &r.hits}, 1.0f / float(k * k), sum);
+        }
+    samplesMs = msSince(start);
+    return encodeSrgb8(sum);
+}
+
 // The shade and write stages of one camera, each file complete or absent. Appends the paths
 // written to `written`.
 void writeImages(const RenderOptions& o, const PreparedScene& p, int k, const HitImage& image,
-                 std::vector<std::string>& written) {
+                 const std::vector<std::uint8_t>& shaded, std::vector<std::string>& written) {
     const int count = int(p.cameras.size());
-    if (const std::string out = pathForCamera(o.outputPath, k, count); !out.empty()) {
-        writeThrough(out, [&](const std::string& to) { writeRgb8(to, image.width, image.height, shadeImage(p.scene, image)); });
-        written.push_back(out);
-    }
+    auto writeRgb = [&](const std::string& option, const std::vector<std::uint8_t>& rgb) {
+        const std::string path = pathForCamera(option, k, count);
+        if (path.empty()) return;
+        writeThrough(path, [&](const std::string& to) { writeRgb8(to, image.width, image.height, rgb); });
+        written.push_back(path);
+    };
+    writeRgb(o.outputPath, shaded);
     if (const std::string aov = pathForCamera(o.aovPath, k, count); !aov.empty()) {
         writeThrough(aov, [&](const std::string& to) { writeAov(to, p.scene, image); });
         written.push_back(aov);
     }
+    if (!o.depthPngPath.empty()) writeRgb(o.depthPngPath, depthPreview(image));
+    if (!o.normalPngPath.empty()) writeRgb(o.normalPngPath, normalPreview(p.scene, image));
 }
 
 void writeStats(const RenderOptions& o, int k, int cameraCount, const RenderedFrame& frame,
@@ -164,8 +198,12 @@ int runRender(const RenderOptions& o) {
         if (o.planOnly) continue;
         const double traceMs = msSince(traceStart);
 
+        const HitImage image{o.width, o.height, &rays, &result.hits};
+        double samplesMs = 0.0;
+        const std::vector<std::uint8_t> shaded =
+            o.outputPath.empty() ? std::vector<std::uint8_t>() : shadedImage(o, p, camera, image, backends, samplesMs);
         const auto writeStart = Clock::now();
-        writeImages(o, p, k, HitImage{o.width, o.height, &rays, &result.hits}, written);
+        writeImages(o, p, k, image, shaded, written);
         const double writeMs = msSince(writeStart);
         traceTimes.push_back(traceMs);
         raysPerFrame = rays.size();
@@ -173,8 +211,8 @@ int runRender(const RenderOptions& o) {
 
         writeStats(o, k, int(p.cameras.size()),
                    RenderedFrame{p.scene, camera, k, rays.size(), result,
-                                 {{"load", p.loadMs}, {"prepare", prepareMs}, {"trace", traceMs}, {"write", writeMs},
-                                  {"total", totalMs}}},
+                                 {{"load", p.loadMs}, {"prepare", prepareMs}, {"trace", traceMs},
+                                  {"antialiasing_samples", samplesMs}, {"write", writeMs}, {"total", totalMs}}},
                    written);
         std::cerr << "dacrt: " << toString(o.request.trace.backend) << " camera " << k << ": "
                   << p.scene.triangleCount() << " triangles, " << rays.size() << " rays, trace " << traceMs << " ms\n";

@@ -12,6 +12,9 @@ struct RenderOptions {
     std::string outputPath;   // shaded image; empty: none
     std::string aovPath;      // EXR AOVs; empty: none
     std::string statsPath;    // JSON; empty: none
+    std::string depthPngPath;   // viewable depth; empty: none
+    std::string normalPngPath;  // viewable normals; empty: none
+    int samplesPerPixel = 1;  // shaded image only: k x k strata per pixel (a square); AOVs keep the centre
     int width = 640;
     int height = 480;
     bool planOnly = false;    // print the memory plan and stop before tracing

@@ -105,7 +105,7 @@ Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
     return r;
 }
 
-std::vector<Ray> primaryRays(const Camera& camera, int width, int height) {
+std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::dvec2 offset) {
     std::vector<Ray> rays(std::size_t(width) * std::size_t(height));
     const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
     const double tanHalf = std::tan(0.5 * camera.yfovRadians);
@@ -113,8 +113,8 @@ std::vector<Ray> primaryRays(const Camera& camera, int width, int height) {
     const glm::vec3 origin = glm::vec3(camera.eye);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
-            const double sx = (2.0 * (x + 0.5) / width - 1.0) * tanHalf * aspect;
-            const double sy = (1.0 - 2.0 * (y + 0.5) / height) * tanHalf;
+            const double sx = (2.0 * (x + offset.x) / width - 1.0) * tanHalf * aspect;
+            const double sy = (1.0 - 2.0 * (y + offset.y) / height) * tanHalf;
             rays[std::size_t(y) * std::size_t(width) + std::size_t(x)] =
                 makeRay(origin, camera.forward + sx * right + sy * camera.up);
         }

@@ -38,7 +38,8 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
 // non-finite direction or origin.
 Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin = 0.0f);
 
-// One ray per pixel through the pixel centre, row-major from the top-left pixel.
-std::vector<Ray> primaryRays(const Camera& camera, int width, int height);
+// One ray per pixel through the point `offset` of the pixel (in pixel units from its top-left
+// corner; the centre by default), row-major from the top-left pixel.
+std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::dvec2 offset = {0.5, 0.5});
 
 }  // namespace dacrt

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -286,4 +287,28 @@ TEST(Cli, TheReadmeCiRecipeRuns) {
     const CommandResult r = run("compare " + cpu + " " + gpu + " --fail-on differ --diff " + diff);
     EXPECT_EQ(r.code, 0) << r.output;
     EXPECT_NE(r.output.find("compare: identical"), std::string::npos) << r.output;
+}
+
+// ---- images a person wants -----------------------------------------------------------------
+
+TEST(Cli, SamplesPerPixelAntialiasTheShadedImageOnly) {
+    const std::string scene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
+    const std::string one = temp("spp1.png"), four = temp("spp4.png"), aov1 = temp("spp1.exr"), aov4 = temp("spp4.exr");
+    const std::string depth = temp("depth.png"), normal = temp("normal.png");
+    ASSERT_EQ(run("render " + scene + " --size 48x36 -o " + one + " --aov " + aov1).code, 0);
+    const CommandResult r = run("render " + scene + " --size 48x36 --spp 4 -o " + four + " --aov " + aov4 +
+                                " --depth-png " + depth + " --normal-png " + normal);
+    ASSERT_EQ(r.code, 0) << r.output;
+    auto bytes = [](const std::string& path) {
+        std::ifstream f(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(f), {});
+    };
+    EXPECT_NE(bytes(one), bytes(four)) << "edges should change under 2 x 2 strata";
+    const CommandResult same = run("compare " + aov1 + " " + aov4 + " --fail-on any");
+    EXPECT_EQ(same.code, 0) << "AOVs keep the pixel centre: " << same.output;
+    EXPECT_GT(std::filesystem::file_size(depth), 0u);
+    EXPECT_GT(std::filesystem::file_size(normal), 0u);
+    const CommandResult bad = run("render " + scene + " --size 8x6 --spp 3 -o " + temp("spp3.png"));
+    EXPECT_EQ(bad.code, 2) << bad.output;
+    EXPECT_NE(bad.output.find("a square"), std::string::npos) << bad.output;
 }
