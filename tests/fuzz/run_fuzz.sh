@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Builds the glTF fuzzer (clang, -fsanitize=fuzzer,address,undefined) in its own build tree,
+# replays every file of the seed corpus, then fuzzes for a bounded time. Exit 0 when nothing
+# was found, 1 on a finding (the reproducer's path is printed), 77 (skip) without clang.
+# docs/fuzzing.md says how to run it for hours.
+#
+#   tests/fuzz/run_fuzz.sh [--build-dir DIR] [--time SECONDS] [--replay-only] [-- LIBFUZZER ARGS...]
+#
+# --build-dir  the clang build tree (default build-fuzz/ in the repository); the working
+#              corpus (DIR/corpus) and findings (DIR/findings/) live there too
+# --time       seconds of fuzzing after the replay (default 60; 0: replay only)
+# Arguments after -- go to libFuzzer, after the script's own (e.g. -fork=2 -ignore_crashes=1).
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+build="$root/build-fuzz"
+seconds=60
+extra=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build-dir) build="$2"; shift 2 ;;
+    --time) seconds="$2"; shift 2 ;;
+    --replay-only) seconds=0; shift ;;
+    --) shift; extra=("$@"); break ;;
+    *) echo "run_fuzz.sh: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+mkdir -p "$build"
+build="$(cd "$build" && pwd)"
+
+cxx="${DACRT_FUZZ_CXX:-clang++}"
+if ! command -v "$cxx" >/dev/null; then
+  echo "run_fuzz.sh: SKIP: $cxx not found (Debian: apt-get install clang libclang-rt-14-dev; .ci/setup does)"
+  exit 77
+fi
+
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+# Configure only once (the generator cannot change afterwards); later runs rebuild incrementally.
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+        -DDACRT_FUZZ=ON >"$build/configure.log" 2>&1 || { cat "$build/configure.log"; exit 1; }
+fi
+cmake --build "$build" --target dacrt_gltf_fuzzer
+fuzzer="$build/dacrt_gltf_fuzzer"
+
+# UBSan reports abort (the code is built with -fno-sanitize-recover=all); these make the
+# report carry a stack. Leaks count as findings (libFuzzer's -detect_leaks=1 default).
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:allocator_may_return_null=0}"
+
+findings="$build/findings"
+mkdir -p "$findings" "$build/corpus"
+# Each input: at most 10 s and 2 GiB, far above what a tiny scene takes (the fuzzer asks the
+# loader to refuse scenes above 256 MiB, so a larger allocation is the loader's finding).
+limits=(-timeout=10 -rss_limit_mb=2560 -malloc_limit_mb=2048 -artifact_prefix="$findings/")
+
+seeds=("$here"/corpus/*)
+echo "run_fuzz.sh: replaying ${#seeds[@]} corpus files"
+if ! "$fuzzer" "${limits[@]}" "${seeds[@]}" >"$build/replay.log" 2>&1; then
+  tail -n 80 "$build/replay.log"
+  echo "run_fuzz.sh: FINDING while replaying the corpus (log: $build/replay.log)"
+  exit 1
+fi
+echo "run_fuzz.sh: replay clean"
+[ "$seconds" -gt 0 ] || exit 0
+
+echo "run_fuzz.sh: fuzzing for $seconds s (log: $build/fuzz.log)"
+# New inputs go to the first corpus folder (the build tree's), never into tests/fuzz/corpus.
+status=0
+"$fuzzer" "${limits[@]}" -dict="$here/gltf.dict" -max_len=8192 -max_total_time="$seconds" -print_final_stats=1 \
+          "${extra[@]}" "$build/corpus" "$here/corpus" >"$build/fuzz.log" 2>&1 || status=$?
+grep -E '^#[0-9]+[[:space:]]+DONE|stat::number_of_executed_units|stat::peak_rss_mb|stat::new_units_added' "$build/fuzz.log" || true
+if [ "$status" -ne 0 ]; then
+  tail -n 80 "$build/fuzz.log"
+  echo "run_fuzz.sh: FINDING (exit $status); reproducers in $findings:"
+  ls -l "$findings"
+  echo "run_fuzz.sh: replay one with: $fuzzer $findings/<file>; keep it as tests/fuzz/corpus/crash-<name>"
+  exit 1
+fi
+echo "run_fuzz.sh: no finding in $seconds s"
