@@ -26,7 +26,7 @@ std::vector<std::string> ignoredOptions(const BackendRequest& r) {
     };
     given(r.trace.regions != 0, parallel, "--regions");
     given(r.trace.axis != DivisionAxis::Best, parallel, "--axis");
-    given(r.trace.threads > 1, b != Backend::CpuSeq, "--threads");
+    given(r.trace.threads > 1, b != Backend::CpuSeq && b != Backend::RayQuery, "--threads");
     given(d.rayLimit != 0, dacrt, "--ray-limit");
     given(d.triLimit != 0, dacrt, "--tri-limit");
     given(d.split != defaults.split, b == Backend::CpuSeq || b == Backend::Cpu, "--split");
@@ -35,7 +35,8 @@ std::vector<std::string> ignoredOptions(const BackendRequest& r) {
     given(d.precision != defaults.precision, b == Backend::CpuSeq || b == Backend::Cpu, "--precision");
     given(r.gpuTuning.workgroupSize != 0, b == Backend::Gpu, "--workgroup-size");
     given(r.gpuTuning.rayGroups != 0, b == Backend::Gpu, "--ray-groups");
-    given(!r.embreeRobust, b == Backend::Embree, "--embree-fast");
+    given(!r.embree.robust, b == Backend::Embree, "--embree-fast");
+    given(!r.embree.packets, b == Backend::Embree, "--embree-single-rays");
     return out;
 }
 
@@ -51,19 +52,22 @@ void checkBackendRequest(const BackendRequest& r) {
                          toString(r.trace.backend) + " (see dacrt render --help: each option names its backends)");
     }
     if (r.trace.backend == Backend::Gpu) checkGpuOptions(r.trace);
-    if (r.trace.backend != Backend::Gpu && r.trace.backend != Backend::Embree) checkCpuOptions(r.trace);
+    if (r.trace.backend != Backend::Gpu && r.trace.backend != Backend::Embree && r.trace.backend != Backend::RayQuery)
+        checkCpuOptions(r.trace);
 }
 
 void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends) {
-    const bool gpu = std::find(backends.begin(), backends.end(), Backend::Gpu) != backends.end();
+    const bool gpu = std::find(backends.begin(), backends.end(), Backend::Gpu) != backends.end() ||
+                     std::find(backends.begin(), backends.end(), Backend::RayQuery) != backends.end();
     if (gpu) return;
-    if (!devices.device.empty()) throw InputError("--device chooses the gpu backend's Vulkan device; no gpu backend runs here");
-    if (devices.validate) throw InputError("--validate runs the gpu backend under the Vulkan validation layers; no gpu backend runs here");
+    if (!devices.device.empty()) throw InputError("--device chooses the Vulkan device of the gpu and rayquery backends; neither runs here");
+    if (devices.validate) throw InputError("--validate runs the gpu and rayquery backends under the Vulkan validation layers; neither runs here");
 }
 
 BackendDispatcher::BackendDispatcher(const DeviceChoice& devices, const std::vector<Backend>& backends)
     : devices_(devices) {
-    if (std::find(backends.begin(), backends.end(), Backend::Gpu) != backends.end()) {
+    if (std::find(backends.begin(), backends.end(), Backend::Gpu) != backends.end() ||
+        std::find(backends.begin(), backends.end(), Backend::RayQuery) != backends.end()) {
         gpu_ = std::make_unique<gpu::Context>(gpu::ContextOptions{devices.device, devices.validate});
         pipelines_ = std::make_unique<gpu::PipelineCache>(*gpu_);
     }
@@ -93,7 +97,16 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
             return traceGpu(geometry, request.trace, request.gpuTuning, *gpu_, threadPool, onPlan, pipelines_.get());
         case Backend::Embree:
             // Embree allocates its BVH itself: there is no plan to show or check.
-            return traceEmbree(geometry, EmbreeOptions{request.embreeRobust, threads}, threadPool);
+        {
+            // A single frame's trace: the BVH is built for it (the bench times refit and static
+            // scenes across frames).
+            EmbreeOptions embree = request.embree;
+            embree.threads = threads;
+            return traceEmbree(geometry, embree, threadPool);
+        }
+        case Backend::RayQuery:
+            if (!gpu_) throw InternalError("the rayquery backend was asked for a trace without a device being opened");
+            return traceRayQuery(geometry, *gpu_, *pipelines_, onPlan);
         case Backend::Brute:
         case Backend::CpuSeq:
         case Backend::Cpu: return traceCpu(geometry, request.trace, threadPool, onPlan, onProgress);

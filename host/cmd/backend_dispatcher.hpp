@@ -18,13 +18,16 @@
 #include "gpu/context.hpp"
 #include "gpu/gpu_tracer.hpp"
 #include "gpu/pipeline_cache.hpp"
+#include "gpu/rayquery_tracer.hpp"
+#include "oracle/embree_tracer.hpp"
 
 namespace dacrt {
 
 struct BackendRequest {
     TraceOptions trace;
     GpuTuning gpuTuning;        // gpu only
-    bool embreeRobust = true;   // embree only
+    EmbreeOptions embree;       // embree only (threads: the request's)
+    RayQueryBuild rayQueryBuild = RayQueryBuild::Dynamic;  // rayquery only (bench: persistent scenes)
 };
 
 // Throws InputError, naming the command-line options, when the request gives a backend an
@@ -41,7 +44,7 @@ void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& 
 
 class BackendDispatcher {
 public:
-    // Opens the Vulkan device now when `backends` includes gpu, so that a missing or
+    // Opens the Vulkan device now when `backends` includes gpu or rayquery, so that a missing or
     // unmatched device fails before any long work.
     BackendDispatcher(const DeviceChoice& devices, const std::vector<Backend>& backends);
     ~BackendDispatcher();
@@ -49,7 +52,8 @@ public:
     // Threads a request runs on: 1 for cpu-seq, else its own count or every core.
     static unsigned threadsOf(const TraceOptions& options);
     ThreadPool& pool(unsigned threads);
-    gpu::Context* gpuContext() { return gpu_.get(); }  // null unless gpu was asked for
+    gpu::Context* gpuContext() { return gpu_.get(); }  // null unless gpu or rayquery was asked for
+    gpu::PipelineCache* pipelines() { return pipelines_.get(); }
     const gpu::Context* gpuContext() const { return gpu_.get(); }
 
     // Checks the request (checkBackendRequest), then traces one frame on its backend.

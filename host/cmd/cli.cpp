@@ -104,8 +104,8 @@ struct Subcommand {
 };
 
 void addDeviceOptions(CLI::App* cmd, DeviceChoice& devices) {
-    cmd->add_option("--device", devices.device, "Vulkan device index or part of its name, see 'dacrt devices' (gpu; default: discrete, integrated, then the rest)");
-    cmd->add_flag("--validate", devices.validate, "run under the Vulkan validation layers; errors fail the run with exit 3 (gpu)");
+    cmd->add_option("--device", devices.device, "Vulkan device index or part of its name, see 'dacrt devices' (gpu, rayquery; default: discrete, integrated, then the rest)");
+    cmd->add_flag("--validate", devices.validate, "run under the Vulkan validation layers; errors fail the run with exit 3 (gpu, rayquery)");
 }
 
 Subcommand addRenderCommand(CLI::App& app) {
@@ -113,7 +113,7 @@ Subcommand addRenderCommand(CLI::App& app) {
         RenderOptions render;
         std::string size = "640x480", eye, target, up;
         double fov = 0.0;
-        bool embreeFast = false;
+        bool embreeFast = false, embreeSingleRays = false;
     };
     auto s = std::make_shared<State>();
     RenderOptions& render = s->render;
@@ -136,6 +136,8 @@ Subcommand addRenderCommand(CLI::App& app) {
     addEnumOption(cmd, "--axis", render.request.trace.axis, "division axis (cpu, gpu)");
     addDacrtOptions(cmd, render.request.trace.dacrt);
     cmd->add_flag("--embree-fast", s->embreeFast, "without RTC_SCENE_FLAG_ROBUST: faster, leaks through edges (embree)");
+    cmd->add_flag("--embree-single-rays", s->embreeSingleRays,
+                  "one rtcIntersect1 per ray instead of 16-wide packets on 4x4 tiles (embree)");
     cmd->add_option("--eye", s->eye, "camera position x,y,z (default: the scene's camera, else a front view framing the scene)");
     cmd->add_option("--target", s->target, "point the camera looks at x,y,z");
     cmd->add_option("--up", s->up, "camera up vector x,y,z (default: the scene camera's, else +y)");
@@ -149,7 +151,8 @@ Subcommand addRenderCommand(CLI::App& app) {
         ->check(CLI::Range(1u, 1024u));
     cmd->add_option("--ray-groups", render.request.gpuTuning.rayGroups,
                     "work items per region, each a band of its rays with its own copy of the region's "
-                    "triangle ids (gpu; default: 2 on a CPU device)")
+                    "triangle ids (gpu; default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; "
+                    "64 / regions on a GPU)")
         ->check(CLI::Range(1u, 64u));
     return {cmd, [s, cmd] {
                 RenderOptions& r = s->render;
@@ -163,7 +166,9 @@ Subcommand addRenderCommand(CLI::App& app) {
                                          "degrees, got " + std::to_string(s->fov));
                     r.camera.fovDegrees = s->fov;
                 }
-                r.request.embreeRobust = !s->embreeFast;
+                r.request.embree.robust = !s->embreeFast;
+                r.request.embree.packets = !s->embreeSingleRays;
+                r.request.embree.imageWidth = std::uint32_t(r.width);
                 return runRender(r);
             }};
 }
@@ -260,9 +265,12 @@ Subcommand addBenchCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("bench", "frame time against error for every backend and option (docs/benchmarks.md)");
     cmd->add_option("scenes", bench.scenes, "glTF scenes")->required();
     addBackendListOption(cmd, "--backends", bench.backends,
-                         "backends (default: cpu-seq,cpu,gpu,embree; gpu only with a device)", enumNameList<Backend>());
-    cmd->add_option("--suite", s->suite, "sweep (every option value) or table51 (the source's Table 5.1 and Figure 5.3)")
-        ->check(CLI::IsMember({"sweep", "table51"}))->default_str("sweep");
+                         "backends (default: cpu-seq,cpu,gpu,embree,rayquery; gpu with a Vulkan device, "
+                         "rayquery with one that has ray query)", enumNameList<Backend>());
+    cmd->add_option("--suite", s->suite,
+                    "sweep (every option value), peers (each DACRT default against every embree and rayquery mode) "
+                    "or table51 (the source's Table 5.1 and Figure 5.3)")
+        ->check(CLI::IsMember({"sweep", "peers", "table51"}))->default_str("sweep");
     cmd->add_option("--orbit", bench.orbit, "K cameras on a circle about the vertical axis")->check(CLI::Range(1, 1000))->default_str("1");
     cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
     cmd->add_option("--repeat", bench.repeat, "timed frames per camera and configuration")->check(CLI::Range(1, 1000))->default_str("3");
@@ -276,7 +284,9 @@ Subcommand addBenchCommand(CLI::App& app) {
     addDeviceOptions(cmd, bench.devices);
     return {cmd, [s] {
                 parseSize(s->size, s->bench.width, s->bench.height);
-                s->bench.suite = s->suite == "table51" ? BenchSuite::Table51 : BenchSuite::Sweep;
+                s->bench.suite = s->suite == "table51" ? BenchSuite::Table51
+                                 : s->suite == "peers" ? BenchSuite::Peers
+                                                       : BenchSuite::Sweep;
                 s->bench.useCache = !s->noCache;
                 return runBenchCommand(s->bench);
             }};

@@ -21,6 +21,13 @@ void Progress::stage(const std::string& what) {
     if (!terminal_) std::cerr << label_ << ": " << what << "\n";
 }
 
+void Progress::note(const std::string& what) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (terminal_) std::cerr << "\r\033[K";
+    std::cerr << label_ << ": " << what << "\n";
+    lastDraw_ = {};  // the bar comes back at the next step
+}
+
 void Progress::step(const std::string& what) {
     std::lock_guard<std::mutex> lock(mutex_);
     ++done_;

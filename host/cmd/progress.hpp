@@ -17,6 +17,8 @@ public:
 
     // A new stage: a line of its own when stderr is not a terminal.
     void stage(const std::string& what);
+    // A finished stage's result: a line of its own on a terminal too (above the bar).
+    void note(const std::string& what);
     // One step done (`what` shown beside the bar on a terminal). Safe from several threads.
     void step(const std::string& what = {});
     // Fraction done, for work counted in other units (rays, blocks). Safe from several threads.

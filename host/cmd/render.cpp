@@ -196,7 +196,11 @@ int runRender(const RenderOptions& o) {
                                                   brute ? ProgressHook([&](double f) { progress.fraction(f, "brute force"); })
                                                         : ProgressHook());
         if (o.planOnly) continue;
-        const double traceMs = msSince(traceStart);
+        // Pipeline compilation is a cost of the process, not of the frame: reported apart.
+        double compileMs = 0.0;
+        for (const auto& [name, ms] : result.phaseMs)
+            if (name == kPipelinePhase) compileMs += ms;
+        const double traceMs = msSince(traceStart) - compileMs;
 
         const HitImage image{o.width, o.height, &rays, &result.hits};
         double samplesMs = 0.0;
@@ -211,7 +215,7 @@ int runRender(const RenderOptions& o) {
 
         writeStats(o, k, int(p.cameras.size()),
                    RenderedFrame{p.scene, camera, k, rays.size(), result,
-                                 {{"load", p.loadMs}, {"prepare", prepareMs}, {"trace", traceMs},
+                                 {{"load", p.loadMs}, {"prepare", prepareMs}, {"shader_compile", compileMs}, {"trace", traceMs},
                                   {"antialiasing_samples", samplesMs}, {"write", writeMs}, {"total", totalMs}}},
                    written);
         std::cerr << "dacrt: " << toString(o.request.trace.backend) << " camera " << k << ": "

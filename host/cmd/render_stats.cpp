@@ -33,7 +33,9 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
                     {"axis", toString(trace.axis)}, {"intersector", toString(trace.dacrt.intersector)},
                     {"triangle_filter", toString(trace.dacrt.triangleFilter)},
                     {"precision", toString(trace.dacrt.precision)}};
-    if (trace.backend == Backend::Embree) j["options"] = {{"robust", o.request.embreeRobust}};
+    if (trace.backend == Backend::Embree)
+        j["options"] = {{"robust", o.request.embree.robust}, {"build", toString(o.request.embree.build)},
+                        {"packets", o.request.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
     nlohmann::ordered_json t;
     for (const auto& [name, ms] : frame.timingsMs) t[name] = ms;
     nlohmann::ordered_json phases;

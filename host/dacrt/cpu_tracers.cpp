@@ -164,7 +164,8 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);
         case Backend::Cpu: return traceParallel(g, options, pool, onPlan);
         case Backend::Gpu:
-        case Backend::Embree: break;
+        case Backend::Embree:
+        case Backend::RayQuery: break;
     }
     throw InternalError("traceCpu called for the " + toString(options.backend) + " backend");
 }

@@ -6,7 +6,7 @@
 
 namespace dacrt {
 
-enum class Backend { Brute, CpuSeq, Cpu, Gpu, Embree };
+enum class Backend { Brute, CpuSeq, Cpu, Gpu, Embree, RayQuery };
 enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
 enum class DivisionAxis { Best, X, Y, Z };
 // Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks
@@ -21,11 +21,12 @@ enum class Precision { F32, F64 };
 
 template <>
 struct EnumNames<Backend> {
-    static constexpr std::array<std::pair<Backend, std::string_view>, 5> table{{{Backend::Brute, "brute"},
+    static constexpr std::array<std::pair<Backend, std::string_view>, 6> table{{{Backend::Brute, "brute"},
                                                                                  {Backend::CpuSeq, "cpu-seq"},
                                                                                  {Backend::Cpu, "cpu"},
                                                                                  {Backend::Gpu, "gpu"},
-                                                                                 {Backend::Embree, "embree"}}};
+                                                                                 {Backend::Embree, "embree"},
+                                                                                 {Backend::RayQuery, "rayquery"}}};
 };
 template <>
 struct EnumNames<SplitMethod> {

@@ -8,10 +8,10 @@
 
 namespace dacrt::gpu {
 
-Buffer::Buffer(const Context& context, std::uint64_t bytes, std::string name)
+Buffer::Buffer(const Context& context, std::uint64_t bytes, std::string name, BufferUse use)
     : device_(context.device()), bytes_(std::max<std::uint64_t>(bytes, 16)), name_(std::move(name)) {
     const DeviceInfo& info = context.info();
-    if (bytes_ > info.maxStorageBufferRange)
+    if (use == BufferUse::Storage && bytes_ > info.maxStorageBufferRange)
         throw InputError("buffer '" + name_ + "' needs " + std::to_string(bytes_) + " bytes but the device's " +
                          "maxStorageBufferRange is " + std::to_string(info.maxStorageBufferRange) + " (over by " +
                          std::to_string(bytes_ - info.maxStorageBufferRange) + " bytes)");
@@ -21,7 +21,19 @@ Buffer::Buffer(const Context& context, std::uint64_t bytes, std::string name)
     VkBufferCreateInfo bufferInfo{};
     bufferInfo.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
     bufferInfo.size = bytes_;
-    bufferInfo.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    switch (use) {
+        case BufferUse::Storage: bufferInfo.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT; break;
+        case BufferUse::AccelerationInput:
+            bufferInfo.usage = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
+                               VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+            break;
+        case BufferUse::AccelerationStorage:
+            bufferInfo.usage = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+            break;
+        case BufferUse::AccelerationScratch:
+            bufferInfo.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+            break;
+    }
     bufferInfo.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     VK_CHECK(vkCreateBuffer(device_, &bufferInfo, nullptr, &buffer_));
     VkMemoryRequirements req;
@@ -37,6 +49,10 @@ Buffer::Buffer(const Context& context, std::uint64_t bytes, std::string name)
     alloc.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     alloc.allocationSize = req.size;
     alloc.memoryTypeIndex = type;
+    VkMemoryAllocateFlagsInfo addressable{};
+    addressable.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO;
+    addressable.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+    if (use != BufferUse::Storage) alloc.pNext = &addressable;
     const VkResult r = vkAllocateMemory(device_, &alloc, nullptr, &memory_);
     if (r != VK_SUCCESS) {
         vkDestroyBuffer(device_, buffer_, nullptr);
@@ -68,6 +84,13 @@ Buffer::~Buffer() {
         vkFreeMemory(device_, memory_, nullptr);
     }
     if (buffer_) vkDestroyBuffer(device_, buffer_, nullptr);
+}
+
+VkDeviceAddress Buffer::deviceAddress() const {
+    VkBufferDeviceAddressInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO;
+    info.buffer = buffer_;
+    return vkGetBufferDeviceAddress(device_, &info);
 }
 
 void Buffer::upload(const void* data, std::uint64_t bytes, std::uint64_t offset) {

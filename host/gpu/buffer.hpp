@@ -10,17 +10,23 @@
 
 namespace dacrt::gpu {
 
-// A storage buffer in host-visible, coherent memory (device-local too where the device has
-// such memory): uploads and readbacks are plain copies.
+// What a buffer is for: the compute kernels' storage, or the parts of a ray-query
+// acceleration structure (its geometry input, its storage, its build scratch), which are
+// reached by device address.
+enum class BufferUse { Storage, AccelerationInput, AccelerationStorage, AccelerationScratch };
+
+// A buffer in host-visible, coherent memory (device-local too where the device has such
+// memory): uploads and readbacks are plain copies.
 class Buffer {
 public:
-    Buffer(const Context& context, std::uint64_t bytes, std::string name);
+    Buffer(const Context& context, std::uint64_t bytes, std::string name, BufferUse use = BufferUse::Storage);
     ~Buffer();
     Buffer(Buffer&& other) noexcept;
     Buffer& operator=(Buffer&&) = delete;
     Buffer(const Buffer&) = delete;
 
     VkBuffer handle() const { return buffer_; }
+    VkDeviceAddress deviceAddress() const;  // for the acceleration-structure uses only
     std::uint64_t size() const { return bytes_; }
     const std::string& name() const { return name_; }
     void upload(const void* data, std::uint64_t bytes, std::uint64_t offset = 0);

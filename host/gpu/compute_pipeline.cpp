@@ -1,5 +1,6 @@
 #include "gpu/compute_pipeline.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "core/errors.hpp"
@@ -10,7 +11,14 @@ namespace dacrt::gpu {
 ComputePipeline::ComputePipeline(const Context& context, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
                                  std::uint32_t pushConstantBytes, const std::vector<std::uint32_t>& specialization,
                                  std::string name)
-    : device_(context.device()), bindings_(bindingCount), pushBytes_(pushConstantBytes), name_(std::move(name)) {
+    : ComputePipeline(context, spirv, std::vector<VkDescriptorType>(bindingCount, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER),
+                      pushConstantBytes, specialization, std::move(name)) {}
+
+ComputePipeline::ComputePipeline(const Context& context, std::span<const std::uint32_t> spirv,
+                                 std::vector<VkDescriptorType> bindingTypes, std::uint32_t pushConstantBytes,
+                                 const std::vector<std::uint32_t>& specialization, std::string name)
+    : device_(context.device()), types_(std::move(bindingTypes)), pushBytes_(pushConstantBytes), name_(std::move(name)) {
+    const std::uint32_t bindingCount = std::uint32_t(types_.size());
     try {
         VkShaderModuleCreateInfo moduleInfo{};
         moduleInfo.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
@@ -20,7 +28,7 @@ ComputePipeline::ComputePipeline(const Context& context, std::span<const std::ui
 
         std::vector<VkDescriptorSetLayoutBinding> bindings(bindingCount);
         for (std::uint32_t b = 0; b < bindingCount; ++b)
-            bindings[b] = VkDescriptorSetLayoutBinding{b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+            bindings[b] = VkDescriptorSetLayoutBinding{b, types_[b], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
         VkDescriptorSetLayoutCreateInfo setInfo{};
         setInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
         setInfo.bindingCount = bindingCount;
@@ -49,14 +57,19 @@ ComputePipeline::ComputePipeline(const Context& context, std::span<const std::ui
         if (context.info().fullSubgroups) pipelineInfo.stage.flags = VK_PIPELINE_SHADER_STAGE_CREATE_REQUIRE_FULL_SUBGROUPS_BIT_EXT;
         pipelineInfo.stage.pSpecializationInfo = specialization.empty() ? nullptr : &spec;
         pipelineInfo.layout = layout_;
-        VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_));
+        VK_CHECK(vkCreateComputePipelines(device_, context.pipelineCache(), 1, &pipelineInfo, nullptr, &pipeline_));
 
-        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, bindingCount};
+        std::vector<VkDescriptorPoolSize> sizes;
+        for (VkDescriptorType t : types_) {
+            auto it = std::find_if(sizes.begin(), sizes.end(), [&](const VkDescriptorPoolSize& p) { return p.type == t; });
+            if (it == sizes.end()) sizes.push_back({t, 1});
+            else ++it->descriptorCount;
+        }
         VkDescriptorPoolCreateInfo poolInfo{};
         poolInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
         poolInfo.maxSets = 1;
-        poolInfo.poolSizeCount = 1;
-        poolInfo.pPoolSizes = &size;
+        poolInfo.poolSizeCount = std::uint32_t(sizes.size());
+        poolInfo.pPoolSizes = sizes.data();
         VK_CHECK(vkCreateDescriptorPool(device_, &poolInfo, nullptr, &pool_));
         VkDescriptorSetAllocateInfo allocInfo{};
         allocInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
@@ -86,22 +99,39 @@ void ComputePipeline::destroy() {
 }
 
 void ComputePipeline::bind(const std::vector<const Buffer*>& buffers) {
-    if (buffers.size() != bindings_)
-        throw std::logic_error("pipeline '" + name_ + "' has " + std::to_string(bindings_) + " bindings, got " +
+    if (buffers.size() != types_.size())
+        throw std::logic_error("pipeline '" + name_ + "' has " + std::to_string(types_.size()) + " bindings, got " +
                                std::to_string(buffers.size()) + " buffers");
     std::vector<VkDescriptorBufferInfo> infos(buffers.size());
-    std::vector<VkWriteDescriptorSet> writes(buffers.size());
+    std::vector<VkWriteDescriptorSet> writes;
     for (std::uint32_t b = 0; b < buffers.size(); ++b) {
+        if (types_[b] != VK_DESCRIPTOR_TYPE_STORAGE_BUFFER || !buffers[b]) continue;
         infos[b] = VkDescriptorBufferInfo{buffers[b]->handle(), 0, VK_WHOLE_SIZE};
-        writes[b] = VkWriteDescriptorSet{};
-        writes[b].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        writes[b].dstSet = set_;
-        writes[b].dstBinding = b;
-        writes[b].descriptorCount = 1;
-        writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        writes[b].pBufferInfo = &infos[b];
+        VkWriteDescriptorSet w{};
+        w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        w.dstSet = set_;
+        w.dstBinding = b;
+        w.descriptorCount = 1;
+        w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        w.pBufferInfo = &infos[b];
+        writes.push_back(w);
     }
     vkUpdateDescriptorSets(device_, std::uint32_t(writes.size()), writes.data(), 0, nullptr);
+}
+
+void ComputePipeline::bindAccelerationStructure(std::uint32_t binding, VkAccelerationStructureKHR structure) {
+    VkWriteDescriptorSetAccelerationStructureKHR as{};
+    as.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR;
+    as.accelerationStructureCount = 1;
+    as.pAccelerationStructures = &structure;
+    VkWriteDescriptorSet w{};
+    w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    w.pNext = &as;
+    w.dstSet = set_;
+    w.dstBinding = binding;
+    w.descriptorCount = 1;
+    w.descriptorType = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
+    vkUpdateDescriptorSets(device_, 1, &w, 0, nullptr);
 }
 
 }  // namespace dacrt::gpu

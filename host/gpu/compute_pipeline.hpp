@@ -17,12 +17,16 @@ class ComputePipeline {
 public:
     ComputePipeline(const Context& context, std::span<const std::uint32_t> spirv, std::uint32_t bindingCount,
                     std::uint32_t pushConstantBytes, const std::vector<std::uint32_t>& specialization, std::string name);
+    // Bindings 0..n-1 of the given types (storage buffers, an acceleration structure).
+    ComputePipeline(const Context& context, std::span<const std::uint32_t> spirv, std::vector<VkDescriptorType> bindingTypes,
+                    std::uint32_t pushConstantBytes, const std::vector<std::uint32_t>& specialization, std::string name);
     ~ComputePipeline();
     ComputePipeline(const ComputePipeline&) = delete;
     ComputePipeline& operator=(const ComputePipeline&) = delete;
 
-    // Points binding k at buffers[k].
+    // Points binding k at buffers[k] (null for a binding that is not a storage buffer).
     void bind(const std::vector<const Buffer*>& buffers);
+    void bindAccelerationStructure(std::uint32_t binding, VkAccelerationStructureKHR structure);
     const std::string& name() const { return name_; }
     VkPipeline pipeline() const { return pipeline_; }
     VkPipelineLayout layout() const { return layout_; }
@@ -38,7 +42,7 @@ private:
     VkPipeline pipeline_ = VK_NULL_HANDLE;
     VkDescriptorPool pool_ = VK_NULL_HANDLE;
     VkDescriptorSet set_ = VK_NULL_HANDLE;
-    std::uint32_t bindings_ = 0;
+    std::vector<VkDescriptorType> types_;
     std::uint32_t pushBytes_ = 0;
     std::string name_;
 };

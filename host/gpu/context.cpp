@@ -5,7 +5,9 @@
 #include <mutex>
 #include <sstream>
 
+#include "core/cache_files.hpp"
 #include "core/errors.hpp"
+#include "gpu/pipeline_store.hpp"
 #include "gpu/vulkan_error.hpp"
 
 namespace dacrt::gpu {
@@ -31,7 +33,10 @@ VkInstance createInstance(bool validate) {
     VkApplicationInfo app{};
     app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
     app.pApplicationName = "dacrt";
-    app.apiVersion = VK_API_VERSION_1_1;
+    // 1.2 for buffer device addresses (the rayquery backend); the compute kernel needs 1.1.
+    std::uint32_t loaderVersion = VK_API_VERSION_1_0;
+    if (vkEnumerateInstanceVersion(&loaderVersion) != VK_SUCCESS) loaderVersion = VK_API_VERSION_1_0;
+    app.apiVersion = loaderVersion >= VK_API_VERSION_1_2 ? VK_API_VERSION_1_2 : VK_API_VERSION_1_1;
     VkInstanceCreateInfo info{};
     info.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     info.pApplicationInfo = &app;
@@ -107,6 +112,36 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     const bool sizeControl = std::any_of(extensions.begin(), extensions.end(), [](const VkExtensionProperties& e) {
         return std::strcmp(e.extensionName, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME) == 0;
     });
+    auto hasExtension = [&](const char* name) {
+        return std::any_of(extensions.begin(), extensions.end(),
+                           [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+    };
+    {
+        std::vector<std::string> missing;
+        if (basic.apiVersion < VK_API_VERSION_1_2) missing.push_back("Vulkan 1.2");
+        for (const char* e : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME})
+            if (!hasExtension(e)) missing.push_back(e);
+        if (missing.empty()) {
+            VkPhysicalDeviceRayQueryFeaturesKHR rq{};
+            rq.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
+            VkPhysicalDeviceAccelerationStructureFeaturesKHR as{};
+            as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+            as.pNext = &rq;
+            VkPhysicalDeviceBufferDeviceAddressFeatures bda{};
+            bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
+            bda.pNext = &as;
+            VkPhysicalDeviceFeatures2 features{};
+            features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+            features.pNext = &bda;
+            vkGetPhysicalDeviceFeatures2(d, &features);
+            if (!rq.rayQuery) missing.push_back("the rayQuery feature");
+            if (!as.accelerationStructure) missing.push_back("the accelerationStructure feature");
+            if (!bda.bufferDeviceAddress) missing.push_back("the bufferDeviceAddress feature");
+        }
+        info.rayQuery = missing.empty();
+        for (std::size_t i = 0; i < missing.size(); ++i) info.rayQueryMissing += (i ? ", " : "") + missing[i];
+    }
     if (sizeControl) {
         VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
         control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
@@ -146,7 +181,8 @@ std::string DeviceInfo::describe() const {
       << "   storage buffers per stage: " << maxPerStageStorageBuffers << "\n"
       << "   subgroup size: " << subgroupSize << (subgroupOperations ? " (arithmetic and shuffles in compute)" : " (no compute arithmetic or shuffles)")
       << "\n   full subgroups on request: " << (fullSubgroups ? "yes" : "no")
-      << "\n   timestamps: " << (timestamps ? "yes" : "no") << "\n";
+      << "\n   timestamps: " << (timestamps ? "yes" : "no")
+      << "\n   ray query (rayquery backend): " << (rayQuery ? "yes" : "no, lacks " + rayQueryMissing) << "\n";
     return s.str();
 }
 
@@ -246,15 +282,39 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
         // The kernel's subgroups must be full (leaves shuffle triangles across all lanes):
         // requested where the device can promise it; elsewhere the workgroup size stays a
         // multiple of the subgroup size, which every driver known to us fills.
+        std::vector<const char*> enabled;
+        void* chain = nullptr;
         VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
         control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
-        const char* sizeControl = VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME;
         if (info_.fullSubgroups) {
             control.computeFullSubgroups = VK_TRUE;
-            deviceInfo.pNext = &control;
-            deviceInfo.enabledExtensionCount = 1;
-            deviceInfo.ppEnabledExtensionNames = &sizeControl;
+            control.pNext = chain;
+            chain = &control;
+            enabled.push_back(VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
         }
+        // Ray query where the device has it: the rayquery backend builds acceleration
+        // structures from device addresses and traces them from a compute shader.
+        VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{};
+        rayQuery.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
+        VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{};
+        accel.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+        VkPhysicalDeviceBufferDeviceAddressFeatures addresses{};
+        addresses.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
+        if (info_.rayQuery) {
+            rayQuery.rayQuery = VK_TRUE;
+            accel.accelerationStructure = VK_TRUE;
+            addresses.bufferDeviceAddress = VK_TRUE;
+            rayQuery.pNext = chain;
+            accel.pNext = &rayQuery;
+            addresses.pNext = &accel;
+            chain = &addresses;
+            for (const char* e : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                                  VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME})
+                enabled.push_back(e);
+        }
+        deviceInfo.pNext = chain;
+        deviceInfo.enabledExtensionCount = std::uint32_t(enabled.size());
+        deviceInfo.ppEnabledExtensionNames = enabled.data();
         VK_CHECK(vkCreateDevice(physical_, &deviceInfo, nullptr, &device_));
         vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 
@@ -268,6 +328,8 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
         VkPhysicalDeviceProperties p;
         vkGetPhysicalDeviceProperties(physical_, &p);
         timestampPeriodNs_ = p.limits.timestampPeriod;
+        store_ = std::make_unique<PipelineStore>(physical_, device_, info_.driver,
+                                                 options.persistentPipelines ? defaultCacheDir() : std::string());
     } catch (...) {
         destroy();
         throw;
@@ -276,7 +338,10 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
 
 Context::~Context() { destroy(); }
 
+VkPipelineCache Context::pipelineCache() const { return store_ ? store_->cache() : VK_NULL_HANDLE; }
+
 void Context::destroy() {
+    store_.reset();  // saved while the device lives
     if (commandPool_) vkDestroyCommandPool(device_, commandPool_, nullptr);
     if (device_) vkDestroyDevice(device_, nullptr);
     if (messenger_) {

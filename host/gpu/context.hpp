@@ -27,6 +27,10 @@ struct DeviceInfo {
     bool subgroupOperations = false;  // compute-stage arithmetic and shuffle operations (the kernel's)
     bool fullSubgroups = false;       // VK_EXT_subgroup_size_control's computeFullSubgroups
     bool timestamps = false;
+    // VK_KHR_acceleration_structure, VK_KHR_ray_query and buffer device addresses, with their
+    // features, on Vulkan 1.2 or later: what the rayquery backend needs. Otherwise, what lacks.
+    bool rayQuery = false;
+    std::string rayQueryMissing;
     bool isCpu() const { return type == VK_PHYSICAL_DEVICE_TYPE_CPU; }  // lavapipe, SwiftShader
     std::string typeName() const;  // as vulkan.hpp names it: DiscreteGpu, Cpu, ...
     std::string describe() const;
@@ -35,7 +39,10 @@ struct DeviceInfo {
 struct ContextOptions {
     std::string device;    // index or part of the name; empty: best available
     bool validate = false; // enable VK_LAYER_KHRONOS_validation and count its errors
+    bool persistentPipelines = true;  // keep compiled pipelines under $XDG_CACHE_HOME/dacrt
 };
+
+class PipelineStore;
 
 class Context {
 public:
@@ -52,6 +59,8 @@ public:
     VkCommandPool commandPool() const { return commandPool_; }
     const DeviceInfo& info() const { return info_; }
     double timestampPeriodNs() const { return timestampPeriodNs_; }
+    VkPipelineCache pipelineCache() const;  // every pipeline is created through it
+    const PipelineStore& pipelineStore() const { return *store_; }
     std::uint32_t memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags wanted) const;
 
     // Validation messages of error severity seen so far (0 unless validate was set).
@@ -71,6 +80,7 @@ private:
     DeviceInfo info_;
     double timestampPeriodNs_ = 1.0;
     std::unique_ptr<Messages> messages_;
+    std::unique_ptr<PipelineStore> store_;
 };
 
 // Every device of every installed driver, in enumeration order. Throws InputError if there

@@ -41,27 +41,50 @@ DispatchRecorder::~DispatchRecorder() {
     if (commands_) vkFreeCommandBuffers(device, context_.commandPool(), 1, &commands_);
 }
 
-void DispatchRecorder::dispatch(const std::string& name, const ComputePipeline& pipeline, std::uint32_t groups,
-                                const void* push) {
+void DispatchRecorder::beginStep(const std::string& name, VkPipelineStageFlags stage, VkAccessFlags reads) {
     const std::uint32_t index = std::uint32_t(names_.size());
     if (index >= maxDispatches_) throw std::logic_error("more dispatches than planned (" + std::to_string(maxDispatches_) + ")");
     if (index > 0) {
         VkMemoryBarrier barrier{};
         barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-        barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-        barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-        vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                             &barrier, 0, nullptr, 0, nullptr);
+        barrier.srcAccessMask = lastWrites_;
+        barrier.dstAccessMask = reads;
+        vkCmdPipelineBarrier(commands_, lastStage_, stage, 0, 1, &barrier, 0, nullptr, 0, nullptr);
     }
     names_.push_back(name);
     if (queries_) vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, queries_, 2 * index);
+}
+
+void DispatchRecorder::endStep(VkPipelineStageFlags stage, VkAccessFlags writes) {
+    const std::uint32_t index = std::uint32_t(names_.size()) - 1;
+    if (queries_) vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, 2 * index + 1);
+    lastStage_ = stage;
+    lastWrites_ = writes;
+}
+
+void DispatchRecorder::dispatch(const std::string& name, const ComputePipeline& pipeline, std::uint32_t groups,
+                                const void* push) {
+    constexpr VkAccessFlags kReads =
+        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR;
+    // Only devices with acceleration structures know their access bit.
+    beginStep(name, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+              context_.info().rayQuery ? kReads : VkAccessFlags(VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT));
     vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline());
     VkDescriptorSet set = pipeline.descriptorSet();
     vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout(), 0, 1, &set, 0, nullptr);
     if (pipeline.pushConstantBytes())
         vkCmdPushConstants(commands_, pipeline.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, pipeline.pushConstantBytes(), push);
     if (groups > 0) vkCmdDispatch(commands_, groups, 1, 1);
-    if (queries_) vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, queries_, 2 * index + 1);
+    endStep(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+}
+
+void DispatchRecorder::buildAccelerationStructures(const std::string& name,
+                                                   const std::function<void(VkCommandBuffer)>& commands) {
+    beginStep(name, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+              VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR |
+                  VK_ACCESS_SHADER_READ_BIT);
+    commands(commands_);
+    endStep(VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR);
 }
 
 void DispatchRecorder::submitAndWait() {

@@ -1,6 +1,7 @@
 #include "gpu/embedded_shaders.hpp"
 
 #include "dacrt.spv.h"
+#include "rayquery.spv.h"
 #include "workgroup_test.spv.h"
 
 namespace dacrt::gpu {
@@ -10,5 +11,7 @@ std::span<const std::uint32_t> dacrtKernelSpirv() { return {dacrt_spv, sizeof(da
 std::span<const std::uint32_t> workgroupTestSpirv() {
     return {workgroup_test_spv, sizeof(workgroup_test_spv) / sizeof(workgroup_test_spv[0])};
 }
+
+std::span<const std::uint32_t> rayQuerySpirv() { return {rayquery_spv, sizeof(rayquery_spv) / sizeof(rayquery_spv[0])}; }
 
 }  // namespace dacrt::gpu

@@ -7,5 +7,6 @@ namespace dacrt::gpu {
 
 std::span<const std::uint32_t> dacrtKernelSpirv();    // shaders/dacrt.comp
 std::span<const std::uint32_t> workgroupTestSpirv();  // shaders/workgroup_test.comp
+std::span<const std::uint32_t> rayQuerySpirv();       // shaders/rayquery.comp
 
 }  // namespace dacrt::gpu

@@ -118,7 +118,7 @@ gpu::ComputePipeline& preparePipeline(const GpuFrame& frame, const DacrtOptions&
         .sharedStart = gpu::raysShareStart(*frame.geometry.rays),
     });
     set.bindTo(pipeline);
-    result.phaseMs.emplace_back("pipeline", msSince(start));
+    result.phaseMs.emplace_back(kPipelinePhase, msSince(start));
     return pipeline;
 }
 

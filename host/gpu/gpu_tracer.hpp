@@ -13,6 +13,10 @@
 
 namespace dacrt {
 
+// The phase in which pipelines are created and compiled (first use in a process; drivers that
+// cache compiled pipelines make it short afterwards): reported apart from the frame's time.
+inline constexpr const char* kPipelinePhase = "pipeline compile";
+
 struct GpuTuning {
     std::uint32_t workgroupSize = 0;  // 0: the device's default (gpu::defaultWorkgroupSize)
     std::uint32_t rayGroups = 0;      // 0: the device's default (gpu::defaultRayGroups)

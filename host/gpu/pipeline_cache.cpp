@@ -1,6 +1,8 @@
 #include "gpu/pipeline_cache.hpp"
 
 #include "core/shader_layout.hpp"
+#include "gpu/binding_set.hpp"
+#include "gpu/dispatch_recorder.hpp"
 #include "gpu/embedded_shaders.hpp"
 
 namespace dacrt::gpu {
@@ -16,13 +18,48 @@ std::vector<std::uint32_t> KernelSpecialization::values() const {
     return v;
 }
 
+namespace {
+
+// Runs the kernel once over a work item that is already finished, so that a driver that
+// compiles at the first dispatch (lavapipe does: about 10 s for this kernel on Mesa 25.0.7
+// without its shader cache) does so here, where the time is reported as the pipeline's, and
+// not inside a frame's dispatches.
+void prime(Context& context, ComputePipeline& pipeline) {
+    DacrtBindingSet set(context, planDacrtBuffers(DacrtBufferCounts{
+                                     .rays = 1, .triangles = 1, .rayIds = 1, .triangleIds = 1, .regions = 1, .workItems = 1, .maxDepth = 0}));
+    TraversalState finished{};
+    finished.phase = 2;  // kPhaseFinished in shaders/dacrt.comp
+    set[DACRT_BINDING_STATES].upload(&finished, sizeof(finished));
+    const WorkItem item{};
+    set[DACRT_BINDING_WORK_ITEMS].upload(&item, sizeof(item));
+    set.bindTo(pipeline);
+    DispatchRecorder recorder(context, 1);
+    const DacrtPush push{};
+    recorder.dispatch("prime", pipeline, 1, &push);
+    recorder.submitAndWait();
+}
+
+}  // namespace
+
 ComputePipeline& PipelineCache::kernel(const KernelSpecialization& specialization) {
     const std::vector<std::uint32_t> values = specialization.values();
     std::unique_ptr<ComputePipeline>& slot = pipelines_[values];
-    if (!slot)
+    if (!slot) {
         slot = std::make_unique<ComputePipeline>(context_, dacrtKernelSpirv(), DACRT_BINDING_COUNT, sizeof(DacrtPush),
                                                  values, "dacrt");
+        prime(context_, *slot);
+    }
     return *slot;
+}
+
+ComputePipeline& PipelineCache::rayQuery() {
+    if (!rayQuery_)
+        rayQuery_ = std::make_unique<ComputePipeline>(
+            context_, rayQuerySpirv(),
+            std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                          VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
+            2 * sizeof(std::uint32_t), std::vector<std::uint32_t>{}, "rayquery");
+    return *rayQuery_;
 }
 
 }  // namespace dacrt::gpu

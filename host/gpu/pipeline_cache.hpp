@@ -1,5 +1,5 @@
 #pragma once
-// The DACRT kernel's compiled pipelines, kept across frames (an orbit, a benchmark), one per
+// The compiled pipelines (the DACRT kernel's and the ray-query shader's), kept across frames (an orbit, a benchmark), one per
 // set of specialization constants: creating one costs about 40 ms on lavapipe.
 #include <cstdint>
 #include <map>
@@ -25,9 +25,17 @@ class PipelineCache {
 public:
     explicit PipelineCache(Context& context) : context_(context) {}
     ComputePipeline& kernel(const KernelSpecialization& specialization);
+    // shaders/rayquery.comp: rays, hits, the top-level acceleration structure.
+    ComputePipeline& rayQuery();
+    // Whether the ray-query pipeline has run once (its caller primes it: the shader binds an
+    // acceleration structure, which only a scene has).
+    bool rayQueryPrimed() const { return rayQueryPrimed_; }
+    void markRayQueryPrimed() { rayQueryPrimed_ = true; }
 
 private:
     Context& context_;
+    std::unique_ptr<ComputePipeline> rayQuery_;
+    bool rayQueryPrimed_ = false;
     std::map<std::vector<std::uint32_t>, std::unique_ptr<ComputePipeline>> pipelines_;
 };
 

@@ -9,6 +9,8 @@
 #include <string>
 
 #include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
 
 #include "core/timing.hpp"
 
@@ -76,12 +78,56 @@ SharedDevice& sharedDevice(unsigned threads) {
     return *slot;
 }
 
+// The identity index buffer of n triangles stored as 3n consecutive vertices, made once per
+// count and shared by every scene of that count: a renderer keeps its topology's indices.
+const std::vector<std::uint32_t>& identityIndices(std::size_t triangles) {
+    static std::mutex mutex;
+    static std::map<std::size_t, std::vector<std::uint32_t>> cache;
+    std::lock_guard<std::mutex> lock(mutex);
+    std::vector<std::uint32_t>& v = cache[triangles];
+    if (v.size() != triangles * 3) {
+        v.resize(triangles * 3);
+        for (std::size_t i = 0; i < v.size(); ++i) v[i] = std::uint32_t(i);
+    }
+    return v;
+}
+
+// Flush-to-zero and denormals-are-zero for the calling thread while it lives, as Embree
+// recommends for speed; the previous mode comes back after (dacrt's tracers share the threads).
+class FlushDenormals {
+public:
+    FlushDenormals() : csr_(_mm_getcsr()) {
+        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    }
+    ~FlushDenormals() { _mm_setcsr(csr_); }
+
+private:
+    unsigned csr_;
+};
+
+RTCBuildQuality geometryQualityOf(EmbreeBuild build) {
+    switch (build) {
+        case EmbreeBuild::Dynamic: return RTC_BUILD_QUALITY_LOW;
+        case EmbreeBuild::Refit: return RTC_BUILD_QUALITY_REFIT;
+        case EmbreeBuild::Static: return RTC_BUILD_QUALITY_HIGH;
+    }
+    return RTC_BUILD_QUALITY_MEDIUM;
+}
+
+Hit hitOf(float tfar, unsigned geomID, unsigned primID, float u, float v) {
+    if (geomID == RTC_INVALID_GEOMETRY_ID) return Hit{kNoHitT, kMissPrim, 0.0f, 0.0f};
+    return Hit{tfar, primID, u, v};  // Embree's u and v weight v1 and v2, as dacrt's do
+}
+
 }  // namespace
 
 struct EmbreeScene::Impl {
     SharedDevice* shared = nullptr;
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
+    RTCGeometry geometry = nullptr;  // owned by the scene once attached
+    EmbreeOptions options;
 
     Impl() = default;
     Impl(const Impl&) = delete;
@@ -106,57 +152,53 @@ struct EmbreeScene::Impl {
         const std::string error = pendingError(call);
         if (!error.empty()) throw std::runtime_error(error);
     }
+
+    void traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, std::vector<Hit>& hits) const;
+    void traceTile(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16],
+                   std::vector<Hit>& hits) const;
 };
 
 EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOptions& options)
     : impl_(std::make_unique<Impl>()) {
     impl_->shared = &sharedDevice(options.threads);
     impl_->device = impl_->shared->device;
+    impl_->options = options;
 
-    // Only what a new frame repeats is timed: copying the triangles and the BVH build.
+    // Only what a new frame repeats is timed: the scene, its geometry and the BVH build.
     const Clock::time_point start = Clock::now();
     impl_->scene = rtcNewScene(impl_->device);
     impl_->check("rtcNewScene");
-    rtcSetSceneFlags(impl_->scene, options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
+    int flags = options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE;
+    if (options.build != EmbreeBuild::Static) flags |= RTC_SCENE_FLAG_DYNAMIC;
+    rtcSetSceneFlags(impl_->scene, RTCSceneFlags(flags));
     impl_->check("rtcSetSceneFlags");
-    // MEDIUM is Embree's default SAH build. HIGH adds spatial splits, several times the build
-    // cost for a faster trace, which a scene rebuilt every frame does not earn back; LOW
-    // (Morton) would make Embree's trace look slower than it is.
-    rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_MEDIUM);
+    rtcSetSceneBuildQuality(impl_->scene, options.build == EmbreeBuild::Static ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_LOW);
     impl_->check("rtcSetSceneBuildQuality");
 
     // An empty list has nothing to attach: the committed empty scene is one every ray misses.
     if (!triangles.empty()) {
         GeometryHandle geometry(rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE));
         impl_->check("rtcNewGeometry");
-
-        // Unindexed triangles: dacrt stores three vertices per triangle, so the index buffer
-        // is the identity and primID equals the triangle's index. Buffers from
-        // rtcSetNewGeometryBuffer are over-allocated by Embree for its 16-byte vertex loads,
-        // so no padding is added here.
-        const std::size_t vertexCount = triangles.size() * 3;
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), vertexCount));
-        impl_->check("rtcSetNewGeometryBuffer(vertex)");
-        auto* indices = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(
-            geometry.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(std::uint32_t), triangles.size()));
-        impl_->check("rtcSetNewGeometryBuffer(index)");
-
-        for (std::size_t i = 0; i < triangles.size(); ++i) {
-            const Triangle& t = triangles[i];
-            for (const glm::vec3* v : {&t.v0, &t.v1, &t.v2}) {
-                *vertices++ = v->x;
-                *vertices++ = v->y;
-                *vertices++ = v->z;
-            }
-            for (std::uint32_t k = 0; k < 3; ++k) *indices++ = std::uint32_t(3 * i + k);
-        }
-
+        // The scene's quality picks the top-level builder only; each mesh is built at its own
+        // quality, which defaults to MEDIUM (SAH). LOW selects the Morton builder that dynamic
+        // scenes are meant to use (4x faster on the Dragon), REFIT keeps the topology's tree.
+        rtcSetGeometryBuildQuality(geometry.get(), geometryQualityOf(options.build));
+        impl_->check("rtcSetGeometryBuildQuality");
+        // dacrt's Triangle is three 16-byte vertex slots (a float3 and padding each), so the
+        // array is a vertex buffer of stride 16 as it is, and every 16-byte load Embree makes
+        // stays inside it. The index buffer is the identity: primID is the triangle's index.
+        rtcSetSharedGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, triangles.data(), 0,
+                                   16, triangles.size() * 3);
+        impl_->check("rtcSetSharedGeometryBuffer(vertex)");
+        rtcSetSharedGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                   identityIndices(triangles.size()).data(), 0, 3 * sizeof(std::uint32_t),
+                                   triangles.size());
+        impl_->check("rtcSetSharedGeometryBuffer(index)");
         rtcCommitGeometry(geometry.get());
         impl_->check("rtcCommitGeometry");
         rtcAttachGeometry(impl_->scene, geometry.get());
         impl_->check("rtcAttachGeometry");
-        // The scene now holds its own reference; the handle's release drops ours.
+        impl_->geometry = geometry.get();  // the scene now holds its own reference; ours is released
     }
 
     rtcCommitScene(impl_->scene);
@@ -165,6 +207,76 @@ EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOpt
 }
 
 EmbreeScene::~EmbreeScene() = default;
+
+double EmbreeScene::update() {
+    const Clock::time_point start = Clock::now();
+    if (impl_->geometry) {
+        rtcUpdateGeometryBuffer(impl_->geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+        impl_->check("rtcUpdateGeometryBuffer");
+        rtcCommitGeometry(impl_->geometry);
+        impl_->check("rtcCommitGeometry");
+    }
+    rtcCommitScene(impl_->scene);
+    impl_->check("rtcCommitScene");
+    return msSince(start);
+}
+
+void EmbreeScene::Impl::traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end,
+                                    std::vector<Hit>& hits) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (std::size_t i = begin; i < end; ++i) {
+        const Ray& ray = rays[i];
+        RTCRayHit query{};
+        query.ray.org_x = ray.origin.x;
+        query.ray.org_y = ray.origin.y;
+        query.ray.org_z = ray.origin.z;
+        // dacrt accepts only t > tmin while Embree's tnear is inclusive (t >= tnear). The two
+        // differ only for a triangle through the point at exactly tmin, which for primary rays
+        // (tmin 0) means a triangle through the eye; that case is left to Embree rather than
+        // nudging tnear, which would move every other answer too.
+        query.ray.tnear = ray.tmin;
+        query.ray.dir_x = ray.dir.x;
+        query.ray.dir_y = ray.dir.y;
+        query.ray.dir_z = ray.dir.z;
+        query.ray.tfar = std::numeric_limits<float>::infinity();
+        query.ray.mask = ~0u;
+        query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        query.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(scene, &context, &query);
+        hits[i] = hitOf(query.ray.tfar, query.hit.geomID, query.hit.primID, query.hit.u, query.hit.v);
+    }
+}
+
+void EmbreeScene::Impl::traceTile(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16],
+                                  std::vector<Hit>& hits) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(64) RTCRayHit16 q;
+    for (int l = 0; l < 16; ++l) {
+        const Ray& ray = rays[valid[l] ? index[l] : index[0]];
+        q.ray.org_x[l] = ray.origin.x;
+        q.ray.org_y[l] = ray.origin.y;
+        q.ray.org_z[l] = ray.origin.z;
+        q.ray.tnear[l] = ray.tmin;  // see traceSingle
+        q.ray.dir_x[l] = ray.dir.x;
+        q.ray.dir_y[l] = ray.dir.y;
+        q.ray.dir_z[l] = ray.dir.z;
+        q.ray.time[l] = 0.0f;
+        q.ray.tfar[l] = std::numeric_limits<float>::infinity();
+        q.ray.mask[l] = ~0u;
+        q.ray.id[l] = unsigned(l);
+        q.ray.flags[l] = 0;
+        q.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+        q.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+        q.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, scene, &context, &q);
+    for (int l = 0; l < 16; ++l)
+        if (valid[l]) hits[index[l]] = hitOf(q.ray.tfar[l], q.hit.geomID[l], q.hit.primID[l], q.hit.u[l], q.hit.v[l]);
+}
 
 TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool) const {
     TraceResult result;
@@ -177,53 +289,44 @@ TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool) c
     // failure is kept and thrown from this thread once every chunk is done.
     std::mutex failureMutex;
     std::string failure;
+    auto keepFailure = [&] {
+        const std::string error = impl_->pendingError(impl_->options.packets ? "rtcIntersect16" : "rtcIntersect1");
+        if (error.empty()) return;
+        std::lock_guard<std::mutex> lock(failureMutex);
+        if (failure.empty()) failure = error;
+    };
 
-    // Embree recommends flush-to-zero and denormals-are-zero for speed; they are left off
-    // because the same threads run dacrt's tracers, whose exact arithmetic they would change.
     const Clock::time_point start = Clock::now();
-    const std::size_t chunks = (rays.size() + kRaysPerChunk - 1) / kRaysPerChunk;
-    pool.parallelFor(chunks, [&](std::size_t chunk, unsigned) {
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
-        const std::size_t end = std::min(rays.size(), (chunk + 1) * kRaysPerChunk);
-        for (std::size_t i = chunk * kRaysPerChunk; i < end; ++i) {
-            const Ray& ray = rays[i];
-            RTCRayHit query{};
-            query.ray.org_x = ray.origin.x;
-            query.ray.org_y = ray.origin.y;
-            query.ray.org_z = ray.origin.z;
-            // dacrt accepts only t > tmin while Embree's tnear is inclusive (t >= tnear). The
-            // two differ only for a triangle through the point at exactly tmin, which for
-            // primary rays (tmin 0) means a triangle through the eye; that case is left to
-            // Embree rather than nudging tnear, which would move every other answer too.
-            query.ray.tnear = ray.tmin;
-            query.ray.dir_x = ray.dir.x;
-            query.ray.dir_y = ray.dir.y;
-            query.ray.dir_z = ray.dir.z;
-            query.ray.time = 0.0f;
-            query.ray.tfar = std::numeric_limits<float>::infinity();
-            query.ray.mask = ~0u;
-            query.ray.id = 0;
-            query.ray.flags = 0;
-            query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            query.hit.primID = RTC_INVALID_GEOMETRY_ID;
-            query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(impl_->scene, &context, &query);
-
-            Hit& hit = result.hits[i];
-            if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-                hit = Hit{kNoHitT, kMissPrim, 0.0f, 0.0f};
-            } else {
-                // Embree's u and v weight v1 and v2, as dacrt's do.
-                hit = Hit{query.ray.tfar, query.hit.primID, query.hit.u, query.hit.v};
+    const std::size_t width = impl_->options.imageWidth ? impl_->options.imageWidth : 16;
+    const std::size_t height = (rays.size() + width - 1) / width;
+    if (!impl_->options.packets) {
+        const std::size_t chunks = (rays.size() + kRaysPerChunk - 1) / kRaysPerChunk;
+        pool.parallelFor(chunks, [&](std::size_t chunk, unsigned) {
+            const FlushDenormals ftz;
+            impl_->traceSingle(rays, chunk * kRaysPerChunk, std::min(rays.size(), (chunk + 1) * kRaysPerChunk), result.hits);
+            keepFailure();
+        });
+    } else {
+        // Tiles of 4x4 pixels; with no image width, 16 consecutive rays. A row of tiles per
+        // work unit.
+        const bool tiled = impl_->options.imageWidth != 0;
+        const std::size_t tileColumns = tiled ? (width + 3) / 4 : 1, tileRows = tiled ? (height + 3) / 4 : height;
+        pool.parallelFor(tileRows, [&](std::size_t row, unsigned) {
+            const FlushDenormals ftz;
+            for (std::size_t column = 0; column < tileColumns; ++column) {
+                std::size_t index[16];
+                alignas(64) int valid[16];  // rtcIntersect16 wants the mask, like the packet, 64-byte aligned
+                for (int l = 0; l < 16; ++l) {
+                    const std::size_t x = tiled ? column * 4 + std::size_t(l % 4) : std::size_t(l);
+                    const std::size_t y = tiled ? row * 4 + std::size_t(l / 4) : row;
+                    index[l] = y * width + x;
+                    valid[l] = x < width && index[l] < rays.size() ? -1 : 0;
+                }
+                impl_->traceTile(rays, index, valid, result.hits);
             }
-        }
-        const std::string error = impl_->pendingError("rtcIntersect1");
-        if (!error.empty()) {
-            std::lock_guard<std::mutex> lock(failureMutex);
-            if (failure.empty()) failure = error;
-        }
-    });
+            keepFailure();
+        });
+    }
     if (!failure.empty()) throw std::runtime_error(failure);
     result.phaseMs.emplace_back("trace", msSince(start));
     return result;

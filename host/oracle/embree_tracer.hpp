@@ -6,22 +6,41 @@
 #include <memory>
 #include <vector>
 
+#include "core/enum_names.hpp"
 #include "core/thread_pool.hpp"
 #include "dacrt/frame_geometry.hpp"
 #include "dacrt/trace_result.hpp"
 
 namespace dacrt {
 
-struct EmbreeOptions {
-    // RTC_SCENE_FLAG_ROBUST: no leaks through shared edges, 3-7% slower. On by default, unlike
-    // Embree itself: without it Embree leaks real pixels on the Bunny's orbit (docs/benchmarks.md).
-    bool robust = true;
-    unsigned threads = 0; // threads of Embree's BVH build; 0: every core
+// How the BVH follows the frames, as Embree's users configure each case.
+// Dynamic: RTC_SCENE_FLAG_DYNAMIC with RTC_BUILD_QUALITY_LOW, a new BVH every frame (a scene
+// whose topology changes). Refit: one scene kept across frames, its geometry at
+// RTC_BUILD_QUALITY_REFIT, the vertex buffer updated and recommitted each frame (valid while
+// only vertices move). Static: RTC_BUILD_QUALITY_HIGH, built once, frames pay the trace only.
+enum class EmbreeBuild { Dynamic, Refit, Static };
+template <>
+struct EnumNames<EmbreeBuild> {
+    static constexpr std::array<std::pair<EmbreeBuild, std::string_view>, 3> table{
+        {{EmbreeBuild::Dynamic, "dynamic"}, {EmbreeBuild::Refit, "refit"}, {EmbreeBuild::Static, "static"}}};
 };
 
-// One Embree device and one committed scene over the given triangles (built in the
-// constructor: that is the per-frame cost of a dynamic scene). Throws std::runtime_error
-// with Embree's error text on failure.
+struct EmbreeOptions {
+    // RTC_SCENE_FLAG_ROBUST: no leaks through shared edges. On by default, unlike Embree
+    // itself: without it Embree leaks real pixels on the Bunny's orbit (docs/benchmarks.md).
+    bool robust = true;
+    unsigned threads = 0;  // threads of Embree's BVH build; 0: every core
+    EmbreeBuild build = EmbreeBuild::Dynamic;
+    // rtcIntersect16 on 4x4 pixel tiles with the coherent flag (primary rays); false: one
+    // rtcIntersect1 per ray.
+    bool packets = true;
+    std::uint32_t imageWidth = 0;  // the rays' image width, for the tiles; 0: runs of 16 rays
+};
+
+// One Embree device (per thread count, for the whole process) and one committed scene over
+// the given triangles, whose vertices Embree reads in place (a shared buffer: the array must
+// outlive the scene and keep its address). Throws std::runtime_error with Embree's error text
+// on failure.
 class EmbreeScene {
 public:
     EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOptions& options);
@@ -31,8 +50,13 @@ public:
 
     double buildMs() const { return buildMs_; }
 
-    // Closest hit of every ray (t > ray.tmin), traced on the pool's threads. phaseMs holds
-    // {"trace", ms}; counters stay zero (Embree does not report them).
+    // After the triangles' vertices moved (same count): refit (Refit) or rebuild (otherwise).
+    // Returns the milliseconds it took.
+    double update();
+
+    // Closest hit of every ray (t > ray.tmin), traced on the pool's threads with flush-to-zero
+    // and denormals-are-zero on (restored afterwards: the same threads run dacrt). phaseMs
+    // holds {"trace", ms}; counters stay zero (Embree does not report them).
     TraceResult trace(const std::vector<Ray>& rays, ThreadPool& pool) const;
 
 private:

@@ -59,7 +59,7 @@ TEST(Bench, SweepWritesRowsAndCacheAndDefaultsAreExact) {
     ASSERT_EQ(r.code, 0) << r.output;
     const nlohmann::json j = out.json();
     const std::size_t rows = j["rows"].size();
-    EXPECT_GE(rows, 30u);  // every option value of cpu-seq and cpu, four embree rows
+    EXPECT_GE(rows, 30u);  // every option value of cpu-seq and cpu, seven embree rows
     EXPECT_EQ(lines(out.dir / "b.csv"), rows + 1);
     expectDefaultsExact(j, {"cpu-seq", "cpu", "embree"});
     std::set<std::string> configs;
@@ -73,7 +73,8 @@ TEST(Bench, SweepWritesRowsAndCacheAndDefaultsAreExact) {
     }
     for (const char* expected : {"cpu-seq intersector=moller-trumbore", "cpu-seq triangle-filter=sat",
                                  "cpu-seq triangle-filter=mora", "cpu-seq precision=f64", "cpu-seq split=sampled-mean",
-                                 "cpu regions=64", "cpu axis=z", "embree static default", "embree robust=off"})
+                                 "cpu regions=64", "cpu axis=z", "embree static default", "embree dynamic robust=off",
+                                 "embree refit default", "embree refit robust=off", "embree dynamic rtcIntersect1"})
         EXPECT_TRUE(configs.count(expected)) << expected;
 
     std::size_t cached = 0;
@@ -111,6 +112,23 @@ TEST(Bench, Table51SuiteReportsSpeedupsOverSequential) {
     const nlohmann::json j = out.json();
     EXPECT_EQ(j["rows"].size(), 1u + 6u * 4u);  // sequential, then six thread/region setups by four axes
     for (const auto& row : j["rows"]) EXPECT_TRUE(row["speedup_over_cpu_seq"].is_number());
+}
+
+TEST(Bench, PeersSuiteRunsEachDefaultAgainstEveryPeerMode) {
+    const BenchOutputs out("peers");
+    const test::CommandResult r = test::runDacrt("bench " + roomScene() +
+                                                 " --suite peers --backends cpu-seq,cpu,embree --size 32x24 --repeat 1 --warmup 0" +
+                                                 out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json j = out.json();
+    EXPECT_EQ(j["command"]["suite"].get<std::string>(), "peers");
+    std::set<std::string> configs;
+    for (const auto& row : j["rows"]) configs.insert(row["series"].get<std::string>() + " " + row["config"].get<std::string>());
+    const std::set<std::string> expected = {"cpu-seq default",       "cpu default",          "embree dynamic default",
+                                            "embree dynamic robust=off", "embree refit default", "embree refit robust=off",
+                                            "embree static default", "embree static robust=off", "embree dynamic rtcIntersect1"};
+    EXPECT_EQ(configs, expected);
+    expectDefaultsExact(j, {"cpu-seq", "cpu", "embree"});
 }
 
 TEST(Bench, OutputsDefaultToOneDirectoryAndAreCheckedFirst) {

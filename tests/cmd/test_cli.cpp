@@ -119,7 +119,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCommand{"BruteWithDacrtOption", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend brute --triangle-filter sat",
                    "--triangle-filter"},
         BadCommand{"DeviceWithCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu --device 0",
-                   "--device chooses the gpu backend's Vulkan device"},
+                   "--device chooses the Vulkan device of the gpu and rayquery backends"},
         BadCommand{"RegionsWithCpuSeq", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu-seq --regions 4 --axis x",
                    "--regions and --axis are not options of --backend cpu-seq"},
         BadCommand{"EmbreeFastOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --embree-fast", "--embree-fast"},

@@ -84,12 +84,16 @@ Agreement compare(const std::vector<Hit>& brute, const std::vector<Hit>& embree)
     return a;
 }
 
-Agreement traceAndCompare(const Frame& frame, bool robust) {
+Agreement traceAndCompare(const Frame& frame, bool robust, EmbreeBuild build = EmbreeBuild::Dynamic, bool packets = true) {
     ThreadPool pool(2);
     const TraceResult brute = traceBrute(frame.geometry, pool);
     EmbreeOptions options;
     options.robust = robust;
-    const TraceResult embree = traceEmbree(frame.geometry, options, pool);
+    options.build = build;
+    options.packets = packets;
+    options.imageWidth = std::uint32_t(frame.width);
+    const EmbreeScene scene(frame.scene.triangles, options);
+    const TraceResult embree = scene.trace(frame.rays, pool);
     EXPECT_EQ(embree.hits.size(), frame.rays.size());
     return compare(brute.hits, embree.hits);
 }
@@ -257,4 +261,42 @@ TEST(EmbreeScene, OneAndTwoThreadsGiveIdenticalHits) {
         for (std::size_t i = 0; i < hits[0].size(); ++i) differing += !bitIdentical(hits[0][i], hits[1][i]);
         EXPECT_EQ(differing, 0u) << (robust ? "robust" : "not robust");
     }
+}
+
+// Each way Embree's users build (dynamic, refit, static) and trace (4x4 packets, single
+// rays), in robust mode, agrees with brute force up to ties.
+TEST(EmbreeAgreesWithBrute, EveryBuildModeAndPackets) {
+    const Scene s = test::shapesScene();
+    const Frame frame(test::shapesScene(), defaultCamera(s, 61, 45), 61, 45);  // odd sizes: partial 4x4 tiles
+    for (EmbreeBuild build : {EmbreeBuild::Dynamic, EmbreeBuild::Refit, EmbreeBuild::Static})
+        for (bool packets : {true, false}) {
+            const Agreement a = traceAndCompare(frame, true, build, packets);
+            const std::string what = toString(build) + (packets ? " packets" : " single rays");
+            EXPECT_GT(a.bruteHits, frame.rays.size() / 20) << what;
+            EXPECT_EQ(a.leaks + a.phantoms + a.wrongPrim + a.depthOrUvOff, 0u) << what << ": " << a.describe();
+        }
+}
+
+// A refitted scene follows its shared vertex buffer: move every vertex, update, and it answers
+// as a scene built on the moved vertices does.
+TEST(EmbreeScene, RefitFollowsMovedVertices) {
+    Scene s = test::shapesScene();
+    const Camera camera = defaultCamera(s, 48, 36);
+    const std::vector<Ray> rays = primaryRays(camera, 48, 36);
+    ThreadPool pool(2);
+    EmbreeOptions options;
+    options.build = EmbreeBuild::Refit;
+    options.imageWidth = 48;
+    EmbreeScene refitted(s.triangles, options);
+    const TraceResult before = refitted.trace(rays, pool);
+    for (Triangle& t : s.triangles) t.v0.x += 0.25f, t.v1.x += 0.25f, t.v2.x += 0.25f;
+    EXPECT_GE(refitted.update(), 0.0);
+    const TraceResult after = refitted.trace(rays, pool);
+    options.build = EmbreeBuild::Dynamic;
+    const EmbreeScene rebuilt(s.triangles, options);
+    const Agreement a = compare(rebuilt.trace(rays, pool).hits, after.hits);
+    EXPECT_EQ(a.leaks + a.phantoms + a.wrongPrim + a.depthOrUvOff, 0u) << a.describe();
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) moved += !bitIdentical(before.hits[i], after.hits[i]);
+    EXPECT_GT(moved, rays.size() / 10);
 }

@@ -20,7 +20,8 @@ inline gpu::Context* gpuContext(std::string* why) {
     if (!tried) {
         tried = true;
         try {
-            context = std::make_unique<gpu::Context>(gpu::ContextOptions{"", true});
+            // No pipeline file: tests leave the user's cache alone (test_pipeline_store.cpp tests it).
+            context = std::make_unique<gpu::Context>(gpu::ContextOptions{"", true, false});
         } catch (const std::exception& e) {
             reason = e.what();
         }

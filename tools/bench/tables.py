@@ -8,11 +8,14 @@ def fmt_psnr(v):
     return "inf" if v == "inf" else f"{v:.1f}"
 
 
-def sweep(path):
+def sweep(path, scene=None):
+    """Every row of one bench run (of one scene, where the run has several)."""
     j = json.load(open(path))
     print("| series | config | min ms | median ms | Mrays/s | real errors | near ties | leaks (real) | max rel depth | PSNR dB | Pareto |")
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     for r in j["rows"]:
+        if scene and r["scene"] != scene:
+            continue
         name = r["config"] + (" **(default)**" if r["default"] else "")
         print(f"| {r['series']} | {name} | {r['frame_ms_min']:.1f} | {r['frame_ms_median']:.1f} | "
               f"{r['mrays_per_s']:.2f} | {r['real_errors']} | {r['near_ties']} | {r['leaks']} ({r['real_leaks']}) | "
@@ -75,7 +78,49 @@ def figure53(path):
               f"{(sp['best'] / worst_inface - 1) * 100:+.0f}% |")
 
 
-KINDS = {"sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
+def driver_of(j):
+    """The lavapipe a run used, from its machine record: "Mesa 25.0.7", say."""
+    import re
+    m = re.search(r"Mesa (\d+\.\d+\.\d+)", j["machine"].get("gpu_driver", ""))
+    return "Mesa " + m.group(1) if m else "?"
+
+
+def peers(paths, scene):
+    """cpu and gpu against every peer row, from runs on different drivers (comma-separated
+    JSON files, each one run): each row is compared with that same run's cpu."""
+    print("| series | config | driver | frame ms (min) | build or refit ms | trace ms | real errors | near ties | leaks (real) | dacrt cpu against it |")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---|")
+    for path in paths.split(","):
+        j = json.load(open(path))
+        driver = driver_of(j)
+        rows = [r for r in j["rows"] if r["scene"] == scene]
+        cpu = next(r for r in rows if r["series"] == "cpu" and r["default"])
+        for r in rows:
+            dacrt = r["series"] in ("cpu", "gpu")
+            if dacrt and not r["default"]:
+                continue
+            # A peer's build (or refit) and trace apart; ray queries' from the GPU timestamps.
+            parts = r.get("parts_ms", {})
+            build = parts.get("build", parts.get("refit"))
+            trace = parts.get("trace")
+            if r["backend"] == "rayquery":
+                trace = parts.get("gpu_timestamps", 0.0) - (build or 0.0)
+            if dacrt:
+                build = trace = None
+            ratio = r["frame_ms_min"] / cpu["frame_ms_min"]
+            if r is cpu:
+                against = "-"
+            elif ratio < 1:
+                against = f"{1 / ratio:.1f}x slower"
+            else:
+                against = f"{ratio:.1f}x faster"
+            where = "CPU" if r["series"].startswith(("cpu", "embree")) else driver
+            print(f"| {r['series']} | {r['config']} | {where} | {r['frame_ms_min']:.1f} | "
+                  f"{'-' if build is None else f'{build:.1f}'} | {'-' if trace is None else f'{trace:.1f}'} | "
+                  f"{r['real_errors']} | {r['near_ties']} | {r['leaks']} ({r['real_leaks']}) | {against} |")
+
+
+KINDS = {"peers": peers, "sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
 
 
 def update(doc):
@@ -88,12 +133,15 @@ def update(doc):
     data = os.path.join(os.path.dirname(os.path.abspath(doc)), "bench")  # docs/bench beside docs/benchmarks.md
 
     def table(match):
+        kind, files, scene = match.group(1), match.group(2), match.group(3)
         out = io.StringIO()
         with contextlib.redirect_stdout(out):
-            KINDS[match.group(1)](os.path.join(data, match.group(2)))
-        return f"<!-- bench-table {match.group(1)} {match.group(2)} -->\n{out.getvalue()}<!-- /bench-table -->"
+            paths = ",".join(os.path.join(data, f) for f in files.split(","))
+            KINDS[kind](paths, scene) if scene else KINDS[kind](paths)
+        head = f"<!-- bench-table {kind} {files}{' ' + scene if scene else ''} -->"
+        return f"{head}\n{out.getvalue()}<!-- /bench-table -->"
 
-    text = re.sub(r"<!-- bench-table (\S+) (\S+) -->\n.*?<!-- /bench-table -->", table, text, flags=re.S)
+    text = re.sub(r"<!-- bench-table (\S+) (\S+)(?: (\S+))? -->\n.*?<!-- /bench-table -->", table, text, flags=re.S)
     open(doc, "w").write(text)
 
 
@@ -101,4 +149,4 @@ if __name__ == "__main__":
     if sys.argv[1] == "update":
         update(sys.argv[2])
     else:
-        KINDS[sys.argv[1]](sys.argv[2])
+        KINDS[sys.argv[1]](*sys.argv[2:])

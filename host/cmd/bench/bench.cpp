@@ -17,6 +17,7 @@
 #include "cmd/progress.hpp"
 #include "core/atomic_file.hpp"
 #include "core/camera.hpp"
+#include "core/cpu_model.hpp"
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
 #include "core/shading.hpp"
@@ -66,11 +67,23 @@ BenchCommand withOutputs(BenchCommand cmd) {
 std::vector<Backend> chooseBackends(const BenchCommand& cmd) {
     if (!cmd.backends.empty()) return cmd.backends;
     std::vector<Backend> backends = {Backend::CpuSeq, Backend::Cpu};
-    if (!gpu::listDevices().empty())
+    const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
+    if (!devices.empty())
         backends.push_back(Backend::Gpu);
     else
         std::cerr << "dacrt bench: no Vulkan device, so no gpu rows (name --backends gpu to make that an error)\n";
-    if (cmd.suite == BenchSuite::Sweep) backends.push_back(Backend::Embree);
+    if (cmd.suite != BenchSuite::Table51) {
+        backends.push_back(Backend::Embree);
+        // The peer on the same device as gpu, where it has ray query (the best device, as the
+        // dispatcher chooses it when --device is not given).
+        const bool rayQuery = std::any_of(devices.begin(), devices.end(), [&](const gpu::DeviceInfo& d) {
+            return d.rayQuery && (cmd.devices.device.empty() ? true : std::to_string(d.index) == cmd.devices.device ||
+                                                                           d.name.find(cmd.devices.device) != std::string::npos);
+        });
+        if (rayQuery) backends.push_back(Backend::RayQuery);
+        else if (!devices.empty())
+            std::cerr << "dacrt bench: the Vulkan device has no ray query, so no rayquery rows (Mesa >= 24.1 has it)\n";
+    }
     return backends;
 }
 
@@ -85,8 +98,9 @@ std::vector<BenchConfig> chooseConfigs(const BenchCommand& cmd, const std::vecto
     std::vector<BenchConfig> configs;
     for (Backend b : backends) {
         const std::vector<BenchConfig> more =
-            cmd.suite == BenchSuite::Sweep ? sweepConfigs(b, hardwareThreads, gpuDefaultRegions, gpuDefaultRayGroups)
-                                           : table51Configs(b, hardwareThreads);
+            cmd.suite == BenchSuite::Sweep   ? sweepConfigs(b, hardwareThreads, gpuDefaultRegions, gpuDefaultRayGroups)
+            : cmd.suite == BenchSuite::Peers ? peerConfigs(b, hardwareThreads)
+                                             : table51Configs(b, hardwareThreads);
         configs.insert(configs.end(), more.begin(), more.end());
     }
     return configs;
@@ -101,9 +115,11 @@ struct FrameOutcome {
 };
 
 // A whole frame as a user pays for it: rays (and, for DACRT, triangle bounds), then the
-// backend (Embree's BVH build included unless the scene is static).
+// backend. Embree's scenes persist across frames as its users keep them: a dynamic one is
+// rebuilt each frame (vertex buffer updated, committed: a full LOW-quality build into the
+// memory of the last one), a refitted one refitted, a static one left alone.
 FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& camera, int width, int height,
-                        BackendDispatcher& dispatcher, const EmbreeScene* staticEmbree) {
+                        BackendDispatcher& dispatcher, EmbreeScene* persistentEmbree, RayQueryScene* persistentRayQuery) {
     FrameOutcome out;
     const auto start = Clock::now();
     const std::vector<Ray> rays = primaryRays(camera, width, height);
@@ -117,7 +133,17 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
     const FrameGeometry g = frameGeometry(scene.triangles, bounds, rays, box);
     const double prepareMs = msSince(start);
     const auto traceStart = Clock::now();
-    out.result = staticEmbree ? staticEmbree->trace(rays, dispatcher.pool(c.threads())) : dispatcher.trace(g, c.request);
+    if (persistentRayQuery) {
+        out.result = persistentRayQuery->trace(rays);
+    } else if (persistentEmbree) {
+        const EmbreeBuild build = c.request.embree.build;
+        const double updateMs = build == EmbreeBuild::Static ? 0.0 : persistentEmbree->update();
+        out.result = persistentEmbree->trace(rays, dispatcher.pool(c.threads()));
+        if (build != EmbreeBuild::Static)
+            out.result.phaseMs.insert(out.result.phaseMs.begin(), {build == EmbreeBuild::Refit ? "refit" : "build", updateMs});
+    } else {
+        out.result = dispatcher.trace(g, c.request);
+    }
     out.ms = msSince(start);
     out.parts.emplace_back(embree ? "rays" : "rays and bounds", prepareMs);
     out.parts.emplace_back("tracer", msSince(traceStart));
@@ -138,7 +164,8 @@ struct Accumulator {
     double minSum = 0.0, medianSum = 0.0;
     std::map<std::string, double> partSums;
     std::vector<std::string> partOrder;
-    std::unique_ptr<EmbreeScene> staticEmbree;
+    std::unique_ptr<EmbreeScene> persistentEmbree;  // built before the frames
+    std::unique_ptr<RayQueryScene> persistentRayQuery;  // allocated before the frames; built by the first
     std::vector<double> cameraMs;
 };
 
@@ -165,7 +192,8 @@ BenchScene loadBenchScene(const std::string& path, const BenchCommand& cmd, cons
     return s;
 }
 
-std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd, const std::vector<BenchConfig>& configs) {
+std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
+                                   BackendDispatcher& dispatcher) {
     std::vector<Accumulator> acc(configs.size());
     for (std::size_t c = 0; c < configs.size(); ++c) {
         BenchRow& row = acc[c].row;
@@ -174,9 +202,15 @@ std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd,
         row.raysPerFrame = std::size_t(cmd.width) * std::size_t(cmd.height);
         row.cameras = int(s.cameras.size());
         row.config = configs[c];
-        if (configs[c].embreeStatic)  // built once: a static scene pays for its BVH outside the frame
-            acc[c].staticEmbree = std::make_unique<EmbreeScene>(
-                s.scene.triangles, EmbreeOptions{configs[c].request.embreeRobust, configs[c].threads()});
+        row.config.request.embree.imageWidth = std::uint32_t(cmd.width);
+        if (configs[c].backend() == Backend::RayQuery)
+            acc[c].persistentRayQuery = std::make_unique<RayQueryScene>(*dispatcher.gpuContext(), *dispatcher.pipelines(),
+                                                                        s.scene.triangles, configs[c].request.rayQueryBuild);
+        if (configs[c].backend() == Backend::Embree) {
+            EmbreeOptions embree = row.config.request.embree;
+            embree.threads = configs[c].threads();
+            acc[c].persistentEmbree = std::make_unique<EmbreeScene>(s.scene.triangles, embree);
+        }
     }
     return acc;
 }
@@ -205,7 +239,8 @@ void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, 
             const BenchConfig& config = a.row.config;
             progress.step(s.name + " " + config.series + " " + config.name + " camera " + std::to_string(k));
             const FrameOutcome frame =
-                traceFrame(config, s.scene, camera, cmd.width, cmd.height, dispatcher, a.staticEmbree.get());
+                traceFrame(config, s.scene, camera, cmd.width, cmd.height, dispatcher, a.persistentEmbree.get(),
+                           a.persistentRayQuery.get());
             if (w < cmd.warmup) continue;
             a.cameraMs.push_back(frame.ms);
             for (const auto& [name, ms] : frame.parts) {
@@ -242,7 +277,7 @@ void finishRows(std::vector<Accumulator>& acc, std::size_t cameras, std::vector<
 void measureScene(const std::string& path, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
                   BackendDispatcher& dispatcher, unsigned hardwareThreads, std::vector<BenchRow>& rows) {
     const BenchScene s = loadBenchScene(path, cmd, rows);
-    std::vector<Accumulator> acc = startRows(s, cmd, configs);
+    std::vector<Accumulator> acc = startRows(s, cmd, configs, dispatcher);
     Progress progress("dacrt bench", s.cameras.size() * (1 + configs.size() * std::size_t(cmd.warmup + cmd.repeat)));
     const std::string cacheDir = cmd.cacheDir.empty() ? defaultCacheDir() : cmd.cacheDir;
     for (std::size_t k = 0; k < s.cameras.size(); ++k)
@@ -267,10 +302,12 @@ void writeJson(const BenchCommand& cmd, const std::vector<BenchRow>& rows, const
                     {"size", std::to_string(cmd.width) + "x" + std::to_string(cmd.height)},
                     {"repeat", cmd.repeat},
                     {"warmup", cmd.warmup},
-                    {"suite", cmd.suite == BenchSuite::Sweep ? "sweep" : "table51"}};
+                    {"suite", cmd.suite == BenchSuite::Sweep ? "sweep" : cmd.suite == BenchSuite::Peers ? "peers" : "table51"}};
     const gpu::Context* context = dispatcher.gpuContext();
-    j["machine"] = {{"hardware_threads", hardwareThreads},
+    j["machine"] = {{"cpu", cpuModelName()},
+                    {"hardware_threads", hardwareThreads},
                     {"gpu_device", context ? context->info().name : std::string()},
+                    {"gpu_driver", context ? context->info().driver : std::string()},
                     {"lp_num_threads", std::getenv("LP_NUM_THREADS") ? std::getenv("LP_NUM_THREADS") : ""}};
     j["near_tie_tolerance_relative"] = kNearTieRelativeDepth;
     j["pareto_time_margin"] = kParetoTimeMargin;

@@ -10,7 +10,7 @@ namespace dacrt {
 
 // sweep: every backend's default, then each option value changed one at a time.
 // table51: the source's Table 5.1 and Figure 5.3 (threads, regions per thread, axes).
-enum class BenchSuite { Sweep, Table51 };
+enum class BenchSuite { Sweep, Peers, Table51 };
 
 struct BenchCommand {
     std::vector<std::string> scenes;

@@ -8,8 +8,10 @@ namespace dacrt {
 
 std::string optionText(const BenchConfig& c) {
     std::ostringstream s;
+    if (c.backend() == Backend::RayQuery) return "build=" + toString(c.request.rayQueryBuild);
     if (c.backend() == Backend::Embree) {
-        s << "robust=" << (c.request.embreeRobust ? "on" : "off") << " timing=" << (c.embreeStatic ? "static" : "dynamic");
+        s << "build=" << toString(c.request.embree.build) << " robust=" << (c.request.embree.robust ? "on" : "off")
+          << " rays=" << (c.request.embree.packets ? "rtcIntersect16_4x4" : "rtcIntersect1") << " threads=" << c.threads();
         return s.str();
     }
     const DacrtOptions d = c.request.trace.dacrt.resolvedFor(c.backend());
@@ -43,18 +45,33 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         change(c);
         out.push_back(c);
     };
+    if (b == Backend::RayQuery) {
+        // As a Vulkan user builds for each case (the device's own ray tracing).
+        for (RayQueryBuild build : {RayQueryBuild::Dynamic, RayQueryBuild::Refit, RayQueryBuild::Static}) {
+            BenchConfig c = base;
+            c.series = "rayquery " + toString(build);
+            c.request.rayQueryBuild = build;
+            c.isDefault = build == RayQueryBuild::Dynamic;
+            out.push_back(c);
+        }
+        return out;
+    }
     if (b == Backend::Embree) {
-        out.push_back(base);
-        BenchConfig s = base;
-        s.series = "embree static";
-        s.embreeStatic = true;
-        out.push_back(s);
-        variant("robust=off", [](BenchConfig& c) { c.request.embreeRobust = false; });
-        variant("robust=off", [](BenchConfig& c) {
-            c.request.embreeRobust = false;
-            c.embreeStatic = true;
-            c.series = "embree static";
-        });
+        // As Embree's users run each case: a series per build mode, robust mode on (the
+        // default, exact on the models) and off, and single rays against packets once.
+        for (EmbreeBuild build : {EmbreeBuild::Dynamic, EmbreeBuild::Refit, EmbreeBuild::Static}) {
+            BenchConfig c = base;
+            c.series = "embree " + toString(build);
+            c.request.embree.build = build;
+            c.isDefault = build == EmbreeBuild::Dynamic;
+            out.push_back(c);
+            c.isDefault = false;
+            c.name = "robust=off";
+            c.request.embree.robust = false;
+            out.push_back(c);
+        }
+        variant("rtcIntersect1", [](BenchConfig& c) { c.request.embree.packets = false; });
+        out.back().series = "embree dynamic";
         return out;
     }
     out.push_back(base);
@@ -85,6 +102,11 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
             if (groups != gpuDefaultRayGroups)
                 variant("ray-groups=" + std::to_string(groups), [groups](BenchConfig& c) { c.request.gpuTuning.rayGroups = groups; });
     return out;
+}
+
+std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads) {
+    if (b == Backend::Embree || b == Backend::RayQuery) return sweepConfigs(b, hardwareThreads, 0, 0);
+    return {baseConfig(b, hardwareThreads)};
 }
 
 // The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).

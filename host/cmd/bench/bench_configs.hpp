@@ -18,6 +18,10 @@ BenchConfig baseConfig(Backend b, unsigned hardwareThreads);
 std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions,
                                       std::uint32_t gpuDefaultRayGroups);
 
+// peers: each DACRT backend's default against every mode of the peers (embree, rayquery):
+// the quick, fair comparison, in one run.
+std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads);
+
 // The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
 std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads);
 

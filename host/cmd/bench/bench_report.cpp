@@ -100,7 +100,7 @@ void writeCsv(const std::string& path, const std::vector<BenchRow>& rows) {
 }
 
 void printSummary(const std::vector<BenchRow>& rows) {
-    std::cout << std::left << std::setw(14) << "series" << std::setw(34) << "config" << std::right << std::setw(10)
+    std::cout << std::left << std::setw(18) << "series" << std::setw(34) << "config" << std::right << std::setw(10)
               << "min ms" << std::setw(10) << "median" << std::setw(8) << "Mray/s" << std::setw(9) << "speedup"
               << std::setw(10) << "real err" << std::setw(10) << "near tie" << std::setw(8) << "leaks" << std::setw(9)
               << "PSNR" << "  pareto\n";
@@ -117,7 +117,7 @@ void printSummary(const std::vector<BenchRow>& rows) {
         if (r.speedupOverSequential) speed << *r.speedupOverSequential << "x";
         ps << std::fixed << std::setprecision(1);
         if (std::isinf(psnr)) ps << "inf"; else ps << psnr;
-        std::cout << std::left << std::setw(14) << r.config.series << std::setw(34)
+        std::cout << std::left << std::setw(18) << r.config.series << std::setw(34)
                   << (r.config.name + (r.config.isDefault ? " *" : "")) << std::right << std::fixed
                   << std::setprecision(1) << std::setw(10) << r.frameMsMin << std::setw(10) << r.frameMsMedian
                   << std::setw(8) << double(r.raysPerFrame) / (r.frameMsMedian * 1e3) << std::setw(9) << speed.str()

@@ -16,7 +16,6 @@ struct BenchConfig {
     std::string series;  // backend, or "embree static"
     std::string name;    // "default" or the option values that differ from it
     BackendRequest request;
-    bool embreeStatic = false;  // embree: BVH built once, outside the frame
     bool isDefault = false;
     Backend backend() const { return request.trace.backend; }
     unsigned threads() const { return BackendDispatcher::threadsOf(request.trace); }

@@ -10,26 +10,7 @@ namespace dacrt {
 // Bumped whenever the reference tracer's answers could change, so stale caches are ignored.
 constexpr const char* kReferenceVersion = "reference-v2";
 
-std::uint64_t fnv1a(const void* data, std::size_t bytes) {
-    std::uint64_t h = 1469598103934665603ull;
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
-
-std::string hex16(std::uint64_t h) {
-    std::ostringstream hex;
-    hex << std::hex << std::setw(16) << std::setfill('0') << h;
-    return hex.str();
-}
-
 std::string digestOf(const void* data, std::size_t bytes) { return hex16(fnv1a(data, bytes)) + "-" + std::to_string(bytes); }
-
-std::string defaultCacheDir() {
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/dacrt";
-    if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/dacrt";
-    return ".dacrt-cache";
-}
 
 std::string cameraKey(const Camera& c, int width, int height) {
     std::ostringstream s;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "core/cache_files.hpp"
 #include "core/camera.hpp"
 #include "core/scene.hpp"
 #include "core/thread_pool.hpp"
@@ -11,11 +12,8 @@
 
 namespace dacrt {
 
-std::uint64_t fnv1a(const void* data, std::size_t bytes);
-std::string hex16(std::uint64_t h);
 // FNV-1a of the bytes and their count: a cache key part, not a cryptographic hash.
 std::string digestOf(const void* data, std::size_t bytes);
-std::string defaultCacheDir();  // $XDG_CACHE_HOME/dacrt, else ~/.cache/dacrt
 std::string cameraKey(const Camera& c, int width, int height);
 
 // The cache key of one camera's reference frame.

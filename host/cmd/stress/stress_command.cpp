@@ -8,6 +8,7 @@
 
 #include "cmd/exit_codes.hpp"
 #include "cmd/output_paths.hpp"
+#include "cmd/progress.hpp"
 #include "cmd/stress/stress.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
@@ -39,14 +40,18 @@ std::vector<StressCase> generateCases(const StressCommand& command, const std::v
 }
 
 // Brute force is the reference every other configuration is compared with, bit for bit.
-BruteReference traceReference(const std::vector<StressCase>& cases, BackendDispatcher& dispatcher) {
+BruteReference traceReference(const std::vector<StressCase>& cases, BackendDispatcher& dispatcher, Progress& progress) {
     BruteReference ref;
     const StressConfig brute = defaultStressConfig(Backend::Brute);
+    double ms = 0.0;
     for (const StressCase& c : cases) {
         const auto start = Clock::now();
         ref.hits.push_back(traceStressCase(c, brute, dispatcher));
         ref.ms.push_back(msSince(start));
+        ms += ref.ms.back();
+        progress.step("brute " + c.name);
     }
+    progress.note("brute-force reference traced in " + std::to_string(int(ms)) + " ms");
     return ref;
 }
 
@@ -70,20 +75,20 @@ StressTally runCase(const StressCase& c, const StressConfig& config, const std::
     return t;
 }
 
-std::vector<StressRow> runConfigurations(const StressCommand& command, const std::vector<Backend>& backends,
-                                         const std::vector<std::string>& families,
+std::vector<StressRow> runConfigurations(const std::vector<StressConfig>& configs, const std::vector<std::string>& families,
                                          const std::vector<StressCase>& cases, const BruteReference& reference,
-                                         BackendDispatcher& dispatcher) {
+                                         BackendDispatcher& dispatcher, Progress& progress) {
     std::vector<StressRow> rows;
-    for (const StressConfig& config : stressConfigs(backends, command.withOptions)) {
+    for (const StressConfig& config : configs) {
         std::map<std::string, StressTally> byFamily;
         double ms = 0.0;
         for (std::size_t i = 0; i < cases.size(); ++i) {
             const StressTally t = runCase(cases[i], config, reference.hits[i], reference.ms[i], dispatcher);
             ms += t.traceMs;  // for brute force, the reference's own time
             byFamily[cases[i].family].add(t);
+            progress.step(config.name + " " + cases[i].name);
         }
-        std::cerr << "dacrt stress: " << config.name << " traced in " << int(ms) << " ms\n";
+        progress.note(config.name + " traced in " + std::to_string(int(ms)) + " ms");
         for (const std::string& f : families) rows.push_back({config.name, config.isDefault, f, byFamily[f]});
     }
     return rows;
@@ -151,8 +156,15 @@ int runStressCommand(const StressCommand& command) {
     checkOutputs({{"--json", command.jsonPath, OutputFormat::Text}}, {});
     const std::vector<StressCase> cases = generateCases(command, families);
     BackendDispatcher dispatcher(command.devices, backends);
-    const BruteReference reference = traceReference(cases, dispatcher);
-    const std::vector<StressRow> rows = runConfigurations(command, backends, families, cases, reference, dispatcher);
+    const std::vector<StressConfig> configs = stressConfigs(backends, command.withOptions);
+    std::vector<StressRow> rows;
+    {
+        // A bar over every (configuration, case) pair and the reference, on a terminal; a line
+        // per stage otherwise.
+        Progress progress("dacrt stress", cases.size() * (configs.size() + 1));
+        const BruteReference reference = traceReference(cases, dispatcher, progress);
+        rows = runConfigurations(configs, families, cases, reference, dispatcher, progress);
+    }
     std::vector<DeterminismResult> determinism;
     if (command.determinism) determinism = determinismChecks(backends, dispatcher, command.size);
 

@@ -1,0 +1,44 @@
+#version 460
+// The rayquery backend: the driver's own ray tracing (VK_KHR_ray_query) over a BLAS of the
+// frame's triangles, one invocation per ray, writing the same Hit records as the DACRT kernel.
+// The peer a Vulkan user would pick; not watertight by specification, so `dacrt bench`
+// measures its error like any other backend's.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_ray_query : require
+
+#define IN(T) in T
+#include "layout.h"
+
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer RayBuffer { Ray rays[]; };
+layout(std430, binding = 1) writeonly buffer HitBuffer { Hit hits[]; };
+layout(binding = 2) uniform accelerationStructureEXT scene;
+
+layout(push_constant) uniform Push {
+    uint rayCount;
+    uint firstRay;
+} push;
+
+void main() {
+    uint i = push.firstRay + gl_GlobalInvocationID.x;
+    if (i >= push.rayCount) return;
+    Ray ray = rays[i];
+    rayQueryEXT query;
+    // Opaque: the closest hit, no any-hit shaders; both faces (dacrt culls none).
+    rayQueryInitializeEXT(query, scene, gl_RayFlagsOpaqueEXT, 0xFFu, ray.origin, ray.tmin, ray.dir, kNoHitT);
+    while (rayQueryProceedEXT(query)) {
+    }
+    Hit h;
+    h.t = kNoHitT;
+    h.prim = kMissPrim;
+    h.u = 0.0;
+    h.v = 0.0;
+    if (rayQueryGetIntersectionTypeEXT(query, true) == gl_RayQueryCommittedIntersectionTriangleEXT) {
+        h.t = rayQueryGetIntersectionTEXT(query, true);
+        h.prim = uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, true));
+        vec2 uv = rayQueryGetIntersectionBarycentricsEXT(query, true);  // weights of v1 and v2, as dacrt's
+        h.u = uv.x;
+        h.v = uv.y;
+    }
+    hits[i] = h;
+}

@@ -1,0 +1,93 @@
+// The rayquery backend (the device's own ray tracing): on a device with VK_KHR_ray_query it
+// agrees with dacrt up to ties and rounding, in every build mode, under the validation
+// layers; on one without, it is refused with the missing extension's name.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "core/errors.hpp"
+#include "gpu/pipeline_cache.hpp"
+#include "gpu/rayquery_tracer.hpp"
+#include "support/frames.hpp"
+#include "support/gpu_support.hpp"
+
+namespace dacrt {
+namespace {
+
+using test::Frame;
+
+// Hits differing in primitive at the same depth are ties; the same primitive's depth differs
+// by the two tests' rounding only.
+std::size_t realDifferences(const std::vector<Hit>& a, const std::vector<Hit>& b) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const bool hitA = a[i].prim != kMissPrim, hitB = b[i].prim != kMissPrim;
+        if (hitA != hitB) {
+            ++n;
+            continue;
+        }
+        if (!hitA) continue;
+        const double rel = std::abs(double(a[i].t) - double(b[i].t)) / std::max(double(a[i].t), double(b[i].t));
+        n += rel > 1e-4;
+    }
+    return n;
+}
+
+TEST(RayQuery, RefusedWithTheMissingExtensionWhereTheDeviceLacksIt) {
+    DACRT_REQUIRE_GPU(context);
+    if (context->info().rayQuery) GTEST_SKIP() << context->info().name << " has ray query";
+    gpu::PipelineCache pipelines(*context);
+    const Scene s = test::shapesScene();
+    try {
+        RayQueryScene scene(*context, pipelines, s.triangles, RayQueryBuild::Dynamic);
+        FAIL() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("VK_KHR_ray_query"), std::string::npos) << e.what();
+    }
+}
+
+TEST(RayQuery, AgreesWithDacrtInEveryBuildModeAcrossFrames) {
+    DACRT_REQUIRE_GPU(context);
+    if (!context->info().rayQuery)
+        GTEST_SKIP() << context->info().name << " (" << context->info().driver << ") lacks " << context->info().rayQueryMissing
+                     << " (lavapipe has ray query from Mesa 24.1; .ci/run runs this on Mesa 25)";
+    gpu::PipelineCache pipelines(*context);
+    const Scene s = test::shapesScene();
+    const Frame frame(test::shapesScene(), test::defaultCamera(s, 64, 48), 64, 48);
+    const TraceResult reference = frame.trace(Backend::CpuSeq);
+    for (RayQueryBuild build : {RayQueryBuild::Dynamic, RayQueryBuild::Refit, RayQueryBuild::Static}) {
+        RayQueryScene scene(*context, pipelines, frame.scene.triangles, build);
+        for (int k = 0; k < 2; ++k) {  // the second frame rebuilds, refits or reuses
+            const TraceResult r = scene.trace(frame.rays);
+            ASSERT_EQ(r.hits.size(), frame.rays.size());
+            EXPECT_GT(test::hitCount(r.hits), frame.rays.size() / 20);
+            EXPECT_LE(realDifferences(reference.hits, r.hits), frame.rays.size() / 200)
+                << toString(build) << " frame " << k;
+        }
+    }
+    EXPECT_TRUE(test::noValidationErrors(*context));
+}
+
+// A refit follows vertices that moved (the topology kept): its hits are those of dacrt on the
+// moved scene, up to ties and rounding, and the move changes far more pixels than that
+// allowance (so a refit that kept the old geometry fails).
+TEST(RayQuery, RefitFollowsMovedVertices) {
+    DACRT_REQUIRE_GPU(context);
+    if (!context->info().rayQuery) GTEST_SKIP() << context->info().name << " lacks " << context->info().rayQueryMissing;
+    gpu::PipelineCache pipelines(*context);
+    Scene s = test::shapesScene();
+    const Camera camera = test::defaultCamera(s, 48, 36);
+    const Frame original(s, camera, 48, 36);
+    RayQueryScene refitted(*context, pipelines, s.triangles, RayQueryBuild::Refit);
+    refitted.trace(original.rays);
+    for (Triangle& t : s.triangles) t.v0.x += 0.25f, t.v1.x += 0.25f, t.v2.x += 0.25f;
+    const Frame moved(s, camera, 48, 36);
+    const std::vector<Hit> truthBefore = original.trace(Backend::CpuSeq).hits, truthAfter = moved.trace(Backend::CpuSeq).hits;
+    const std::size_t allowance = moved.rays.size() / 200;
+    ASSERT_GT(realDifferences(truthBefore, truthAfter), 10 * allowance) << "the move must show in the image";
+    EXPECT_LE(realDifferences(truthAfter, refitted.trace(moved.rays).hits), allowance);
+    EXPECT_TRUE(test::noValidationErrors(*context));
+}
+
+}  // namespace
+}  // namespace dacrt
