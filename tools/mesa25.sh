@@ -27,6 +27,8 @@ if [ ! -f "$dir/lvp_icd.json" ]; then
   printf '{"file_format_version": "1.0.0", "ICD": {"library_path": "%s/libvulkan_lvp.so", "api_version": "1.4.305"}}\n' \
     "$lib" > "$dir.partial/lvp_icd.json"
   rm -rf "$dir" && mv "$dir.partial" "$dir"
+  rm -rf "$work"  # the exec below would skip the EXIT trap
+  trap - EXIT
 fi
 export VK_DRIVER_FILES=$dir/lvp_icd.json
 export LD_LIBRARY_PATH=$dir/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}

@@ -95,12 +95,15 @@ struct TriangleAccelerationStructure::Impl {
     }
 };
 
-TriangleAccelerationStructure::TriangleAccelerationStructure(const Context& context, const Buffer& vertices,
-                                                             std::uint64_t triangleCount, AccelerationBuild mode) {
-    const DeviceInfo& info = context.info();
+void requireRayQuery(const DeviceInfo& info) {
     if (!info.rayQuery)
         throw InputError("device '" + info.name + "' (" + info.driver + ") lacks " + info.rayQueryMissing +
                          ", which the rayquery backend needs (lavapipe has them from Mesa 24.1)");
+}
+
+TriangleAccelerationStructure::TriangleAccelerationStructure(const Context& context, const Buffer& vertices,
+                                                             std::uint64_t triangleCount, AccelerationBuild mode) {
+    requireRayQuery(context.info());
     if (triangleCount == 0 || triangleCount > std::numeric_limits<std::uint32_t>::max() / 3)
         throw InputError("the rayquery backend takes 1 to " + std::to_string(std::numeric_limits<std::uint32_t>::max() / 3) +
                          " triangles, not " + std::to_string(triangleCount));

@@ -13,6 +13,9 @@ namespace dacrt::gpu {
 // every frame), updatable (refitted every frame), fast trace (built once).
 enum class AccelerationBuild { FastBuild, Updatable, FastTrace };
 
+// Throws InputError naming the extensions the device lacks for ray queries.
+void requireRayQuery(const DeviceInfo& info);
+
 class TriangleAccelerationStructure {
 public:
     // Sizes and allocates everything for `triangleCount` triangles whose vertices lie in

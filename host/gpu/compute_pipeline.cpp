@@ -105,7 +105,9 @@ void ComputePipeline::bind(const std::vector<const Buffer*>& buffers) {
     std::vector<VkDescriptorBufferInfo> infos(buffers.size());
     std::vector<VkWriteDescriptorSet> writes;
     for (std::uint32_t b = 0; b < buffers.size(); ++b) {
-        if (types_[b] != VK_DESCRIPTOR_TYPE_STORAGE_BUFFER || !buffers[b]) continue;
+        if (types_[b] != VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) continue;  // written by its owner (an acceleration structure)
+        if (!buffers[b])
+            throw std::logic_error("pipeline '" + name_ + "': storage buffer binding " + std::to_string(b) + " given no buffer");
         infos[b] = VkDescriptorBufferInfo{buffers[b]->handle(), 0, VK_WHOLE_SIZE};
         VkWriteDescriptorSet w{};
         w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;

@@ -186,6 +186,23 @@ std::string DeviceInfo::describe() const {
     return s.str();
 }
 
+std::uint32_t chooseDevice(const std::vector<DeviceInfo>& devices, const std::string& choice) {
+    if (devices.empty()) throw InputError("no Vulkan device found (on Debian, mesa-vulkan-drivers provides lavapipe)");
+    if (choice.empty()) {
+        std::uint32_t best = 0;
+        for (std::uint32_t i = 1; i < devices.size(); ++i)
+            if (typeRank(devices[i].type) < typeRank(devices[best].type)) best = i;
+        return best;
+    }
+    // A number is an index, never part of a name ("1" would match "LLVM 15").
+    const bool numeric = std::all_of(choice.begin(), choice.end(), ::isdigit);
+    for (std::uint32_t i = 0; i < devices.size(); ++i)
+        if (numeric ? std::to_string(devices[i].index) == choice : devices[i].name.find(choice) != std::string::npos) return i;
+    std::string choices;
+    for (const DeviceInfo& d : devices) choices += "\n  " + std::to_string(d.index) + ": " + d.name + " (" + d.typeName() + ")";
+    throw InputError("the device '" + choice + "' matches no Vulkan device; the choices are:" + choices);
+}
+
 std::vector<DeviceInfo> listDevices() {
     VkInstance instance = createInstance(false);
     std::vector<DeviceInfo> infos;
@@ -235,29 +252,9 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
         if (devices.empty()) throw InputError("no Vulkan device found (on Debian, mesa-vulkan-drivers provides lavapipe)");
         std::vector<DeviceInfo> infos;
         for (std::uint32_t i = 0; i < devices.size(); ++i) infos.push_back(describeDevice(devices[i], i));
-        std::int64_t chosen = -1;
-        if (options.device.empty()) {
-            int bestRank = 99;
-            for (std::uint32_t i = 0; i < devices.size(); ++i) {
-                VkPhysicalDeviceProperties p;
-                vkGetPhysicalDeviceProperties(devices[i], &p);
-                if (typeRank(p.deviceType) < bestRank) bestRank = typeRank(p.deviceType), chosen = i;
-            }
-        } else {
-            const bool numeric = std::all_of(options.device.begin(), options.device.end(), ::isdigit);
-            for (std::uint32_t i = 0; i < devices.size() && chosen < 0; ++i) {
-                if (numeric ? std::to_string(i) == options.device
-                            : infos[i].name.find(options.device) != std::string::npos)
-                    chosen = i;
-            }
-            if (chosen < 0) {
-                std::string choices;
-                for (const DeviceInfo& d : infos) choices += "\n  " + std::to_string(d.index) + ": " + d.name + " (" + d.typeName() + ")";
-                throw InputError("the device '" + options.device + "' matches no Vulkan device; the choices are:" + choices);
-            }
-        }
-        physical_ = devices[std::size_t(chosen)];
-        info_ = infos[std::size_t(chosen)];
+        const std::uint32_t chosen = chooseDevice(infos, options.device);
+        physical_ = devices[chosen];
+        info_ = infos[chosen];
 
         std::uint32_t familyCount = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, nullptr);

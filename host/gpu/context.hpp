@@ -60,7 +60,6 @@ public:
     const DeviceInfo& info() const { return info_; }
     double timestampPeriodNs() const { return timestampPeriodNs_; }
     VkPipelineCache pipelineCache() const;  // every pipeline is created through it
-    const PipelineStore& pipelineStore() const { return *store_; }
     std::uint32_t memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags wanted) const;
 
     // Validation messages of error severity seen so far (0 unless validate was set).
@@ -86,5 +85,10 @@ private:
 // Every device of every installed driver, in enumeration order. Throws InputError if there
 // is no Vulkan driver at all.
 std::vector<DeviceInfo> listDevices();
+
+// The device a Context opens for `choice` (ContextOptions::device): empty, the best by type
+// (discrete, integrated, virtual, CPU, other; the first of equals); digits, that index; else
+// the first whose name contains it. Throws InputError listing the choices when none matches.
+std::uint32_t chooseDevice(const std::vector<DeviceInfo>& devices, const std::string& choice);
 
 }  // namespace dacrt::gpu

@@ -43,18 +43,11 @@ struct RayQueryScene::Impl {
 
 RayQueryScene::RayQueryScene(gpu::Context& context, gpu::PipelineCache& pipelines, const std::vector<Triangle>& triangles,
                              RayQueryBuild build) {
-    const gpu::DeviceInfo& info = context.info();
-    if (!info.rayQuery)
-        throw InputError("device '" + info.name + "' (" + info.driver + ") lacks " + info.rayQueryMissing +
-                         ", which the rayquery backend needs (lavapipe has them from Mesa 24.1)");
+    gpu::requireRayQuery(context.info());
     impl_ = std::make_unique<Impl>(context, pipelines, triangles, build);
 }
 
 RayQueryScene::~RayQueryScene() = default;
-
-std::uint64_t RayQueryScene::deviceBytes() const {
-    return impl_->vertices.size() + impl_->structure.bytes() + (impl_->rays ? impl_->rays->size() + impl_->hits->size() : 0);
-}
 
 TraceResult RayQueryScene::trace(const std::vector<Ray>& rays) {
     Impl& m = *impl_;

@@ -34,11 +34,10 @@ public:
     RayQueryScene(const RayQueryScene&) = delete;
     RayQueryScene& operator=(const RayQueryScene&) = delete;
 
-    std::uint64_t deviceBytes() const;
-
     // One frame in one command buffer: the vertices uploaded again and the structure built
     // (the first frame, and every frame of a dynamic scene) or updated (refit), then the rays
-    // traced. phaseMs holds upload, build (or refit), trace and readback; the gpu report the
+    // traced. phaseMs holds upload, build (or refit: the structure's part alone), dispatch
+    // (build and trace together, as the device ran them) and readback; the gpu report the
     // timestamps.
     TraceResult trace(const std::vector<Ray>& rays);
 

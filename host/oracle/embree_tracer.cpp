@@ -254,9 +254,14 @@ void EmbreeScene::Impl::traceTile(const std::vector<Ray>& rays, const std::size_
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    // Inactive lanes carry a copy of an active lane's ray (they are masked out, but their
+    // fields must still be finite); a tile with no active lane is skipped.
+    int active = 0;
+    while (active < 16 && !valid[active]) ++active;
+    if (active == 16) return;
     alignas(64) RTCRayHit16 q;
     for (int l = 0; l < 16; ++l) {
-        const Ray& ray = rays[valid[l] ? index[l] : index[0]];
+        const Ray& ray = rays[valid[l] ? index[l] : index[active]];
         q.ray.org_x[l] = ray.origin.x;
         q.ray.org_y[l] = ray.origin.y;
         q.ray.org_z[l] = ray.origin.z;

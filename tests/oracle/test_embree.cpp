@@ -290,7 +290,7 @@ TEST(EmbreeScene, RefitFollowsMovedVertices) {
     EmbreeScene refitted(s.triangles, options);
     const TraceResult before = refitted.trace(rays, pool);
     for (Triangle& t : s.triangles) t.v0.x += 0.25f, t.v1.x += 0.25f, t.v2.x += 0.25f;
-    EXPECT_GE(refitted.update(), 0.0);
+    refitted.update();  // the shared vertex buffer changed: refit
     const TraceResult after = refitted.trace(rays, pool);
     options.build = EmbreeBuild::Dynamic;
     const EmbreeScene rebuilt(s.triangles, options);

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <chrono>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -74,12 +75,15 @@ std::vector<Backend> chooseBackends(const BenchCommand& cmd) {
         std::cerr << "dacrt bench: no Vulkan device, so no gpu rows (name --backends gpu to make that an error)\n";
     if (cmd.suite != BenchSuite::Table51) {
         backends.push_back(Backend::Embree);
-        // The peer on the same device as gpu, where it has ray query (the best device, as the
-        // dispatcher chooses it when --device is not given).
-        const bool rayQuery = std::any_of(devices.begin(), devices.end(), [&](const gpu::DeviceInfo& d) {
-            return d.rayQuery && (cmd.devices.device.empty() ? true : std::to_string(d.index) == cmd.devices.device ||
-                                                                           d.name.find(cmd.devices.device) != std::string::npos);
-        });
+        // The peer on the same device as gpu (the one the dispatcher opens), where that device
+        // has ray query; a --device that matches nothing fails when the dispatcher opens it.
+        bool rayQuery = false;
+        if (!devices.empty()) {
+            try {
+                rayQuery = devices[gpu::chooseDevice(devices, cmd.devices.device)].rayQuery;
+            } catch (const InputError&) {
+            }
+        }
         if (rayQuery) backends.push_back(Backend::RayQuery);
         else if (!devices.empty())
             std::cerr << "dacrt bench: the Vulkan device has no ray query, so no rayquery rows (Mesa >= 24.1 has it)\n";
@@ -114,7 +118,7 @@ struct FrameOutcome {
     TraceResult result;
 };
 
-// A whole frame as a user pays for it: rays (and, for DACRT, triangle bounds), then the
+// A whole frame as a user pays for it: rays (and, for dacrt's backends, triangle bounds), then the
 // backend. Embree's scenes persist across frames as its users keep them: a dynamic one is
 // rebuilt each frame (vertex buffer updated, committed: a full LOW-quality build into the
 // memory of the last one), a refitted one refitted, a static one left alone.
@@ -124,9 +128,10 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
     const auto start = Clock::now();
     const std::vector<Ray> rays = primaryRays(camera, width, height);
     const bool embree = c.backend() == Backend::Embree;
+    const bool peer = embree || c.backend() == Backend::RayQuery;  // they build their own hierarchy
     std::vector<Bounds> bounds;
     Box box;
-    if (!embree) {
+    if (!peer) {
         bounds = allTriangleBounds(scene.triangles);
         box = sceneBounds(scene.triangles);
     }
@@ -145,7 +150,7 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
         out.result = dispatcher.trace(g, c.request);
     }
     out.ms = msSince(start);
-    out.parts.emplace_back(embree ? "rays" : "rays and bounds", prepareMs);
+    out.parts.emplace_back(peer ? "rays" : "rays and bounds", prepareMs);
     out.parts.emplace_back("tracer", msSince(traceStart));
     for (const auto& p : out.result.phaseMs) out.parts.push_back(p);
     if (out.result.gpu) {
@@ -218,6 +223,8 @@ std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd,
 // Every configuration's frames of one camera. Configurations are interleaved (repeat, then
 // configuration), so that a slow spell of this shared machine lands on every configuration
 // alike instead of on whichever one happened to run then.
+constexpr int kVulkanSettleMs = 200;
+
 void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, const std::string& cacheDir,
                    std::vector<Accumulator>& acc, BackendDispatcher& dispatcher, unsigned hardwareThreads,
                    Progress& progress) {
@@ -241,6 +248,12 @@ void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, 
             const FrameOutcome frame =
                 traceFrame(config, s.scene, camera, cmd.width, cmd.height, dispatcher, a.persistentEmbree.get(),
                            a.persistentRayQuery.get());
+            // lavapipe's worker threads spin on for a while after a dispatch; the next frame, on
+            // the same cores, would pay for it (Mesa 25.0.7, Dragon: the ray generation after a gpu
+            // frame took 10.7 ms instead of 5.3 with no pause or a 20 ms one, 5.3 with 200 ms;
+            // docs/benchmarks.md). An untimed pause lets them go to sleep.
+            if (config.backend() == Backend::Gpu || config.backend() == Backend::RayQuery)
+                std::this_thread::sleep_for(std::chrono::milliseconds(kVulkanSettleMs));
             if (w < cmd.warmup) continue;
             a.cameraMs.push_back(frame.ms);
             for (const auto& [name, ms] : frame.parts) {

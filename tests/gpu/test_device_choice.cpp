@@ -1,0 +1,53 @@
+// Which device a Context opens (and the bench asks about ray query): one function, so the two
+// cannot disagree. Runs without a Vulkan device: it chooses among descriptions.
+#include <gtest/gtest.h>
+
+#include "core/errors.hpp"
+#include "gpu/context.hpp"
+
+namespace dacrt {
+namespace {
+
+gpu::DeviceInfo device(std::uint32_t index, const std::string& name, VkPhysicalDeviceType type) {
+    gpu::DeviceInfo d;
+    d.index = index;
+    d.name = name;
+    d.type = type;
+    return d;
+}
+
+const std::vector<gpu::DeviceInfo> kDevices = {
+    device(0, "llvmpipe (LLVM 15.0.6, 256 bits)", VK_PHYSICAL_DEVICE_TYPE_CPU),
+    device(1, "Intel(R) UHD Graphics 620", VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU),
+    device(2, "NVIDIA GeForce RTX 4090", VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU),
+    device(3, "NVIDIA GeForce RTX 4090", VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU),
+};
+
+TEST(DeviceChoice, WithoutAChoiceTheFirstOfTheBestType) {
+    EXPECT_EQ(gpu::chooseDevice(kDevices, ""), 2u);
+    EXPECT_EQ(gpu::chooseDevice({kDevices[0], kDevices[1]}, ""), 1u);
+    EXPECT_EQ(gpu::chooseDevice({kDevices[0]}, ""), 0u);
+}
+
+TEST(DeviceChoice, DigitsAreAnIndexNeverPartOfAName) {
+    EXPECT_EQ(gpu::chooseDevice(kDevices, "1"), 1u);  // not llvmpipe, whose name holds a "1"
+    EXPECT_EQ(gpu::chooseDevice(kDevices, "3"), 3u);
+    EXPECT_EQ(gpu::chooseDevice(kDevices, "NVIDIA"), 2u);
+    EXPECT_EQ(gpu::chooseDevice(kDevices, "llvmpipe"), 0u);
+}
+
+TEST(DeviceChoice, NoMatchIsAnInputErrorListingTheChoices) {
+    for (const std::string choice : {"7", "Radeon"}) {
+        try {
+            gpu::chooseDevice(kDevices, choice);
+            FAIL() << choice << " matched";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("'" + choice + "'"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("3: NVIDIA GeForce RTX 4090 (DiscreteGpu)"), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_THROW(gpu::chooseDevice({}, ""), InputError);
+}
+
+}  // namespace
+}  // namespace dacrt
