@@ -40,6 +40,11 @@ std::vector<std::string> ignoredOptions(const BackendRequest& r) {
     return out;
 }
 
+// Whether any of `backends` opens the Vulkan device.
+bool usesVulkan(const std::vector<Backend>& backends) {
+    return std::any_of(backends.begin(), backends.end(), runsOnVulkan);
+}
+
 }  // namespace
 
 void checkBackendRequest(const BackendRequest& r) {
@@ -52,22 +57,18 @@ void checkBackendRequest(const BackendRequest& r) {
                          toString(r.trace.backend) + " (see dacrt render --help: each option names its backends)");
     }
     if (r.trace.backend == Backend::Gpu) checkGpuOptions(r.trace);
-    if (r.trace.backend != Backend::Gpu && r.trace.backend != Backend::Embree && r.trace.backend != Backend::RayQuery)
-        checkCpuOptions(r.trace);
+    if (r.trace.backend != Backend::Gpu && !isPeer(r.trace.backend)) checkCpuOptions(r.trace);
 }
 
 void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends) {
-    const bool gpu = std::find(backends.begin(), backends.end(), Backend::Gpu) != backends.end() ||
-                     std::find(backends.begin(), backends.end(), Backend::RayQuery) != backends.end();
-    if (gpu) return;
+    if (usesVulkan(backends)) return;
     if (!devices.device.empty()) throw InputError("--device chooses the Vulkan device of the gpu and rayquery backends; neither runs here");
     if (devices.validate) throw InputError("--validate runs the gpu and rayquery backends under the Vulkan validation layers; neither runs here");
 }
 
 BackendDispatcher::BackendDispatcher(const DeviceChoice& devices, const std::vector<Backend>& backends)
     : devices_(devices) {
-    if (std::find(backends.begin(), backends.end(), Backend::Gpu) != backends.end() ||
-        std::find(backends.begin(), backends.end(), Backend::RayQuery) != backends.end()) {
+    if (usesVulkan(backends)) {
         gpu_ = std::make_unique<gpu::Context>(gpu::ContextOptions{devices.device, devices.validate});
         pipelines_ = std::make_unique<gpu::PipelineCache>(*gpu_);
     }

@@ -7,6 +7,10 @@
 namespace dacrt {
 
 enum class Backend { Brute, CpuSeq, Cpu, Gpu, Embree, RayQuery };
+// gpu and rayquery run on a Vulkan device.
+constexpr bool runsOnVulkan(Backend b) { return b == Backend::Gpu || b == Backend::RayQuery; }
+// embree and rayquery are the peers: they build their own hierarchy and take no DACRT options.
+constexpr bool isPeer(Backend b) { return b == Backend::Embree || b == Backend::RayQuery; }
 enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
 enum class DivisionAxis { Best, X, Y, Z };
 // Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks

@@ -19,6 +19,10 @@ std::string apiString(std::uint32_t v) {
            std::to_string(VK_API_VERSION_PATCH(v));
 }
 
+// What the rayquery backend needs of a device, checked by describeDevice and enabled by Context.
+constexpr const char* kRayQueryExtensions[] = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                                               VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+
 int typeRank(VkPhysicalDeviceType t) {  // the default choice: discrete, integrated, then the rest
     switch (t) {
         case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
@@ -109,18 +113,15 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, nullptr));
     std::vector<VkExtensionProperties> extensions(extensionCount);
     VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, extensions.data()));
-    const bool sizeControl = std::any_of(extensions.begin(), extensions.end(), [](const VkExtensionProperties& e) {
-        return std::strcmp(e.extensionName, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME) == 0;
-    });
     auto hasExtension = [&](const char* name) {
         return std::any_of(extensions.begin(), extensions.end(),
                            [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
     };
+    const bool sizeControl = hasExtension(VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
     {
         std::vector<std::string> missing;
         if (basic.apiVersion < VK_API_VERSION_1_2) missing.push_back("Vulkan 1.2");
-        for (const char* e : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
-                              VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME})
+        for (const char* e : kRayQueryExtensions)
             if (!hasExtension(e)) missing.push_back(e);
         if (missing.empty()) {
             VkPhysicalDeviceRayQueryFeaturesKHR rq{};
@@ -249,7 +250,6 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
         }
 
         const std::vector<VkPhysicalDevice> devices = physicalDevices(instance_);
-        if (devices.empty()) throw InputError("no Vulkan device found (on Debian, mesa-vulkan-drivers provides lavapipe)");
         std::vector<DeviceInfo> infos;
         for (std::uint32_t i = 0; i < devices.size(); ++i) infos.push_back(describeDevice(devices[i], i));
         const std::uint32_t chosen = chooseDevice(infos, options.device);
@@ -305,9 +305,7 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
             accel.pNext = &rayQuery;
             addresses.pNext = &accel;
             chain = &addresses;
-            for (const char* e : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
-                                  VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME})
-                enabled.push_back(e);
+            for (const char* e : kRayQueryExtensions) enabled.push_back(e);
         }
         deviceInfo.pNext = chain;
         deviceInfo.enabledExtensionCount = std::uint32_t(enabled.size());

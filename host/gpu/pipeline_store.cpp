@@ -16,9 +16,13 @@ namespace {
 
 constexpr char kMagic[8] = {'D', 'A', 'C', 'R', 'T', 'P', 'C', '1'};
 
-std::string storeKey(VkPhysicalDevice physical, const std::string& driver) {
+VkPhysicalDeviceProperties propertiesOf(VkPhysicalDevice physical) {
     VkPhysicalDeviceProperties p;
     vkGetPhysicalDeviceProperties(physical, &p);
+    return p;
+}
+
+std::string storeKey(const VkPhysicalDeviceProperties& p, const std::string& driver) {
     std::uint64_t h = fnv1a(&p.vendorID, sizeof(p.vendorID));
     h = fnv1a(&p.deviceID, sizeof(p.deviceID), h);
     h = fnv1a(&p.driverVersion, sizeof(p.driverVersion), h);
@@ -28,8 +32,9 @@ std::string storeKey(VkPhysicalDevice physical, const std::string& driver) {
     return hex16(h);
 }
 
-// The file: magic, the key (16 characters), the payload's size and hash, the payload.
-std::vector<char> readValid(const std::string& path, const std::string& key) {
+// The file: magic, the key (16 characters), the payload's size and hash, the payload. Sets
+// `hash` to the payload's (checked) hash when the file is valid.
+std::vector<char> readValid(const std::string& path, const std::string& key, std::uint64_t& payloadHash) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return {};
     const std::vector<char> file((std::istreambuf_iterator<char>(in)), {});
@@ -41,17 +46,16 @@ std::vector<char> readValid(const std::string& path, const std::string& key) {
     std::memcpy(&size, file.data() + sizeof(kMagic) + 16, 8);
     std::memcpy(&hash, file.data() + sizeof(kMagic) + 24, 8);
     if (size != file.size() - header || fnv1a(file.data() + header, size) != hash) return {};
+    payloadHash = hash;
     return {file.begin() + std::ptrdiff_t(header), file.end()};
 }
 
 // The driver's own header (VkPipelineCacheHeaderVersionOne) must name this device too: a
 // file copied from another machine under the same key is refused here, not by the driver.
-bool headerMatches(const std::vector<char>& payload, VkPhysicalDevice physical) {
+bool headerMatches(const std::vector<char>& payload, const VkPhysicalDeviceProperties& p) {
     VkPipelineCacheHeaderVersionOne header;
     if (payload.size() < sizeof(header)) return false;
     std::memcpy(&header, payload.data(), sizeof(header));
-    VkPhysicalDeviceProperties p;
-    vkGetPhysicalDeviceProperties(physical, &p);
     return header.headerSize >= sizeof(header) && header.headerSize <= payload.size() &&
            header.headerVersion == VK_PIPELINE_CACHE_HEADER_VERSION_ONE && header.vendorID == p.vendorID &&
            header.deviceID == p.deviceID && std::memcmp(header.pipelineCacheUUID, p.pipelineCacheUUID, VK_UUID_SIZE) == 0;
@@ -61,13 +65,16 @@ bool headerMatches(const std::vector<char>& payload, VkPhysicalDevice physical) 
 
 PipelineStore::PipelineStore(VkPhysicalDevice physical, VkDevice device, const std::string& driver,
                              const std::string& folder)
-    : device_(device), key_(storeKey(physical, driver)) {
+    : device_(device) {
+    const VkPhysicalDeviceProperties properties = propertiesOf(physical);
+    key_ = storeKey(properties, driver);
     std::vector<char> data;
     if (!folder.empty()) {
         path_ = folder + "/vulkan-pipelines-" + key_ + ".bin";
-        data = readValid(path_, key_);
-        if (!data.empty() && !headerMatches(data, physical)) data.clear();
-        loadedHash_ = fnv1a(data.data(), data.size());
+        std::uint64_t hash = 0;
+        data = readValid(path_, key_, hash);
+        if (!data.empty() && !headerMatches(data, properties)) data.clear();
+        loadedHash_ = data.empty() ? fnv1a(nullptr, 0) : hash;
     }
     VkPipelineCacheCreateInfo info{};
     info.sType = VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO;
@@ -90,10 +97,10 @@ void PipelineStore::save() const {
         std::vector<char> payload(size);
         VK_CHECK(vkGetPipelineCacheData(device_, cache_, &size, payload.data()));
         payload.resize(size);
-        if (fnv1a(payload.data(), payload.size()) == loadedHash_) return;  // nothing new to keep
+        const std::uint64_t bytes = payload.size(), hash = fnv1a(payload.data(), payload.size());
+        if (hash == loadedHash_) return;  // nothing new to keep
         std::string file(kMagic, sizeof(kMagic));
         file += key_;
-        const std::uint64_t bytes = payload.size(), hash = fnv1a(payload.data(), payload.size());
         file.append(reinterpret_cast<const char*>(&bytes), 8);
         file.append(reinterpret_cast<const char*>(&hash), 8);
         file.append(payload.data(), payload.size());

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "core/errors.hpp"
 #include "core/timing.hpp"
 #include "gpu/acceleration_structure.hpp"
 #include "gpu/buffer.hpp"
@@ -61,7 +60,7 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays) {
     const bool rebuild = !m.built || m.build == RayQueryBuild::Dynamic;
     const bool refit = m.built && m.build == RayQueryBuild::Refit;
     if (rebuild || refit) m.vertices.upload(m.triangles.data(), m.triangles.size() * sizeof(Triangle));
-    if (!m.rays || m.rays->size() < std::max<std::uint64_t>(rays.size() * sizeof(Ray), 16)) {
+    if (!m.rays || m.rays->size() < rays.size() * sizeof(Ray)) {
         m.rays = std::make_unique<gpu::Buffer>(m.context, rays.size() * sizeof(Ray), "rayquery rays");
         m.hits = std::make_unique<gpu::Buffer>(m.context, rays.size() * sizeof(Hit), "rayquery hits");
     }

@@ -127,8 +127,7 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
     FrameOutcome out;
     const auto start = Clock::now();
     const std::vector<Ray> rays = primaryRays(camera, width, height);
-    const bool embree = c.backend() == Backend::Embree;
-    const bool peer = embree || c.backend() == Backend::RayQuery;  // they build their own hierarchy
+    const bool peer = isPeer(c.backend());
     std::vector<Bounds> bounds;
     Box box;
     if (!peer) {
@@ -252,7 +251,7 @@ void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, 
             // the same cores, would pay for it (Mesa 25.0.7, Dragon: the ray generation after a gpu
             // frame took 10.7 ms instead of 5.3 with no pause or a 20 ms one, 5.3 with 200 ms;
             // docs/benchmarks.md). An untimed pause lets them go to sleep.
-            if (config.backend() == Backend::Gpu || config.backend() == Backend::RayQuery)
+            if (runsOnVulkan(config.backend()))
                 std::this_thread::sleep_for(std::chrono::milliseconds(kVulkanSettleMs));
             if (w < cmd.warmup) continue;
             a.cameraMs.push_back(frame.ms);
@@ -315,7 +314,7 @@ void writeJson(const BenchCommand& cmd, const std::vector<BenchRow>& rows, const
                     {"size", std::to_string(cmd.width) + "x" + std::to_string(cmd.height)},
                     {"repeat", cmd.repeat},
                     {"warmup", cmd.warmup},
-                    {"suite", cmd.suite == BenchSuite::Sweep ? "sweep" : cmd.suite == BenchSuite::Peers ? "peers" : "table51"}};
+                    {"suite", toString(cmd.suite)}};
     const gpu::Context* context = dispatcher.gpuContext();
     j["machine"] = {{"cpu", cpuModelName()},
                     {"hardware_threads", hardwareThreads},

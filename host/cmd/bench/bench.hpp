@@ -5,12 +5,20 @@
 #include <vector>
 
 #include "cmd/backend_dispatcher.hpp"
+#include "core/enum_names.hpp"
 
 namespace dacrt {
 
 // sweep: every backend's default, then each option value changed one at a time.
+// peers: each DACRT default against every mode of the peers (embree, rayquery).
 // table51: the source's Table 5.1 and Figure 5.3 (threads, regions per thread, axes).
 enum class BenchSuite { Sweep, Peers, Table51 };
+
+template <>
+struct EnumNames<BenchSuite> {
+    static constexpr std::array<std::pair<BenchSuite, std::string_view>, 3> table{
+        {{BenchSuite::Sweep, "sweep"}, {BenchSuite::Peers, "peers"}, {BenchSuite::Table51, "table51"}}};
+};
 
 struct BenchCommand {
     std::vector<std::string> scenes;

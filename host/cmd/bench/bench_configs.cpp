@@ -105,7 +105,7 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
 }
 
 std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads) {
-    if (b == Backend::Embree || b == Backend::RayQuery) return sweepConfigs(b, hardwareThreads, 0, 0);
+    if (isPeer(b)) return sweepConfigs(b, hardwareThreads, 0, 0);
     return {baseConfig(b, hardwareThreads)};
 }
 

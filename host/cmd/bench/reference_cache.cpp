@@ -1,6 +1,5 @@
 #include "cmd/bench/reference_cache.hpp"
 
-#include <cstdlib>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
