@@ -86,11 +86,14 @@ std::vector<std::string> dacrtBackendNames() { return {"brute", "cpu-seq", "cpu"
 // The DACRT options that render and bench share.
 void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     addEnumOption(cmd, "--split", o.split, "DACRT split (cpu, cpu-seq; gpu always splits at the spatial median)");
-    const std::string limits = std::to_string(kCpuLeafLimit) + " on the cpu backends, " + std::to_string(kGpuLeafLimit) + " on gpu";
+    const std::string gpu = ", " + std::to_string(kGpuLeafLimit) + " on gpu";
     cmd->add_option("--ray-limit", o.rayLimit, "leaf when fewer live rays (cpu-seq, cpu, gpu)")
-        ->check(CLI::Range(1u, 1u << 30))->default_str(limits);
+        ->check(CLI::Range(1u, 1u << 30))
+        ->default_str(std::to_string(kCpuLeafLimit) + " on the cpu backends" + gpu);
     cmd->add_option("--tri-limit", o.triLimit, "leaf when fewer triangles (cpu-seq, cpu, gpu)")
-        ->check(CLI::Range(1u, 1u << 30))->default_str(limits);
+        ->check(CLI::Range(1u, 1u << 30))
+        ->default_str(std::to_string(kCpuSimdTriangleLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +
+                      " with a non-default intersector, filter or precision)" + gpu);
     addEnumOption(cmd, "--intersector", o.intersector, "leaf ray/triangle test (cpu, cpu-seq)");
     addEnumOption(cmd, "--triangle-filter", o.triangleFilter,
                   "triangle/box filter: bounds, sat (exact separating axes) or mora (inexact) (cpu, cpu-seq)");

@@ -1,6 +1,8 @@
 #include "core/camera.hpp"
 
 #include <cmath>
+#include <exception>
+#include <mutex>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -105,21 +107,42 @@ Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
     return r;
 }
 
-std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::dvec2 offset) {
-    std::vector<Ray> rays(std::size_t(width) * std::size_t(height));
+namespace {
+
+void primaryRayRow(const Camera& camera, int width, int height, glm::dvec2 offset, int y, Ray* row) {
     const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
     const double tanHalf = std::tan(0.5 * camera.yfovRadians);
     const double aspect = double(width) / double(height);
     const glm::vec3 origin = glm::vec3(camera.eye);
-    for (int y = 0; y < height; ++y) {
-        for (int x = 0; x < width; ++x) {
-            const double sx = (2.0 * (x + offset.x) / width - 1.0) * tanHalf * aspect;
-            const double sy = (1.0 - 2.0 * (y + offset.y) / height) * tanHalf;
-            rays[std::size_t(y) * std::size_t(width) + std::size_t(x)] =
-                makeRay(origin, camera.forward + sx * right + sy * camera.up);
-        }
+    for (int x = 0; x < width; ++x) {
+        const double sx = (2.0 * (x + offset.x) / width - 1.0) * tanHalf * aspect;
+        const double sy = (1.0 - 2.0 * (y + offset.y) / height) * tanHalf;
+        row[x] = makeRay(origin, camera.forward + sx * right + sy * camera.up);
     }
+}
+
+}  // namespace
+
+std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::dvec2 offset) {
+    std::vector<Ray> rays(std::size_t(width) * std::size_t(height));
+    for (int y = 0; y < height; ++y) primaryRayRow(camera, width, height, offset, y, &rays[std::size_t(y) * std::size_t(width)]);
     return rays;
+}
+
+void primaryRays(const Camera& camera, int width, int height, ThreadPool& pool, std::vector<Ray>& rays,
+                 glm::dvec2 offset) {
+    rays.resize(std::size_t(width) * std::size_t(height));
+    std::exception_ptr failure;
+    std::mutex failureMutex;
+    pool.parallelFor(std::size_t(height), [&](std::size_t y, unsigned) {
+        try {
+            primaryRayRow(camera, width, height, offset, int(y), &rays[y * std::size_t(width)]);
+        } catch (...) {  // the pool's threads must not throw: the first error is rethrown here
+            const std::lock_guard<std::mutex> lock(failureMutex);
+            if (!failure) failure = std::current_exception();
+        }
+    });
+    if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace dacrt

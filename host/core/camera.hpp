@@ -41,5 +41,8 @@ Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin = 0
 // One ray per pixel through the point `offset` of the pixel (in pixel units from its top-left
 // corner; the centre by default), row-major from the top-left pixel.
 std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::dvec2 offset = {0.5, 0.5});
+// The same rays, rows on every thread of pool, into rays (resized; reusing its memory).
+void primaryRays(const Camera& camera, int width, int height, ThreadPool& pool, std::vector<Ray>& rays,
+                 glm::dvec2 offset = {0.5, 0.5});
 
 }  // namespace dacrt

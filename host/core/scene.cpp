@@ -1,5 +1,6 @@
 #include "core/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -34,6 +35,31 @@ std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles) {
     std::vector<Bounds> bounds(triangles.size());
     for (std::size_t i = 0; i < triangles.size(); ++i) bounds[i] = triangleBounds(triangles[i]);
     return bounds;
+}
+
+void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool& pool, std::vector<Bounds>& bounds,
+                              Box& box) {
+    constexpr std::size_t kChunk = 16384;
+    bounds.resize(triangles.size());
+    const std::size_t chunks = (triangles.size() + kChunk - 1) / kChunk;
+    std::vector<Box> chunkBox(chunks);
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        const std::size_t end = std::min(triangles.size(), (c + 1) * kChunk);
+        Box b;
+        for (std::size_t i = c * kChunk; i < end; ++i) {
+            const Triangle& t = triangles[i];
+            bounds[i] = triangleBounds(t);
+            b.extend(t.v0);
+            b.extend(t.v1);
+            b.extend(t.v2);
+        }
+        chunkBox[c] = b;
+    });
+    box = Box{};
+    for (const Box& b : chunkBox) {
+        box.lo = glm::min(box.lo, b.lo);
+        box.hi = glm::max(box.hi, b.hi);
+    }
 }
 
 void validateScene(const Scene& scene) {

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "core/shader_layout.hpp"
+#include "core/thread_pool.hpp"
 
 namespace dacrt {
 
@@ -64,6 +65,11 @@ Bounds triangleBounds(const Triangle& t);
 glm::vec3 geometricNormal(const Triangle& t);
 Box sceneBounds(const std::vector<Triangle>& triangles);
 std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles);
+// Both at once on every thread of pool, into bounds (resized; reusing its memory from frame to
+// frame) and box: the same values as allTriangleBounds and sceneBounds, bit for bit (chunks
+// are merged in order, so even the sign of a zero bound is the sequential one).
+void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool& pool, std::vector<Bounds>& bounds,
+                              Box& box);
 
 // Checks that the scene can be traced: triangles exist and every coordinate is finite.
 // Throws InputError naming the first offending triangle and its provenance.

@@ -58,13 +58,17 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     planFrameInputs(g, result.memory);
     result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
     result.memory.add("triangle ids", std::uint64_t(triCount) * 4);
+    const std::uint64_t scratchIds = partitionScratchIds(rayCount, triCount);
+    result.memory.add("partition scratch", scratchIds * 4);
     if (onPlan && !onPlan(result.memory)) return result;
 
     result.hits.assign(rayCount, missHit());
     std::vector<std::uint32_t> rayIds(rayCount), triIds(triCount);
     std::iota(rayIds.begin(), rayIds.end(), 0u);
     std::iota(triIds.begin(), triIds.end(), 0u);
-    DacrtTraversal traversal(g, options, result.hits.data(), rayIds.data(), triIds.data(), result.counters);
+    std::vector<std::uint32_t> scratch(scratchIds);
+    DacrtTraversal traversal(g, options, result.hits.data(), rayIds.data(), triIds.data(), scratch.data(),
+                             result.counters);
     std::uint32_t terminated = 0;
     const std::uint32_t crossing = traversal.trace(g.sceneBox, terminated, rayCount, 0, triCount);
     result.counters.raysCulled = rayCount - crossing;
@@ -91,6 +95,7 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     result.counters.raysCulled = division.culledRays;
 
     std::vector<Counters> perWorker(pool.size());
+    std::vector<std::uint32_t> scratch(division.scratchIdsPerWorker * pool.size());
     std::vector<Region>& table = division.regions;
     // Step 1 finishes rays that never leave their slab; a transfer finishes the rays that
     // move toward the triangles' region but cannot reach it (nor, then, any region beyond).
@@ -98,7 +103,8 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
         Region& rays = table[rayRegion];
         const Region& tris = table[triRegion];
         DacrtTraversal traversal(g, options.dacrt, result.hits.data(), division.rayIds.data(),
-                                 division.triIds.data(), perWorker[worker]);
+                                 division.triIds.data(), scratch.data() + worker * division.scratchIdsPerWorker,
+                                 perWorker[worker]);
         const RetireRule retire{axis, triRegion == rayRegion ? 0 : (triRegion > rayRegion ? 1 : -1)};
         traversal.trace(regionBox(tris), rays.terminated, rays.rayEnd, tris.triBegin, tris.triEnd, retire);
     };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace dacrt {
 
@@ -10,6 +11,13 @@ float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin) {
     for (int a = 0; a < 3; ++a)
         m = std::max({m, std::abs(sceneBox.lo[a]), std::abs(sceneBox.hi[a]), std::abs(rayOrigin[a])});
     return std::max(m * 0x1p-18f, 0x1p-100f);
+}
+
+bool raysShareStart(const std::vector<Ray>& rays) {
+    return std::all_of(rays.begin(), rays.end(), [&](const Ray& r) {
+        return std::memcmp(&r.origin, &rays.front().origin, sizeof(r.origin)) == 0 &&
+               std::memcmp(&r.tmin, &rays.front().tmin, sizeof(r.tmin)) == 0;
+    });
 }
 
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
@@ -21,6 +29,7 @@ FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::v
     g.sceneBox = sceneBox;
     g.rayOrigin = rays.front().origin;
     g.margin = filterMargin(sceneBox, g.rayOrigin);
+    g.raysShareStart = raysShareStart(rays);
     return g;
 }
 

@@ -15,7 +15,13 @@ struct FrameGeometry {
     Box sceneBox;          // exact bounds of the triangles
     glm::vec3 rayOrigin{};  // every ray starts here (primary rays)
     float margin = 0.0f;    // filter widening, see filterMargin()
+    bool raysShareStart = false;  // see raysShareStart()
 };
+
+// Whether every ray has the first ray's origin and tmin, bit for bit (primary rays do): the
+// kernels (SIMD filters, compute shaders) then take them once instead of loading them per
+// ray, with the per-ray arithmetic unchanged.
+bool raysShareStart(const std::vector<Ray>& rays);
 
 // Widening applied to every box before a ray or triangle filter, so that rounding in the
 // intersection test can never move a hit out of the cells that test it. See

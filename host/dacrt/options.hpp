@@ -61,10 +61,12 @@ struct EnumNames<Precision> {
 };
 
 // Leaf limits of each backend when DacrtOptions leaves them 0, chosen by measurement
-// (docs/benchmarks.md): a leaf costs the CPU one test per pair, while on lavapipe a
-// partition costs several times a leaf's test per element (docs/gpu.md), so the gpu stops
-// splitting earlier.
+// (docs/benchmarks.md): a leaf costs the CPU one test per pair, and the SIMD leaf of the
+// default options tests a vector of triangles at once, so it takes more triangles before a
+// split pays; on lavapipe a partition costs several times a leaf's test per element
+// (docs/gpu.md), so the gpu stops splitting earlier still.
 constexpr std::uint32_t kCpuLeafLimit = 8;
+constexpr std::uint32_t kCpuSimdTriangleLimit = 32;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 
 struct DacrtOptions {
@@ -81,7 +83,7 @@ struct DacrtOptions {
         DacrtOptions o = *this;
         const std::uint32_t limit = backend == Backend::Gpu ? kGpuLeafLimit : kCpuLeafLimit;
         if (o.rayLimit == 0) o.rayLimit = limit;
-        if (o.triLimit == 0) o.triLimit = limit;
+        if (o.triLimit == 0) o.triLimit = backend != Backend::Gpu && exactDefaults() ? kCpuSimdTriangleLimit : limit;
         return o;
     }
 

@@ -21,6 +21,7 @@ struct Division {
     std::vector<std::uint32_t> triIds;         // every triangle once per region it overlaps
     std::uint64_t culledRays = 0;
     std::uint64_t straddlerCopies = 0;         // triIds.size() minus the triangle count
+    std::uint64_t scratchIdsPerWorker = 0;     // partitionScratchIds of the largest ranges
     bool complete = false;                     // false: stopped after the plan, ids not filled
 };
 

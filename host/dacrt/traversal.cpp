@@ -22,8 +22,11 @@ int longestAxis(const Box& b) {
 
 }  // namespace
 
+std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange) { return std::max(rayRange, triRange); }
+
 DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& options, Hit* hits,
-                               std::uint32_t* rayIds, std::uint32_t* triIds, Counters& counters)
+                               std::uint32_t* rayIds, std::uint32_t* triIds, std::uint32_t* scratch,
+                               Counters& counters)
     : rays_(g.rays->data()),
       triangles_(g.triangles->data()),
       triangleBounds_(g.triangleBounds->data()),
@@ -33,6 +36,11 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       hits_(hits),
       rayIds_(rayIds),
       triIds_(triIds),
+      scratch_(scratch),
+      raysShareStart_(g.raysShareStart),
+      simd_(scratch != nullptr && options_.triangleFilter == TriangleFilter::Bounds &&
+            options_.intersector == Intersector::Watertight && options_.precision == Precision::F32 &&
+            g.rays->size() <= simd::kMaxRays && g.triangles->size() <= simd::kMaxTriangles),
       counters_(counters) {}
 
 std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
@@ -59,6 +67,8 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
 
 [[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
     counters_.rayBoxTests += end - begin;
+    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, hits_, rayIds_ + begin, end - begin, cell, raysShareStart_,
+                                                            scratch_);
     std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
         return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
     });
@@ -66,10 +76,14 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
 }
 
 std::uint32_t DacrtTraversal::filterTriangles(const Box& child, const Box& cell, std::uint32_t begin,
-                                              std::uint32_t end) {
+                                              std::uint32_t end, int axis, bool lowChild) {
     std::uint32_t* first = triIds_ + begin;
     switch (options_.triangleFilter) {
         case TriangleFilter::Bounds:
+            if (simd_)
+                return begin + simd::partitionTrianglesOnFace(triangleBounds_, triIds_ + begin, end - begin, axis,
+                                                              lowChild, lowChild ? cell.hi[axis] : cell.lo[axis],
+                                                              scratch_);
             first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
                 const Bounds& b = triangleBounds_[id];
                 return shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
@@ -126,7 +140,7 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
         const Box cell = widen(*child, margin_);
         const std::uint32_t childRays = filterRays(cell, terminated, rayEnd);
         if (childRays == terminated) continue;
-        const std::uint32_t childTris = filterTriangles(*child, cell, triBegin, triEnd);
+        const std::uint32_t childTris = filterTriangles(*child, cell, triBegin, triEnd, axis, child == &low);
         const bool stalled = childRays == rayEnd && childTris == triEnd;
         node(*child, terminated, childRays, triBegin, childTris, depth + 1, stalled ? stalls + 1 : 0);
     }
@@ -137,7 +151,9 @@ void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32
     ++counters_.leaves;
     counters_.rayTriangleTests += std::uint64_t(rayEnd - terminated) * (triEnd - triBegin);
     auto same = [](const Ray& ray) -> const Ray& { return ray; };
-    if (options_.precision == Precision::F64)
+    if (simd_)
+        leafSimd(box, terminated, rayEnd, triBegin, triEnd);
+    else if (options_.precision == Precision::F64)
         leafWith(box, terminated, rayEnd, triBegin, triEnd, toF64, testTriangleF64);
     else if (options_.intersector == Intersector::MollerTrumbore)
         leafWith(box, terminated, rayEnd, triBegin, triEnd, same, testTriangleMollerTrumbore);
@@ -159,7 +175,23 @@ template <typename PrepareRay, typename TestTriangle>
             test(prepared, triangles_[prim], prim, best);
         }
         hits_[rayId] = best;
-        if (best.prim != kMissPrim && shared::hitEndsInBox(ray, box.lo, box.hi, best.t)) {
+    }
+    endRaysHitInBox(box, terminated, rayEnd);
+}
+
+void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
+                              std::uint32_t triBegin, std::uint32_t triEnd) {
+    for (std::uint32_t j = triBegin; j < triEnd; j += simd::kLeafBatch) {
+        simd::gatherLeafTriangles(triangles_, triIds_ + j, std::min(triEnd - j, simd::kLeafBatch), batch_);
+        simd::intersectBatch(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_);
+    }
+    endRaysHitInBox(box, terminated, rayEnd);
+}
+
+void DacrtTraversal::endRaysHitInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd) {
+    for (std::uint32_t k = terminated; k < rayEnd; ++k) {
+        const std::uint32_t rayId = rayIds_[k];
+        if (hits_[rayId].prim != kMissPrim && shared::hitEndsInBox(rays_[rayId], box.lo, box.hi, hits_[rayId].t)) {
             std::swap(rayIds_[k], rayIds_[terminated]);
             ++terminated;
         }

@@ -5,6 +5,7 @@
 
 #include "dacrt/predicates.hpp"
 #include "dacrt/frame_geometry.hpp"
+#include "dacrt/simd_kernels.hpp"
 #include "dacrt/options.hpp"
 #include "dacrt/trace_result.hpp"
 
@@ -20,10 +21,15 @@ struct RetireRule {
     int direction = 0;  // 0: rays with dir[axis] == 0; +1 / -1: non-crossing rays moving that way
 };
 
+// Ids a traversal's stable partitions park the rejected ids in: at least as many as the
+// longest ray or triangle id range it is given.
+std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange);
+
 class DacrtTraversal {
 public:
+    // scratch: partitionScratchIds(...) ids, for the SIMD path of the default options.
     DacrtTraversal(const FrameGeometry& geometry, const DacrtOptions& options, Hit* hits, std::uint32_t* rayIds,
-                   std::uint32_t* triIds, Counters& counters);
+                   std::uint32_t* triIds, std::uint32_t* scratch, Counters& counters);
 
     // Traces the live rays rayIds[terminated, rayEnd) against triIds[triBegin, triEnd)
     // inside box. Rays whose final hit is found are swapped to position `terminated`, which
@@ -39,11 +45,19 @@ private:
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd);
     std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);
+    void leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                  std::uint32_t triEnd);
+    void endRaysHitInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd);
     template <typename PrepareRay, typename TestTriangle>
     void leafWith(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
                   std::uint32_t triEnd, PrepareRay prepare, TestTriangle test);
-    // cell is child widened by the filter margin; the Mora filter reads child itself.
-    std::uint32_t filterTriangles(const Box& child, const Box& cell, std::uint32_t begin, std::uint32_t end);
+    // cell is child widened by the filter margin; the Mora filter reads child itself. cell
+    // differs from the parent's widened cell in one face, on axis (the high face when child is
+    // the low one), and the SIMD path tests that face alone: never "no" where the full test
+    // says "maybe", and the same answer wherever the node's triangles overlap the node's
+    // widened cell, which the roots' do (scene bounds; region binning) and so every child's.
+    std::uint32_t filterTriangles(const Box& child, const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
+                                  bool lowChild);
     float splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const;
 
     const Ray* rays_;
@@ -55,6 +69,10 @@ private:
     Hit* hits_;
     std::uint32_t* rayIds_;
     std::uint32_t* triIds_;
+    std::uint32_t* scratch_;
+    bool raysShareStart_;
+    bool simd_;  // the default options (bounds filter, watertight float32 test) on SIMD kernels
+    simd::LeafTriangles batch_;
     Counters& counters_;
 };
 

@@ -107,7 +107,7 @@ gpu::DacrtBindingSet uploadFrame(const GpuFrame& frame, const gpu::Context& cont
 gpu::ComputePipeline& preparePipeline(const GpuFrame& frame, const DacrtOptions& options, const gpu::DeviceInfo& device,
                                       gpu::PipelineCache& pipelines, const gpu::DacrtBindingSet& set,
                                       TraceResult& result) {
-    const bool sharedStart = gpu::raysShareStart(*frame.geometry.rays);  // a scan of every ray: not compilation
+    const bool sharedStart = frame.geometry.raysShareStart;
     const auto start = Clock::now();
     const DacrtOptions leafLimits = options.resolvedFor(Backend::Gpu);
     gpu::ComputePipeline& pipeline = pipelines.kernel(gpu::KernelSpecialization{

@@ -39,14 +39,6 @@ std::vector<std::uint32_t> groupTriangleIds(const Division& division, std::uint3
     return ids;
 }
 
-bool raysShareStart(const std::vector<Ray>& rays) {
-    // Bitwise, so that the kernel's arithmetic on the shared values is the per-ray one.
-    return std::all_of(rays.begin(), rays.end(), [&](const Ray& r) {
-        return std::memcmp(&r.origin, &rays.front().origin, sizeof(r.origin)) == 0 &&
-               std::memcmp(&r.tmin, &rays.front().tmin, sizeof(r.tmin)) == 0;
-    });
-}
-
 WorkPlan planWorkItems(const Division& division, const std::vector<TransferRound>& schedule, std::uint32_t groups) {
     WorkPlan plan;
     plan.groups = groups;

@@ -21,10 +21,6 @@ namespace dacrt::gpu {
 std::vector<Region> groupRegions(const Division& division, std::uint32_t groups);
 std::vector<std::uint32_t> groupTriangleIds(const Division& division, std::uint32_t groups);
 
-// Whether every ray has the first ray's origin and tmin, bit for bit (primary rays do): the
-// kernel then takes them from push constants instead of loading them per ray.
-bool raysShareStart(const std::vector<Ray>& rays);
-
 struct WorkPlan {
     std::uint32_t groups = 1;
     std::vector<Region> slots;              // groupRegions

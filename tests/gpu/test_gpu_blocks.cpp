@@ -186,12 +186,12 @@ TEST(GpuBlocks, PrimaryRaysShareTheirStart) {
     camera.eye = glm::dvec3(0.1, 0.2, 3.0);
     camera.yfovRadians = 0.8;
     std::vector<Ray> rays = primaryRays(camera, 8, 6);
-    EXPECT_TRUE(gpu::raysShareStart(rays));
+    EXPECT_TRUE(raysShareStart(rays));
     rays[17].origin.y = std::nextafter(rays[17].origin.y, 10.0f);
-    EXPECT_FALSE(gpu::raysShareStart(rays)) << "one origin a unit in the last place away";
+    EXPECT_FALSE(raysShareStart(rays)) << "one origin a unit in the last place away";
     rays = primaryRays(camera, 8, 6);
     rays[40].tmin = 1e-6f;
-    EXPECT_FALSE(gpu::raysShareStart(rays)) << "one tmin differs";
+    EXPECT_FALSE(raysShareStart(rays)) << "one tmin differs";
 }
 
 TEST(GpuBlocks, RayGroupsSplitEachRegionsRaysAndCopyItsTriangles) {

@@ -122,18 +122,25 @@ struct FrameOutcome {
 // backend. Embree's scenes persist across frames as its users keep them: a dynamic one is
 // rebuilt each frame (vertex buffer updated, committed: a full LOW-quality build into the
 // memory of the last one), a refitted one refitted, a static one left alone.
+// The frame's rays and bounds live in buffers kept from frame to frame, as a renderer of a
+// dynamic scene keeps them, and are computed on the configuration's threads.
+struct FrameBuffers {
+    std::vector<Ray> rays;
+    std::vector<Bounds> bounds;
+};
+
 FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& camera, int width, int height,
-                        BackendDispatcher& dispatcher, EmbreeScene* persistentEmbree, RayQueryScene* persistentRayQuery) {
+                        BackendDispatcher& dispatcher, EmbreeScene* persistentEmbree, RayQueryScene* persistentRayQuery,
+                        FrameBuffers& buffers) {
     FrameOutcome out;
     const auto start = Clock::now();
-    const std::vector<Ray> rays = primaryRays(camera, width, height);
+    ThreadPool& pool = dispatcher.pool(c.threads());
+    std::vector<Ray>& rays = buffers.rays;
+    primaryRays(camera, width, height, pool, rays);
     const bool peer = isPeer(c.backend());
-    std::vector<Bounds> bounds;
+    std::vector<Bounds>& bounds = buffers.bounds;
     Box box;
-    if (!peer) {
-        bounds = allTriangleBounds(scene.triangles);
-        box = sceneBounds(scene.triangles);
-    }
+    if (!peer) triangleBoundsInParallel(scene.triangles, pool, bounds, box);
     const FrameGeometry g = frameGeometry(scene.triangles, bounds, rays, box);
     const double prepareMs = msSince(start);
     const auto traceStart = Clock::now();
@@ -171,6 +178,7 @@ struct Accumulator {
     std::unique_ptr<EmbreeScene> persistentEmbree;  // built before the frames
     std::unique_ptr<RayQueryScene> persistentRayQuery;  // allocated before the frames; built by the first
     std::vector<double> cameraMs;
+    FrameBuffers buffers;
 };
 
 struct BenchScene {
@@ -246,7 +254,7 @@ void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, 
             progress.step(s.name + " " + config.series + " " + config.name + " camera " + std::to_string(k));
             const FrameOutcome frame =
                 traceFrame(config, s.scene, camera, cmd.width, cmd.height, dispatcher, a.persistentEmbree.get(),
-                           a.persistentRayQuery.get());
+                           a.persistentRayQuery.get(), a.buffers);
             // lavapipe's worker threads spin on for a while after a dispatch; the next frame, on
             // the same cores, would pay for it (Mesa 25.0.7, Dragon: the ray generation after a gpu
             // frame took 10.7 ms instead of 5.3 with no pause or a 20 ms one, 5.3 with 200 ms;

@@ -1,0 +1,307 @@
+// Compiled once per instruction set by Highway's foreach_target (this file includes itself);
+// HWY_DYNAMIC_DISPATCH picks the best one the machine supports on first use.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "dacrt/simd_kernels.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+#include <hwy/highway.h>
+
+#include <algorithm>
+
+#include "dacrt/predicates.hpp"
+#include "dacrt/simd_kernels.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace dacrt::simd {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using DF = hn::ScalableTag<float>;
+using DU = hn::RebindToUnsigned<DF>;
+using DI = hn::RebindToSigned<DF>;
+using VF = hn::Vec<DF>;
+using VU = hn::Vec<DU>;
+using MF = hn::Mask<DF>;
+
+// shared::min(a, b) is `b < a ? b : a` and shared::max(a, b) is `a < b ? b : a`: written the
+// same way, equal operands of different sign (+0, -0) resolve as in the scalar code.
+HWY_INLINE VF minLike(VF a, VF b) { return hn::IfThenElse(b < a, b, a); }
+HWY_INLINE VF maxLike(VF a, VF b) { return hn::IfThenElse(a < b, b, a); }
+
+// Ids that pass first (compress-stored in place: the write position never passes the read
+// position), the others through scratch behind them. Both keep their order.
+template <class Passes>
+HWY_INLINE std::uint32_t stablePartition(std::uint32_t* ids, std::uint32_t count, std::uint32_t* scratch,
+                                         const Passes& passes) {
+    const DU du;
+    const std::size_t n = hn::Lanes(du);
+    std::size_t kept = 0, moved = 0, i = 0;
+    for (; i + n <= count; i += n) {
+        const VU v = hn::LoadU(du, ids + i);
+        const auto m = passes(v);
+        kept += hn::CompressBlendedStore(v, m, du, ids + kept);
+        moved += hn::CompressBlendedStore(v, hn::Not(m), du, scratch + moved);
+    }
+    if (i < count) {
+        // The tail through a zeroed copy: no load past the range (a neighbour's, or the end of
+        // the array), and id 0 in the idle lanes is a valid gather.
+        alignas(64) std::uint32_t tail[64] = {};
+        std::copy(ids + i, ids + count, tail);
+        const VU v = hn::Load(du, tail);
+        const auto valid = hn::FirstN(du, count - i);
+        const auto m = hn::And(passes(v), valid);
+        kept += hn::CompressBlendedStore(v, m, du, ids + kept);
+        moved += hn::CompressBlendedStore(v, hn::AndNot(m, valid), du, scratch + moved);
+    }
+    std::copy(scratch, scratch + moved, ids + kept);
+    return std::uint32_t(kept);
+}
+
+// shared::slabInterval, lane by lane.
+HWY_INLINE void slabInterval(VF origin, VF invDir, float lo, float hi, VF& tNear, VF& tFar) {
+    const DF df;
+    const VF vlo = hn::Set(df, lo), vhi = hn::Set(df, hi);
+    const VF t0 = hn::Mul(hn::Sub(vlo, origin), invDir);
+    const VF t1 = hn::Mul(hn::Sub(vhi, origin), invDir);
+    const MF parallel = invDir == hn::Zero(df);
+    const MF inside = hn::And(origin >= vlo, origin <= vhi);
+    const VF none = hn::Set(df, kNoHitT), all = hn::Set(df, -kNoHitT);
+    tNear = hn::IfThenElse(parallel, hn::IfThenElse(inside, all, none), minLike(t0, t1));
+    tFar = hn::IfThenElse(parallel, hn::IfThenElse(inside, none, all), maxLike(t0, t1));
+}
+
+template <bool kSharedStart>
+HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
+                                       const Box& cell, std::uint32_t* scratch) {
+    static_assert(sizeof(Ray) == 16 * sizeof(float) && sizeof(Hit) == 4 * sizeof(float));
+    const float* ray = reinterpret_cast<const float*>(rays);
+    const float* hit = reinterpret_cast<const float*>(hits);
+    const DF df;
+    const DI di;
+    const DU du;
+    // Shared: every ray's origin and tmin are rays[0]'s bit for bit, so one broadcast gives
+    // each lane the value a gather would.
+    const VF sharedOrigin[3] = {hn::Set(df, rays[0].origin.x), hn::Set(df, rays[0].origin.y),
+                                hn::Set(df, rays[0].origin.z)};
+    const VF sharedTmin = hn::Set(df, rays[0].tmin);
+    return stablePartition(ids, count, scratch, [&](VU id) {
+        const auto index = hn::BitCast(di, id);
+        const auto base = hn::ShiftLeft<4>(index);
+        auto field = [&](int offset) { return hn::GatherIndex(df, ray, hn::Add(base, hn::Set(di, offset))); };
+        // shared::rayMayCrossCell: origin at floats 0-2, tmin at 3, invDir at 8-10; hit t at 0.
+        VF xn, xf, yn, yf, zn, zf;
+        slabInterval(kSharedStart ? sharedOrigin[0] : field(0), field(8), cell.lo.x, cell.hi.x, xn, xf);
+        slabInterval(kSharedStart ? sharedOrigin[1] : field(1), field(9), cell.lo.y, cell.hi.y, yn, yf);
+        slabInterval(kSharedStart ? sharedOrigin[2] : field(2), field(10), cell.lo.z, cell.hi.z, zn, zf);
+        const VF tNear = maxLike(xn, maxLike(yn, zn));
+        const VF tFar = minLike(xf, minLike(yf, zf));
+        const VF tmin = kSharedStart ? sharedTmin : field(3);
+        const VF tmax = hn::GatherIndex(df, hit, hn::ShiftLeft<2>(index));
+        const MF m = hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
+        return hn::RebindMask(du, m);
+    });
+}
+
+std::uint32_t PartitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
+                            const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
+    return raysShareStart ? partitionRays<true>(rays, hits, ids, count, cell, scratch)
+                          : partitionRays<false>(rays, hits, ids, count, cell, scratch);
+}
+
+std::uint32_t PartitionTriangles(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, const Box& cell,
+                                 std::uint32_t* scratch) {
+    static_assert(sizeof(Bounds) == 8 * sizeof(float));
+    const float* b = reinterpret_cast<const float*>(bounds);
+    const DF df;
+    const DI di;
+    const DU du;
+    const VF cLoX = hn::Set(df, cell.lo.x), cLoY = hn::Set(df, cell.lo.y), cLoZ = hn::Set(df, cell.lo.z);
+    const VF cHiX = hn::Set(df, cell.hi.x), cHiY = hn::Set(df, cell.hi.y), cHiZ = hn::Set(df, cell.hi.z);
+    return stablePartition(ids, count, scratch, [&](VU id) {
+        const auto base = hn::ShiftLeft<3>(hn::BitCast(di, id));
+        auto field = [&](int offset) { return hn::GatherIndex(df, b, hn::Add(base, hn::Set(di, offset))); };
+        // shared::boundsOverlap: lo at floats 0-2, hi at 4-6.
+        const MF m = hn::And(hn::And(hn::And(field(0) <= cHiX, field(1) <= cHiY), hn::And(field(2) <= cHiZ, field(4) >= cLoX)),
+                             hn::And(field(5) >= cLoY, field(6) >= cLoZ));
+        return hn::RebindMask(du, m);
+    });
+}
+
+std::uint32_t PartitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
+                                       bool lowSide, float bound, std::uint32_t* scratch) {
+    const float* b = reinterpret_cast<const float*>(bounds) + (lowSide ? 0 : 4) + axis;
+    const DF df;
+    const DI di;
+    const DU du;
+    const VF face = hn::Set(df, bound);
+    if (lowSide)
+        return stablePartition(ids, count, scratch, [&](VU id) {
+            return hn::RebindMask(du, hn::GatherIndex(df, b, hn::ShiftLeft<3>(hn::BitCast(di, id))) <= face);
+        });
+    return stablePartition(ids, count, scratch, [&](VU id) {
+        return hn::RebindMask(du, hn::GatherIndex(df, b, hn::ShiftLeft<3>(hn::BitCast(di, id))) >= face);
+    });
+}
+
+HWY_INLINE bool triangleHasNoArea(const LeafTriangles& batch, std::size_t j) {
+    auto vertex = [&](int k) { return glm::vec3(batch.vertex[k][0][j], batch.vertex[k][1][j], batch.vertex[k][2][j]); };
+    return shared::triangleHasNoArea(vertex(0), vertex(1), vertex(2));
+}
+
+// Copies the triangles' vertices into the batch's lanes, a vector of triangles per gather.
+void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds, std::uint32_t count,
+                         LeafTriangles& batch) {
+    static_assert(sizeof(Triangle) == 12 * sizeof(float));
+    const float* tri = reinterpret_cast<const float*>(triangles);
+    const DF df;
+    const DI di;
+    const DU du;
+    const std::size_t n = hn::Lanes(du);
+    batch.count = count;
+    for (std::size_t j = 0; j < count; j += n) {
+        // Past count: id 0, a valid triangle whose lanes the tests never read as hits.
+        alignas(64) std::uint32_t ids[64] = {};
+        std::copy(triIds + j, triIds + std::min<std::size_t>(count, j + n), ids);
+        const VU id = hn::Load(du, ids);
+        hn::Store(id, du, &batch.prim[j]);
+        const auto base = hn::Mul(hn::BitCast(di, id), hn::Set(di, 12));
+        for (int k = 0; k < 3; ++k)
+            for (int c = 0; c < 3; ++c)
+                hn::Store(hn::GatherIndex(df, tri, hn::Add(base, hn::Set(di, 4 * k + c))), df, &batch.vertex[k][c][j]);
+    }
+}
+
+// shared::intersectWatertight for one ray and hn::Lanes triangles; the tie rule then runs
+// per hit lane in scalar code.
+void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                    const LeafTriangles& batch) {
+    const DF df;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    const VF zero = hn::Zero(df);
+    const VF projectionSlack = hn::Set(df, shared::kProjectionSlack);
+    alignas(64) float tLane[64], uLane[64], vLane[64];
+    std::uint8_t bits[8];
+    for (std::uint32_t r = 0; r < rayCount; ++r) {
+        const std::uint32_t rayId = rayIds[r];
+        const Ray& ray = rays[rayId];
+        Hit best = hits[rayId];
+        const int kx = int(ray.axes & 3u), ky = int((ray.axes >> 2) & 3u), kz = int((ray.axes >> 4) & 3u);
+        const VF sx = hn::Set(df, ray.shear.x), sy = hn::Set(df, ray.shear.y), sz = hn::Set(df, ray.shear.z);
+        const VF origin[3] = {hn::Set(df, ray.origin.x), hn::Set(df, ray.origin.y), hn::Set(df, ray.origin.z)};
+        const VF tmin = hn::Set(df, ray.tmin);
+        for (std::size_t j = 0; j < batch.count; j += n) {
+            VF a[3], b[3], c[3];
+            for (int k = 0; k < 3; ++k) {
+                a[k] = hn::Sub(hn::Load(df, &batch.vertex[0][k][j]), origin[k]);
+                b[k] = hn::Sub(hn::Load(df, &batch.vertex[1][k][j]), origin[k]);
+                c[k] = hn::Sub(hn::Load(df, &batch.vertex[2][k][j]), origin[k]);
+            }
+            const VF ax = hn::Sub(a[kx], hn::Mul(sx, a[kz])), ay = hn::Sub(a[ky], hn::Mul(sy, a[kz]));
+            const VF bx = hn::Sub(b[kx], hn::Mul(sx, b[kz])), by = hn::Sub(b[ky], hn::Mul(sy, b[kz]));
+            const VF cx = hn::Sub(c[kx], hn::Mul(sx, c[kz])), cy = hn::Sub(c[ky], hn::Mul(sy, c[kz]));
+            const VF eu = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
+            const VF ev = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
+            const VF ew = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+            const MF anyNegative = hn::Or(hn::Or(eu < zero, ev < zero), ew < zero);
+            const MF anyPositive = hn::Or(hn::Or(eu > zero, ev > zero), ew > zero);
+            MF m = hn::AndNot(hn::And(anyNegative, anyPositive), hn::FirstN(df, batch.count - j));
+            const VF det = hn::Add(hn::Add(eu, ev), ew);
+            m = hn::AndNot(det == zero, m);
+            const VF reach = maxLike(maxLike(maxLike(hn::Abs(a[0]), hn::Abs(a[1])), maxLike(hn::Abs(a[2]), hn::Abs(b[0]))),
+                                     maxLike(maxLike(hn::Abs(b[1]), hn::Abs(b[2])),
+                                             maxLike(maxLike(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
+            const VF slack = hn::Mul(reach, projectionSlack);
+            const VF negSlack = hn::Neg(slack);
+            const MF outside = hn::Or(hn::Or(minLike(ax, minLike(bx, cx)) > slack, maxLike(ax, maxLike(bx, cx)) < negSlack),
+                                      hn::Or(minLike(ay, minLike(by, cy)) > slack, maxLike(ay, maxLike(by, cy)) < negSlack));
+            m = hn::AndNot(outside, m);
+            if (hn::AllFalse(df, m)) continue;
+            const VF az = hn::Mul(sz, a[kz]), bz = hn::Mul(sz, b[kz]), cz = hn::Mul(sz, c[kz]);
+            const VF tScaled = hn::Add(hn::Add(hn::Mul(eu, az), hn::Mul(ev, bz)), hn::Mul(ew, cz));
+            const MF front = det > zero;
+            const MF behind = hn::Or(hn::And(front, tScaled <= zero), hn::AndNot(front, tScaled >= zero));
+            m = hn::AndNot(behind, m);
+            const VF t = hn::Div(tScaled, det);
+            m = hn::And(m, t > tmin);
+            if (hn::AllFalse(df, m)) continue;
+            hn::Store(t, df, tLane);
+            hn::Store(hn::Div(ev, det), df, uLane);
+            hn::Store(hn::Div(ew, det), df, vLane);
+            hn::StoreMaskBits(df, m, bits);
+            for (std::size_t l = 0; l < n; ++l) {
+                if (!((bits[l / 8] >> (l % 8)) & 1)) continue;
+                // The no-area rule, last of the conjunction, only where the rest says hit.
+                if (triangleHasNoArea(batch, j + l)) continue;
+                const std::uint32_t prim = batch.prim[j + l];
+                if (shared::hitPrecedes(tLane[l], prim, best.t, best.prim)) best = Hit{tLane[l], prim, uLane[l], vLane[l]};
+            }
+        }
+        hits[rayId] = best;
+    }
+}
+
+std::int64_t CompiledTarget() { return HWY_TARGET; }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace dacrt::simd
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace dacrt::simd {
+
+HWY_EXPORT(PartitionRays);
+HWY_EXPORT(PartitionTriangles);
+HWY_EXPORT(PartitionTrianglesOnFace);
+HWY_EXPORT(IntersectBatch);
+HWY_EXPORT(GatherLeafTriangles);
+HWY_EXPORT(CompiledTarget);
+
+std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
+                                        const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
+    return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, hits, ids, count, cell, raysShareStart, scratch);
+}
+
+std::uint32_t partitionTrianglesOverlapCell(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
+                                            const Box& cell, std::uint32_t* scratch) {
+    return HWY_DYNAMIC_DISPATCH(PartitionTriangles)(bounds, ids, count, cell, scratch);
+}
+
+std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
+                                       bool lowSide, float bound, std::uint32_t* scratch) {
+    return HWY_DYNAMIC_DISPATCH(PartitionTrianglesOnFace)(bounds, ids, count, axis, lowSide, bound, scratch);
+}
+
+void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds, std::uint32_t count,
+                         LeafTriangles& batch) {
+    HWY_DYNAMIC_DISPATCH(GatherLeafTriangles)(triangles, triIds, count, batch);
+}
+
+void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                    const LeafTriangles& batch) {
+    HWY_DYNAMIC_DISPATCH(IntersectBatch)(rays, hits, rayIds, rayCount, batch);
+}
+
+std::string activeTarget() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CompiledTarget)()); }
+
+std::vector<std::string> availableTargets() {
+    std::vector<std::string> names;
+    for (std::int64_t t : hwy::SupportedAndGeneratedTargets()) names.push_back(hwy::TargetName(t));
+    return names;
+}
+
+void forceTarget(const std::string& name) {
+    if (name.empty()) {
+        hwy::SetSupportedTargetsForTest(0);
+        return;
+    }
+    hwy::SetSupportedTargetsForTest(0);
+    for (std::int64_t t : hwy::SupportedAndGeneratedTargets())
+        if (name == hwy::TargetName(t)) {
+            hwy::SetSupportedTargetsForTest(t);
+            return;
+        }
+    throw std::invalid_argument("no SIMD target named " + name + " is available here");
+}
+
+}  // namespace dacrt::simd
+#endif

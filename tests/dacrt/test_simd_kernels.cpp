@@ -1,0 +1,264 @@
+// The SIMD kernels against the scalar predicates they replace, on every instruction set this
+// binary holds that the machine runs: same ids in the same order, same hits bit for bit.
+#include <algorithm>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/camera.hpp"
+#include "core/random.hpp"
+#include "dacrt/predicates.hpp"
+#include "dacrt/simd_kernels.hpp"
+#include "dacrt/traversal.hpp"
+
+using namespace dacrt;
+
+namespace {
+
+// Every available target in turn, then the best again.
+class EveryTarget : public ::testing::Test {
+protected:
+    template <typename Body>
+    void forEachTarget(Body body) {
+        const std::vector<std::string> targets = simd::availableTargets();
+        ASSERT_FALSE(targets.empty());
+        for (const std::string& t : targets) {
+            SCOPED_TRACE("target " + t);
+            simd::forceTarget(t);
+            ASSERT_EQ(simd::activeTarget(), t);
+            body();
+        }
+    }
+    void TearDown() override { simd::forceTarget(""); }
+};
+
+// Coordinates drawn from a few values on purpose: equal coordinates (a ray origin on a cell
+// face, bounds touching a cell) and zero direction components are where a kernel that
+// differs from the scalar rule would show.
+float adversarialCoordinate(Random& rng) {
+    static const float kValues[] = {-1.0f, -0.5f, 0.0f, -0.0f, 0.25f, 0.5f, 1.0f, 1e-30f, 3.0f};
+    if (rng.uniform() < 0.4) return kValues[rng.index(std::size(kValues))];
+    return rng.uniformFloat(-2.0f, 2.0f) * (rng.uniform() < 0.2 ? 1e6f : 1.0f);
+}
+
+Ray randomRay(Random& rng) {
+    glm::vec3 origin{adversarialCoordinate(rng), adversarialCoordinate(rng), adversarialCoordinate(rng)};
+    glm::dvec3 dir = rng.onSphere();
+    for (int a = 0; a < 3; ++a)
+        if (rng.uniform() < 0.15) dir[a] = 0.0;  // parallel to a slab
+    if (dir == glm::dvec3(0.0)) dir.z = 1.0;
+    return makeRay(origin, dir, rng.uniform() < 0.3 ? rng.uniformFloat(0.0f, 1.0f) : 0.0f);
+}
+
+Box randomCell(Random& rng) {
+    Box b;
+    for (int a = 0; a < 3; ++a) {
+        float p = adversarialCoordinate(rng), q = rng.uniform() < 0.1 ? p : adversarialCoordinate(rng);
+        b.lo[a] = std::min(p, q);
+        b.hi[a] = std::max(p, q);
+    }
+    return b;
+}
+
+std::vector<std::uint32_t> scalarPartition(std::vector<std::uint32_t> ids, std::uint32_t& kept,
+                                           const std::function<bool(std::uint32_t)>& passes) {
+    std::vector<std::uint32_t> out, rest;
+    for (std::uint32_t id : ids) (passes(id) ? out : rest).push_back(id);
+    kept = std::uint32_t(out.size());
+    out.insert(out.end(), rest.begin(), rest.end());
+    return out;
+}
+
+std::vector<std::uint32_t> shuffledIds(Random& rng, std::uint32_t universe, std::uint32_t count) {
+    std::vector<std::uint32_t> ids(universe);
+    for (std::uint32_t i = 0; i < universe; ++i) ids[i] = i;
+    rng.shuffle(ids);
+    ids.resize(count);
+    return ids;
+}
+
+bool sameHit(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit)) == 0; }
+
+}  // namespace
+
+// With their own starts, and sharing one (the broadcast path).
+TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
+    forEachTarget([] {
+      for (const bool shareStart : {false, true}) {
+        SCOPED_TRACE(shareStart ? "rays share their start" : "rays start apart");
+        Random rng(11);
+        std::uint32_t keptTotal = 0, rejectedTotal = 0;
+        std::vector<Ray> rays(300);
+        std::vector<Hit> hits(rays.size(), missHit());
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            rays[i] = randomRay(rng);
+            if (shareStart && i > 0) {
+                rays[i].origin = rays[0].origin;
+                rays[i].tmin = rays[0].tmin;
+            }
+            if (rng.uniform() < 0.5) hits[i] = Hit{rng.uniform() < 0.2 ? 0.0f : rng.uniformFloat(0.0f, 4.0f), 1, 0, 0};
+        }
+        for (int trial = 0; trial < 400; ++trial) {
+            const Box cell = randomCell(rng);
+            const std::uint32_t count = std::uint32_t(rng.index(70));  // every tail length of every width
+            std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(rays.size()), count);
+            std::uint32_t expectedKept = 0;
+            const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
+                return shared::rayMayCrossCell(rays[id], cell.lo, cell.hi, hits[id].t);
+            });
+            std::vector<std::uint32_t> scratch(count + 1);
+            const std::uint32_t kept = simd::partitionRaysMayCrossCell(rays.data(), hits.data(), ids.data(), count, cell,
+                                                                       shareStart, scratch.data());
+            ASSERT_EQ(kept, expectedKept) << "trial " << trial;
+            ASSERT_EQ(ids, expected) << "trial " << trial;
+            keptTotal += kept;
+            rejectedTotal += count - kept;
+        }
+        EXPECT_GT(keptTotal, 400u);  // both answers are common, so both are compared
+        EXPECT_GT(rejectedTotal, 1000u);
+      }
+    });
+}
+
+TEST_F(EveryTarget, TrianglePartitionKeepsTheScalarAnswerAndOrder) {
+    forEachTarget([] {
+        Random rng(12);
+        std::uint32_t keptTotal = 0, rejectedTotal = 0;
+        std::vector<Bounds> bounds(300);
+        for (Bounds& b : bounds) {
+            const Box box = randomCell(rng);
+            b.lo = box.lo;
+            b.hi = box.hi;
+        }
+        for (int trial = 0; trial < 400; ++trial) {
+            const Box cell = randomCell(rng);
+            const std::uint32_t count = std::uint32_t(rng.index(70));
+            std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(bounds.size()), count);
+            std::uint32_t expectedKept = 0;
+            const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
+                return shared::boundsOverlap(bounds[id].lo, bounds[id].hi, cell.lo, cell.hi);
+            });
+            std::vector<std::uint32_t> scratch(count + 1);
+            const std::uint32_t kept =
+                simd::partitionTrianglesOverlapCell(bounds.data(), ids.data(), count, cell, scratch.data());
+            ASSERT_EQ(kept, expectedKept) << "trial " << trial;
+            ASSERT_EQ(ids, expected) << "trial " << trial;
+            keptTotal += kept;
+            rejectedTotal += count - kept;
+        }
+        EXPECT_GT(keptTotal, 1000u);
+        EXPECT_GT(rejectedTotal, 1000u);
+    });
+}
+
+// Children of a cell the triangles overlap: the one-face test answers boundsOverlap.
+TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCell) {
+    forEachTarget([] {
+        Random rng(14);
+        std::uint32_t keptTotal = 0, rejectedTotal = 0;
+        for (int trial = 0; trial < 300; ++trial) {
+            const Box parent = randomCell(rng);
+            std::vector<Bounds> bounds(200);
+            for (Bounds& b : bounds)
+                for (int a = 0; a < 3; ++a) {  // lo <= parent.hi and hi >= parent.lo: they overlap it
+                    b.lo[a] = std::min(adversarialCoordinate(rng), parent.hi[a]);
+                    b.hi[a] = std::max({b.lo[a], parent.lo[a], adversarialCoordinate(rng)});
+                }
+            const int axis = int(rng.index(3));
+            const bool lowSide = rng.uniform() < 0.5;
+            Box child = parent;
+            const float face = rng.uniform() < 0.3 ? bounds[rng.index(bounds.size())].lo[axis]
+                                                    : rng.uniformFloat(parent.lo[axis], parent.hi[axis]);
+            (lowSide ? child.hi : child.lo)[axis] = face;
+            const std::uint32_t count = std::uint32_t(rng.index(70));
+            std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(bounds.size()), count);
+            for (const Bounds& b : bounds) ASSERT_TRUE(shared::boundsOverlap(b.lo, b.hi, parent.lo, parent.hi));
+            std::uint32_t expectedKept = 0;
+            const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
+                return shared::boundsOverlap(bounds[id].lo, bounds[id].hi, child.lo, child.hi);
+            });
+            std::vector<std::uint32_t> scratch(count + 1);
+            const std::uint32_t kept =
+                simd::partitionTrianglesOnFace(bounds.data(), ids.data(), count, axis, lowSide, face, scratch.data());
+            ASSERT_EQ(kept, expectedKept) << "trial " << trial;
+            ASSERT_EQ(ids, expected) << "trial " << trial;
+            keptTotal += kept;
+            rejectedTotal += count - kept;
+        }
+        EXPECT_GT(keptTotal, 1000u);
+        EXPECT_GT(rejectedTotal, 1000u);
+    });
+}
+
+// Rays aimed at vertices and edges shared by neighbouring triangles, duplicated triangles
+// (equal t: the tie rule decides), degenerate ones, far offsets and grazing directions.
+TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
+    forEachTarget([] {
+        Random rng(13);
+        std::size_t hitsFound = 0, tiesOnDuplicates = 0;
+        for (int trial = 0; trial < 300; ++trial) {
+            const float scale = rng.uniform() < 0.3 ? 1e5f : 1.0f;
+            const glm::vec3 offset = rng.uniform() < 0.3 ? rng.vec3(-1e6f, 1e6f) : glm::vec3(0.0f);
+            std::vector<Triangle> tris(std::uint32_t(rng.index(90)) + 1);
+            // A fan around a shared vertex, so rays through it and along its edges meet several.
+            const glm::vec3 hub = offset + rng.vec3(-1.0f, 1.0f) * scale;
+            for (std::size_t i = 0; i < tris.size(); ++i) {
+                Triangle& t = tris[i];
+                if (i > 0 && rng.uniform() < 0.15) {
+                    t = tris[rng.index(i)];  // a duplicate under another id
+                    continue;
+                }
+                t.v0 = rng.uniform() < 0.6 ? hub : offset + rng.vec3(-1.0f, 1.0f) * scale;
+                t.v1 = offset + rng.vec3(-1.0f, 1.0f) * scale;
+                t.v2 = rng.uniform() < 0.1 ? t.v1 : offset + rng.vec3(-1.0f, 1.0f) * scale;  // some have no area
+            }
+            std::vector<Ray> rays(40);
+            for (Ray& r : rays) {
+                const glm::vec3 eye = offset + rng.vec3(-3.0f, 3.0f) * scale;
+                const Triangle& aim = tris[rng.index(tris.size())];
+                const double pick = rng.uniform();
+                const glm::vec3 target = pick < 0.3 ? hub : (pick < 0.5 ? aim.v1 : (pick < 0.7 ? 0.5f * (aim.v0 + aim.v1) : aim.v2));
+                glm::dvec3 d = glm::dvec3(target) - glm::dvec3(eye);
+                if (glm::length(d) == 0.0) d = {0.0, 0.0, 1.0};
+                r = makeRay(eye, glm::normalize(d), rng.uniform() < 0.2 ? rng.uniformFloat(0.0f, 2.0f) * scale : 0.0f);
+            }
+            std::vector<std::uint32_t> triIds = shuffledIds(rng, std::uint32_t(tris.size()), std::uint32_t(tris.size()));
+            triIds.resize(std::min<std::size_t>(triIds.size(), simd::kLeafBatch));
+            std::vector<std::uint32_t> rayIds = shuffledIds(rng, std::uint32_t(rays.size()), std::uint32_t(rays.size()));
+            std::vector<Hit> expected(rays.size(), missHit()), got(rays.size(), missHit());
+            for (std::size_t i = 0; i < rays.size(); ++i)
+                if (rng.uniform() < 0.3) expected[i] = got[i] = Hit{rng.uniformFloat(0.0f, 5.0f) * scale, 7, 0.25f, 0.5f};
+            for (std::uint32_t id : rayIds)
+                for (std::uint32_t prim : triIds) testTriangle(rays[id], tris[prim], prim, expected[id]);
+            simd::LeafTriangles batch;
+            simd::gatherLeafTriangles(tris.data(), triIds.data(), std::uint32_t(triIds.size()), batch);
+            simd::intersectBatch(rays.data(), got.data(), rayIds.data(), std::uint32_t(rayIds.size()), batch);
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                if (expected[i].prim != kMissPrim && expected[i].prim != 7) ++hitsFound;
+                for (std::uint32_t prim : triIds)
+                    if (prim != expected[i].prim && expected[i].prim < tris.size() &&
+                        std::memcmp(&tris[prim], &tris[expected[i].prim], sizeof(Triangle)) == 0)
+                        ++tiesOnDuplicates;
+            }
+            for (std::size_t i = 0; i < rays.size(); ++i)
+                ASSERT_TRUE(sameHit(got[i], expected[i]))
+                    << "trial " << trial << " ray " << i << ": simd prim " << got[i].prim << " t " << got[i].t
+                    << ", scalar prim " << expected[i].prim << " t " << expected[i].t;
+        }
+        EXPECT_GT(hitsFound, 2000u);
+        EXPECT_GT(tiesOnDuplicates, 50u);  // the tie rule is exercised, not only distinct depths
+    });
+}
+
+TEST(SimdTargets, TheBestIsChosenByDefaultAndForcingAnUnknownOneIsAnError) {
+    simd::forceTarget("");
+    const std::vector<std::string> targets = simd::availableTargets();
+    ASSERT_FALSE(targets.empty());
+    EXPECT_EQ(simd::activeTarget(), targets.front());
+    EXPECT_THROW(simd::forceTarget("no-such-target"), std::invalid_argument);
+    simd::forceTarget("");
+    EXPECT_EQ(simd::activeTarget(), targets.front());
+}
