@@ -1,8 +1,11 @@
 #include "cmd/cli.hpp"
 
+
+#include <algorithm>
 #include <cmath>
-#include <iostream>
+#include <cstdlib>
 #include <functional>
+#include <iostream>
 #include <memory>
 #include <sstream>
 
@@ -14,7 +17,9 @@
 #include "cmd/render.hpp"
 #include "cmd/stress/stress.hpp"
 #include "core/atomic_file.hpp"
+#include "core/cpu_model.hpp"
 #include "core/errors.hpp"
+#include "dacrt/simd_kernels.hpp"
 #include "gpu/context.hpp"
 #include "gpu/vulkan_error.hpp"
 #include "oracle/compare.hpp"
@@ -179,6 +184,10 @@ Subcommand addRenderCommand(CLI::App& app) {
 Subcommand addDevicesCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("devices", "list the Vulkan devices and the limits that matter here");
     return {cmd, [] {
+                std::string simdTargets;
+                for (const std::string& t : simd::availableTargets()) simdTargets += " " + t;
+                std::cout << "cpu: " << cpuModelName() << "; SIMD kernels run " << simd::activeTarget()
+                          << " (this binary can run:" << simdTargets << "; DACRT_SIMD_TARGET chooses)\n";
                 const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
                 if (devices.empty()) std::cout << "no Vulkan devices\n";
                 for (const gpu::DeviceInfo& d : devices) std::cout << d.describe();
@@ -291,9 +300,25 @@ Subcommand addBenchCommand(CLI::App& app) {
             }};
 }
 
+// DACRT_SIMD_TARGET runs the cpu backends' kernels on a named instruction set instead of the
+// best one (to compare them on one machine); checked before anything else runs.
+void applySimdTargetFromEnvironment() {
+    const char* name = std::getenv("DACRT_SIMD_TARGET");
+    if (!name || !*name) return;
+    const std::vector<std::string> available = simd::availableTargets();
+    if (std::find(available.begin(), available.end(), name) == available.end()) {
+        std::string list;
+        for (const std::string& t : available) list += (list.empty() ? "" : ", ") + t;
+        throw InputError(std::string("DACRT_SIMD_TARGET=") + name +
+                         " is not an instruction set this binary can run on this machine (it can run " + list + ")");
+    }
+    simd::forceTarget(name);
+}
+
 // Runs the chosen subcommand and maps what it throws to its exit code.
 int runReportingErrors(const std::function<int()>& run) {
     try {
+        applySimdTargetFromEnvironment();
         return run();
     } catch (const InputError& e) {
         std::cerr << "dacrt: error: " << e.what() << "\n";

@@ -10,6 +10,29 @@
 #include "dacrt/predicates.hpp"
 #include "dacrt/simd_kernels.hpp"
 
+#ifndef DACRT_SIMD_COMPRESS_TABLE
+#define DACRT_SIMD_COMPRESS_TABLE
+namespace dacrt::simd {
+// For each 8-bit lane mask, the indices of its set lanes in order: the permutation that
+// compresses a vector of up to 8 lanes. Static, so no target copies it per call (Highway
+// 1.0.3's own table for AVX2 is a local constant that GCC 12 rebuilds on the stack every
+// time: 1 KiB per compress, the whole cost of the AVX2 partitions).
+struct CompressTable {
+    std::uint8_t lanes[256][8];
+};
+constexpr CompressTable makeCompressTable() {
+    CompressTable t{};
+    for (int mask = 0; mask < 256; ++mask) {
+        int k = 0;
+        for (int lane = 0; lane < 8; ++lane)
+            if (mask & (1 << lane)) t.lanes[mask][k++] = std::uint8_t(lane);
+    }
+    return t;
+}
+alignas(64) static constexpr CompressTable kCompressTable = makeCompressTable();
+}  // namespace dacrt::simd
+#endif
+
 HWY_BEFORE_NAMESPACE();
 namespace dacrt::simd {
 namespace HWY_NAMESPACE {
@@ -27,8 +50,30 @@ using MF = hn::Mask<DF>;
 HWY_INLINE VF minLike(VF a, VF b) { return hn::IfThenElse(b < a, b, a); }
 HWY_INLINE VF maxLike(VF a, VF b) { return hn::IfThenElse(a < b, b, a); }
 
-// Ids that pass first (compress-stored in place: the write position never passes the read
-// position), the others through scratch behind them. Both keep their order.
+// The lanes of v that m selects, first and in order (the rest unspecified).
+HWY_INLINE VU compressIds(VU v, hn::Mask<DU> m) {
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+    return hn::Compress(v, m);  // vpcompressd, register form
+#else
+    const DU du;
+    if constexpr (hn::MaxLanes(du) == 1) {
+        return v;
+    } else {
+        static_assert(hn::MaxLanes(du) <= 8);
+        std::uint8_t bits[8] = {};
+        hn::StoreMaskBits(du, m, bits);
+        const hn::Rebind<std::uint8_t, DU> d8;
+        const VU lanes = hn::PromoteTo(du, hn::LoadU(d8, kCompressTable.lanes[bits[0]]));
+        return hn::TableLookupLanes(v, hn::IndicesFromVec(du, hn::BitCast(hn::RebindToSigned<DU>(), lanes)));
+    }
+#endif
+}
+
+// Ids that pass first (compressed in place: the write position never passes the read
+// position), the others through scratch behind them. Both keep their order. Each compressed
+// vector is stored whole: its lanes past the count land on ids already read, or on the
+// scratch's slack, never past the range (blended stores would not, but AMD runs AVX2's
+// masked stores in microcode, and some Zen generations AVX-512's compressing stores).
 template <class Passes>
 HWY_INLINE std::uint32_t stablePartition(std::uint32_t* ids, std::uint32_t count, std::uint32_t* scratch,
                                          const Passes& passes) {
@@ -38,19 +83,28 @@ HWY_INLINE std::uint32_t stablePartition(std::uint32_t* ids, std::uint32_t count
     for (; i + n <= count; i += n) {
         const VU v = hn::LoadU(du, ids + i);
         const auto m = passes(v);
-        kept += hn::CompressBlendedStore(v, m, du, ids + kept);
-        moved += hn::CompressBlendedStore(v, hn::Not(m), du, scratch + moved);
+        const std::size_t passing = hn::CountTrue(du, m);
+        hn::StoreU(compressIds(v, m), du, ids + kept);
+        hn::StoreU(compressIds(v, hn::Not(m)), du, scratch + moved);
+        kept += passing;
+        moved += n - passing;
     }
     if (i < count) {
-        // The tail through a zeroed copy: no load past the range (a neighbour's, or the end of
-        // the array), and id 0 in the idle lanes is a valid gather.
-        alignas(64) std::uint32_t tail[64] = {};
+        // The tail through zeroed copies: no access past the range (a neighbour's, or the end
+        // of the array), and id 0 in the idle lanes is a valid gather.
+        alignas(64) std::uint32_t tail[64] = {}, pass[64], fail[64];
+        const std::size_t rest = count - i;
         std::copy(ids + i, ids + count, tail);
         const VU v = hn::Load(du, tail);
-        const auto valid = hn::FirstN(du, count - i);
+        const auto valid = hn::FirstN(du, rest);
         const auto m = hn::And(passes(v), valid);
-        kept += hn::CompressBlendedStore(v, m, du, ids + kept);
-        moved += hn::CompressBlendedStore(v, hn::AndNot(m, valid), du, scratch + moved);
+        const std::size_t passing = hn::CountTrue(du, m);
+        hn::Store(compressIds(v, m), du, pass);
+        hn::Store(compressIds(v, hn::AndNot(m, valid)), du, fail);
+        std::copy(pass, pass + passing, ids + kept);
+        std::copy(fail, fail + (rest - passing), scratch + moved);
+        kept += passing;
+        moved += rest - passing;
     }
     std::copy(scratch, scratch + moved, ids + kept);
     return std::uint32_t(kept);
@@ -70,11 +124,11 @@ HWY_INLINE void slabInterval(VF origin, VF invDir, float lo, float hi, VF& tNear
 }
 
 template <bool kSharedStart>
-HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
-                                       const Box& cell, std::uint32_t* scratch) {
-    static_assert(sizeof(Ray) == 16 * sizeof(float) && sizeof(Hit) == 4 * sizeof(float));
+HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const FilterRay* filter, std::uint32_t* ids,
+                                       std::uint32_t count, const Box& cell, std::uint32_t* scratch) {
+    static_assert(sizeof(Ray) == 16 * sizeof(float));
     const float* ray = reinterpret_cast<const float*>(rays);
-    const float* hit = reinterpret_cast<const float*>(hits);
+    const float* packed = reinterpret_cast<const float*>(filter);
     const DF df;
     const DI di;
     const DU du;
@@ -85,26 +139,30 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
     const VF sharedTmin = hn::Set(df, rays[0].tmin);
     return stablePartition(ids, count, scratch, [&](VU id) {
         const auto index = hn::BitCast(di, id);
-        const auto base = hn::ShiftLeft<4>(index);
+        const auto base = hn::ShiftLeft<4>(index), packedBase = hn::ShiftLeft<2>(index);
         auto field = [&](int offset) { return hn::GatherIndex(df, ray, hn::Add(base, hn::Set(di, offset))); };
-        // shared::rayMayCrossCell: origin at floats 0-2, tmin at 3, invDir at 8-10; hit t at 0.
+        auto packedField = [&](int offset) {
+            return hn::GatherIndex(df, packed, hn::Add(packedBase, hn::Set(di, offset)));
+        };
+        // shared::rayMayCrossCell: origin at floats 0-2 of a Ray, tmin at 3; invDir and the
+        // best t so far from the FilterRay.
         VF xn, xf, yn, yf, zn, zf;
-        slabInterval(kSharedStart ? sharedOrigin[0] : field(0), field(8), cell.lo.x, cell.hi.x, xn, xf);
-        slabInterval(kSharedStart ? sharedOrigin[1] : field(1), field(9), cell.lo.y, cell.hi.y, yn, yf);
-        slabInterval(kSharedStart ? sharedOrigin[2] : field(2), field(10), cell.lo.z, cell.hi.z, zn, zf);
+        slabInterval(kSharedStart ? sharedOrigin[0] : field(0), packedField(0), cell.lo.x, cell.hi.x, xn, xf);
+        slabInterval(kSharedStart ? sharedOrigin[1] : field(1), packedField(1), cell.lo.y, cell.hi.y, yn, yf);
+        slabInterval(kSharedStart ? sharedOrigin[2] : field(2), packedField(2), cell.lo.z, cell.hi.z, zn, zf);
         const VF tNear = maxLike(xn, maxLike(yn, zn));
         const VF tFar = minLike(xf, minLike(yf, zf));
         const VF tmin = kSharedStart ? sharedTmin : field(3);
-        const VF tmax = hn::GatherIndex(df, hit, hn::ShiftLeft<2>(index));
+        const VF tmax = packedField(3);
         const MF m = hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
         return hn::RebindMask(du, m);
     });
 }
 
-std::uint32_t PartitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
+std::uint32_t PartitionRays(const Ray* rays, const FilterRay* filter, std::uint32_t* ids, std::uint32_t count,
                             const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
-    return raysShareStart ? partitionRays<true>(rays, hits, ids, count, cell, scratch)
-                          : partitionRays<false>(rays, hits, ids, count, cell, scratch);
+    return raysShareStart ? partitionRays<true>(rays, filter, ids, count, cell, scratch)
+                          : partitionRays<false>(rays, filter, ids, count, cell, scratch);
 }
 
 std::uint32_t PartitionTriangles(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, const Box& cell,
@@ -172,8 +230,8 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 
 // shared::intersectWatertight for one ray and hn::Lanes triangles; the tie rule then runs
 // per hit lane in scalar code.
-void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                    const LeafTriangles& batch) {
+void IntersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::uint32_t* rayIds,
+                    std::uint32_t rayCount, const LeafTriangles& batch) {
     const DF df;
     const DU du;
     const std::size_t n = hn::Lanes(df);
@@ -237,6 +295,7 @@ void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
             }
         }
         hits[rayId] = best;
+        filter[rayId].tmax = best.t;
     }
 }
 
@@ -256,9 +315,14 @@ HWY_EXPORT(IntersectBatch);
 HWY_EXPORT(GatherLeafTriangles);
 HWY_EXPORT(CompiledTarget);
 
-std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
-                                        const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
-    return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, hits, ids, count, cell, raysShareStart, scratch);
+void fillFilterRays(const Ray* rays, const Hit* hits, std::size_t count, FilterRay* filter) {
+    for (std::size_t i = 0; i < count; ++i) filter[i] = FilterRay{rays[i].invDir, hits[i].t};
+}
+
+std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const FilterRay* filter, std::uint32_t* ids,
+                                        std::uint32_t count, const Box& cell, bool raysShareStart,
+                                        std::uint32_t* scratch) {
+    return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, filter, ids, count, cell, raysShareStart, scratch);
 }
 
 std::uint32_t partitionTrianglesOverlapCell(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
@@ -276,9 +340,9 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     HWY_DYNAMIC_DISPATCH(GatherLeafTriangles)(triangles, triIds, count, batch);
 }
 
-void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                    const LeafTriangles& batch) {
-    HWY_DYNAMIC_DISPATCH(IntersectBatch)(rays, hits, rayIds, rayCount, batch);
+void intersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::uint32_t* rayIds,
+                    std::uint32_t rayCount, const LeafTriangles& batch) {
+    HWY_DYNAMIC_DISPATCH(IntersectBatch)(rays, hits, filter, rayIds, rayCount, batch);
 }
 
 std::string activeTarget() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CompiledTarget)()); }

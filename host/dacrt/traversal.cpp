@@ -22,10 +22,11 @@ int longestAxis(const Box& b) {
 
 }  // namespace
 
-std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange) { return std::max(rayRange, triRange); }
+std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange) {
+    return std::max(rayRange, triRange) + simd::kScratchSlack;
+}
 
-DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& options, Hit* hits,
-                               std::uint32_t* rayIds, std::uint32_t* triIds, std::uint32_t* scratch,
+DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& options, const TraversalBuffers& buffers,
                                Counters& counters)
     : rays_(g.rays->data()),
       triangles_(g.triangles->data()),
@@ -33,14 +34,14 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       origin_(g.rayOrigin),
       margin_(g.margin),
       options_(options.resolvedFor(Backend::Cpu)),
-      hits_(hits),
-      rayIds_(rayIds),
-      triIds_(triIds),
-      scratch_(scratch),
+      hits_(buffers.hits),
+      rayIds_(buffers.rayIds),
+      triIds_(buffers.triIds),
+      scratch_(buffers.scratch),
+      filterRays_(buffers.filterRays),
       raysShareStart_(g.raysShareStart),
-      simd_(scratch != nullptr && options_.triangleFilter == TriangleFilter::Bounds &&
-            options_.intersector == Intersector::Watertight && options_.precision == Precision::F32 &&
-            g.rays->size() <= simd::kMaxRays && g.triangles->size() <= simd::kMaxTriangles),
+      simd_(scratch_ && filterRays_ && options_.exactDefaults() && g.rays->size() <= simd::kMaxRays &&
+            g.triangles->size() <= simd::kMaxTriangles),
       counters_(counters) {}
 
 std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
@@ -67,7 +68,7 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
 
 [[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
     counters_.rayBoxTests += end - begin;
-    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, hits_, rayIds_ + begin, end - begin, cell, raysShareStart_,
+    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, filterRays_, rayIds_ + begin, end - begin, cell, raysShareStart_,
                                                             scratch_);
     std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
         return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
@@ -183,7 +184,7 @@ void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::ui
                               std::uint32_t triBegin, std::uint32_t triEnd) {
     for (std::uint32_t j = triBegin; j < triEnd; j += simd::kLeafBatch) {
         simd::gatherLeafTriangles(triangles_, triIds_ + j, std::min(triEnd - j, simd::kLeafBatch), batch_);
-        simd::intersectBatch(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_);
+        simd::intersectBatch(rays_, hits_, filterRays_, rayIds_ + terminated, rayEnd - terminated, batch_);
     }
     endRaysHitInBox(box, terminated, rayEnd);
 }

@@ -25,11 +25,21 @@ struct RetireRule {
 // longest ray or triangle id range it is given.
 std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange);
 
+// The arrays a traversal permutes and updates. The last two serve the SIMD path of the
+// default options (without them the scalar path runs): scratch holds partitionScratchIds of
+// the ranges traced, filterRays one entry per ray (simd::fillFilterRays).
+struct TraversalBuffers {
+    Hit* hits = nullptr;
+    std::uint32_t* rayIds = nullptr;
+    std::uint32_t* triIds = nullptr;
+    std::uint32_t* scratch = nullptr;
+    simd::FilterRay* filterRays = nullptr;
+};
+
 class DacrtTraversal {
 public:
-    // scratch: partitionScratchIds(...) ids, for the SIMD path of the default options.
-    DacrtTraversal(const FrameGeometry& geometry, const DacrtOptions& options, Hit* hits, std::uint32_t* rayIds,
-                   std::uint32_t* triIds, std::uint32_t* scratch, Counters& counters);
+    DacrtTraversal(const FrameGeometry& geometry, const DacrtOptions& options, const TraversalBuffers& buffers,
+                   Counters& counters);
 
     // Traces the live rays rayIds[terminated, rayEnd) against triIds[triBegin, triEnd)
     // inside box. Rays whose final hit is found are swapped to position `terminated`, which
@@ -70,6 +80,7 @@ private:
     std::uint32_t* rayIds_;
     std::uint32_t* triIds_;
     std::uint32_t* scratch_;
+    simd::FilterRay* filterRays_;
     bool raysShareStart_;
     bool simd_;  // the default options (bounds filter, watertight float32 test) on SIMD kernels
     simd::LeafTriangles batch_;

@@ -109,9 +109,11 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
             const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
                 return shared::rayMayCrossCell(rays[id], cell.lo, cell.hi, hits[id].t);
             });
-            std::vector<std::uint32_t> scratch(count + 1);
-            const std::uint32_t kept = simd::partitionRaysMayCrossCell(rays.data(), hits.data(), ids.data(), count, cell,
-                                                                       shareStart, scratch.data());
+            std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
+            std::vector<simd::FilterRay> filter(rays.size());
+            simd::fillFilterRays(rays.data(), hits.data(), rays.size(), filter.data());
+            const std::uint32_t kept = simd::partitionRaysMayCrossCell(rays.data(), filter.data(), ids.data(), count,
+                                                                       cell, shareStart, scratch.data());
             ASSERT_EQ(kept, expectedKept) << "trial " << trial;
             ASSERT_EQ(ids, expected) << "trial " << trial;
             keptTotal += kept;
@@ -141,7 +143,7 @@ TEST_F(EveryTarget, TrianglePartitionKeepsTheScalarAnswerAndOrder) {
             const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
                 return shared::boundsOverlap(bounds[id].lo, bounds[id].hi, cell.lo, cell.hi);
             });
-            std::vector<std::uint32_t> scratch(count + 1);
+            std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
             const std::uint32_t kept =
                 simd::partitionTrianglesOverlapCell(bounds.data(), ids.data(), count, cell, scratch.data());
             ASSERT_EQ(kept, expectedKept) << "trial " << trial;
@@ -180,7 +182,7 @@ TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCell) {
             const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
                 return shared::boundsOverlap(bounds[id].lo, bounds[id].hi, child.lo, child.hi);
             });
-            std::vector<std::uint32_t> scratch(count + 1);
+            std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
             const std::uint32_t kept =
                 simd::partitionTrianglesOnFace(bounds.data(), ids.data(), count, axis, lowSide, face, scratch.data());
             ASSERT_EQ(kept, expectedKept) << "trial " << trial;
@@ -235,7 +237,9 @@ TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
                 for (std::uint32_t prim : triIds) testTriangle(rays[id], tris[prim], prim, expected[id]);
             simd::LeafTriangles batch;
             simd::gatherLeafTriangles(tris.data(), triIds.data(), std::uint32_t(triIds.size()), batch);
-            simd::intersectBatch(rays.data(), got.data(), rayIds.data(), std::uint32_t(rayIds.size()), batch);
+            std::vector<simd::FilterRay> filter(rays.size());
+            simd::fillFilterRays(rays.data(), got.data(), rays.size(), filter.data());
+            simd::intersectBatch(rays.data(), got.data(), filter.data(), rayIds.data(), std::uint32_t(rayIds.size()), batch);
             for (std::size_t i = 0; i < rays.size(); ++i) {
                 if (expected[i].prim != kMissPrim && expected[i].prim != 7) ++hitsFound;
                 for (std::uint32_t prim : triIds)
@@ -243,6 +247,7 @@ TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
                         std::memcmp(&tris[prim], &tris[expected[i].prim], sizeof(Triangle)) == 0)
                         ++tiesOnDuplicates;
             }
+            for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(filter[i].tmax, got[i].t) << "the filter's t follows";
             for (std::size_t i = 0; i < rays.size(); ++i)
                 ASSERT_TRUE(sameHit(got[i], expected[i]))
                     << "trial " << trial << " ray " << i << ": simd prim " << got[i].prim << " t " << got[i].t

@@ -23,6 +23,7 @@
 #include "core/gltf_loader.hpp"
 #include "core/shading.hpp"
 #include "core/timing.hpp"
+#include "dacrt/simd_kernels.hpp"
 #include "oracle/compare.hpp"
 #include "gpu/device_defaults.hpp"
 #include "oracle/embree_tracer.hpp"
@@ -325,6 +326,7 @@ void writeJson(const BenchCommand& cmd, const std::vector<BenchRow>& rows, const
                     {"suite", toString(cmd.suite)}};
     const gpu::Context* context = dispatcher.gpuContext();
     j["machine"] = {{"cpu", cpuModelName()},
+                    {"simd_target", simd::activeTarget()},
                     {"hardware_threads", hardwareThreads},
                     {"gpu_device", context ? context->info().name : std::string()},
                     {"gpu_driver", context ? context->info().driver : std::string()},
