@@ -99,6 +99,13 @@ void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
         ->check(CLI::Range(1u, 1u << 30))
         ->default_str(std::to_string(kCpuSimdTriangleLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +
                       " with a non-default intersector, filter or precision)" + gpu);
+    cmd->add_option("--packets", o.packets,
+                    "filter primary rays 8x8 pixels at a time high in the recursion, one by one below "
+                    "(cpu, cpu-seq; the default tests only): on or off")
+        ->default_str("on");
+    cmd->add_option("--packet-flush", o.packetFlush, "a node with fewer packets goes on ray by ray (cpu, cpu-seq)")
+        ->check(CLI::Range(1u, 1u << 30))
+        ->default_str(std::to_string(kPacketFlushDefault));
     addEnumOption(cmd, "--intersector", o.intersector, "leaf ray/triangle test (cpu, cpu-seq)");
     addEnumOption(cmd, "--triangle-filter", o.triangleFilter,
                   "triangle/box filter: bounds, sat (exact separating axes) or mora (inexact) (cpu, cpu-seq)");

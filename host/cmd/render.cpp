@@ -97,7 +97,7 @@ std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScen
     for (int j = 0; j < k; ++j)
         for (int i = 0; i < k; ++i) {
             const std::vector<Ray> rays = primaryRays(camera, o.width, o.height, {(i + 0.5) / k, (j + 0.5) / k});
-            const FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box);
+            const FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
             const TraceResult r = backends.trace(g, o.request);
             accumulateShading(p.scene, HitImage{o.width, o.height, &rays, &r.hits}, 1.0f / float(k * k), sum);
         }
@@ -185,7 +185,7 @@ int runRender(const RenderOptions& o) {
         const Camera& camera = p.cameras[std::size_t(k)];
         const auto frameStart = Clock::now();
         const std::vector<Ray> rays = primaryRays(camera, o.width, o.height);
-        const FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box);
+        const FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
         const double prepareMs = p.prepareMs + msSince(frameStart);
 
         const auto traceStart = Clock::now();

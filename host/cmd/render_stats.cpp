@@ -52,6 +52,7 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     for (std::size_t i = 0; i < c.terminatedPerRound.size(); ++i)
         rounds.push_back({{"round", c.roundNames[i]}, {"terminated", c.terminatedPerRound[i]}});
     j["counters"] = {{"ray_box_tests", c.rayBoxTests},
+                     {"packet_box_tests", c.packetBoxTests},
                      {"ray_triangle_tests", c.rayTriangleTests},
                      {"leaves", c.leaves},
                      {"rays_retired_without_hit", c.raysRetired},

@@ -61,6 +61,8 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     const std::uint64_t scratchIds = partitionScratchIds(rayCount, triCount);
     result.memory.add("partition scratch", scratchIds * 4);
     result.memory.add("filter rays", std::uint64_t(rayCount) * sizeof(simd::FilterRay));
+    const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
+    planPacketBuffers(g, resolved, scratchIds, 1, result.memory);
     if (onPlan && !onPlan(result.memory)) return result;
 
     result.hits.assign(rayCount, missHit());
@@ -70,8 +72,11 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     std::vector<std::uint32_t> scratch(scratchIds);
     std::vector<simd::FilterRay> filterRays(rayCount);
     simd::fillFilterRays(g.rays->data(), result.hits.data(), rayCount, filterRays.data());
-    DacrtTraversal traversal(g, options, {result.hits.data(), rayIds.data(), triIds.data(), scratch.data(), filterRays.data()},
-                             result.counters);
+    PacketStorage packets(g, resolved, scratchIds, 1);
+    DacrtTraversal traversal(
+        g, options,
+        {result.hits.data(), rayIds.data(), triIds.data(), scratch.data(), filterRays.data(), packets.forWorker(0)},
+        result.counters);
     std::uint32_t terminated = 0;
     const std::uint32_t crossing = traversal.trace(g.sceneBox, terminated, rayCount, 0, triCount);
     result.counters.raysCulled = rayCount - crossing;
@@ -91,7 +96,14 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     auto start = Clock::now();
     const int axis = options.axis == DivisionAxis::Best ? chooseDivisionAxis(g, regions) : int(options.axis) - 1;
     result.axis = axis;
-    Division division = divideScene(g, regions, axis, pool, result.memory, onPlan);
+    const DacrtOptions resolved = options.dacrt.resolvedFor(Backend::Cpu);
+    std::uint64_t scratchIds = 0;
+    auto planWorkers = [&](const Division& d, MemoryPlan& plan) {
+        scratchIds = partitionScratchIds(d.mostRegionRays, d.mostRegionTriangles);
+        plan.add("partition scratch (per thread)", scratchIds * 4 * pool.size());
+        planPacketBuffers(g, resolved, scratchIds, pool.size(), plan);
+    };
+    Division division = divideScene(g, regions, axis, pool, result.memory, onPlan, planWorkers);
     if (!division.complete) return result;
     result.hits.assign(g.rays->size(), missHit());
     std::vector<simd::FilterRay> filterRays(g.rays->size());
@@ -105,7 +117,8 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     result.counters.raysCulled = division.culledRays;
 
     std::vector<Counters> perWorker(pool.size());
-    std::vector<std::uint32_t> scratch(division.scratchIdsPerWorker * pool.size());
+    std::vector<std::uint32_t> scratch(scratchIds * pool.size());
+    PacketStorage packets(g, resolved, scratchIds, pool.size());
     std::vector<Region>& table = division.regions;
     // Step 1 finishes rays that never leave their slab; a transfer finishes the rays that
     // move toward the triangles' region but cannot reach it (nor, then, any region beyond).
@@ -114,7 +127,7 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
         const Region& tris = table[triRegion];
         DacrtTraversal traversal(g, options.dacrt,
                                  {result.hits.data(), division.rayIds.data(), division.triIds.data(),
-                                  scratch.data() + worker * division.scratchIdsPerWorker, filterRays.data()},
+                                  scratch.data() + worker * scratchIds, filterRays.data(), packets.forWorker(worker)},
                                  perWorker[worker]);
         const RetireRule retire{axis, triRegion == rayRegion ? 0 : (triRegion > rayRegion ? 1 : -1)};
         traversal.trace(regionBox(tris), rays.terminated, rays.rayEnd, tris.triBegin, tris.triEnd, retire);

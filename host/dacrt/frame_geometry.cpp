@@ -21,7 +21,7 @@ bool raysShareStart(const std::vector<Ray>& rays) {
 }
 
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
-                            const std::vector<Ray>& rays, const Box& sceneBox) {
+                            const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth) {
     FrameGeometry g;
     g.triangles = &triangles;
     g.triangleBounds = &bounds;
@@ -30,6 +30,7 @@ FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::v
     g.rayOrigin = rays.front().origin;
     g.margin = filterMargin(sceneBox, g.rayOrigin);
     g.raysShareStart = raysShareStart(rays);
+    g.imageWidth = imageWidth && rays.size() % imageWidth == 0 ? imageWidth : 0;
     return g;
 }
 

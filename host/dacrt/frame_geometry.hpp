@@ -1,5 +1,6 @@
 #pragma once
 // Everything a tracer reads, prepared once per frame and shared by every backend.
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -16,6 +17,7 @@ struct FrameGeometry {
     glm::vec3 rayOrigin{};  // every ray starts here (primary rays)
     float margin = 0.0f;    // filter widening, see filterMargin()
     bool raysShareStart = false;  // see raysShareStart()
+    std::uint32_t imageWidth = 0;  // rays are an image's pixels, row by row, this many a row (0: unknown)
 };
 
 // Whether every ray has the first ray's origin and tmin, bit for bit (primary rays do): the
@@ -31,7 +33,9 @@ float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin);
 
 // The frame every tracer reads: the arrays (which must outlive it), the scene box, the rays'
 // common origin (the first ray's) and the filter margin derived from both.
+// imageWidth: the rays' row length when they are an image's pixels (packets group them in
+// tiles), else 0.
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
-                            const std::vector<Ray>& rays, const Box& sceneBox);
+                            const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth = 0);
 
 }  // namespace dacrt

@@ -68,6 +68,7 @@ struct EnumNames<Precision> {
 constexpr std::uint32_t kCpuLeafLimit = 8;
 constexpr std::uint32_t kCpuSimdTriangleLimit = 32;
 constexpr std::uint32_t kGpuLeafLimit = 64;
+constexpr std::uint32_t kPacketFlushDefault = 16;
 
 struct DacrtOptions {
     std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default
@@ -77,6 +78,10 @@ struct DacrtOptions {
     Intersector intersector = Intersector::Watertight;
     TriangleFilter triangleFilter = TriangleFilter::Bounds;
     Precision precision = Precision::F32;
+    // Ray packets (docs/cpu-reference.md): primary rays filtered 8x8 pixels at a time high in
+    // the recursion, one by one below; the SIMD path of rays that share their start only.
+    bool packets = true;
+    std::uint32_t packetFlush = 0;  // a node with fewer packets goes on ray by ray; 0: the default
 
     // These options with the leaf limits of `backend` filled in where they are 0.
     DacrtOptions resolvedFor(Backend backend) const {
@@ -84,6 +89,7 @@ struct DacrtOptions {
         const std::uint32_t limit = backend == Backend::Gpu ? kGpuLeafLimit : kCpuLeafLimit;
         if (o.rayLimit == 0) o.rayLimit = limit;
         if (o.triLimit == 0) o.triLimit = backend != Backend::Gpu && exactDefaults() ? kCpuSimdTriangleLimit : limit;
+        if (o.packetFlush == 0) o.packetFlush = kPacketFlushDefault;
         return o;
     }
 

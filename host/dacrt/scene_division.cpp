@@ -1,6 +1,5 @@
 #include "dacrt/predicates.hpp"
 #include "dacrt/scene_division.hpp"
-#include "dacrt/traversal.hpp"
 
 #include <algorithm>
 #include <array>
@@ -93,7 +92,7 @@ int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
 }
 
 Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& pool, MemoryPlan& plan,
-                     const PlanHook& onPlan) {
+                     const PlanHook& onPlan, const DivisionPlanHook& planTracer) {
     const std::vector<Ray>& rays = *g.rays;
     const std::vector<Bounds>& tb = *g.triangleBounds;
     const Box& box = g.sceneBox;
@@ -215,13 +214,11 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
     plan.add("region table", std::uint64_t(n) * sizeof(Region));
     plan.add("ray ids", rayTotal * 4);
     plan.add("triangle ids (with straddlers)", triTotal * 4);
-    std::uint64_t mostRays = 0, mostTris = 0;
     for (const Region& r : d.regions) {
-        mostRays = std::max<std::uint64_t>(mostRays, r.rayEnd - r.rayBegin);
-        mostTris = std::max<std::uint64_t>(mostTris, r.triEnd - r.triBegin);
+        d.mostRegionRays = std::max<std::uint64_t>(d.mostRegionRays, r.rayEnd - r.rayBegin);
+        d.mostRegionTriangles = std::max<std::uint64_t>(d.mostRegionTriangles, r.triEnd - r.triBegin);
     }
-    d.scratchIdsPerWorker = partitionScratchIds(mostRays, mostTris);
-    plan.add("partition scratch (per thread)", d.scratchIdsPerWorker * 4 * pool.size());
+    if (planTracer) planTracer(d, plan);
     if (onPlan && !onPlan(plan)) return d;
 
     // Pass 2: fill.

@@ -21,7 +21,8 @@ struct Division {
     std::vector<std::uint32_t> triIds;         // every triangle once per region it overlaps
     std::uint64_t culledRays = 0;
     std::uint64_t straddlerCopies = 0;         // triIds.size() minus the triangle count
-    std::uint64_t scratchIdsPerWorker = 0;     // partitionScratchIds of the largest ranges
+    std::uint64_t mostRegionRays = 0;          // the largest region's ray and triangle counts
+    std::uint64_t mostRegionTriangles = 0;
     bool complete = false;                     // false: stopped after the plan, ids not filled
 };
 
@@ -43,10 +44,11 @@ int chooseDivisionAxis(const FrameGeometry& geometry, unsigned regionCount);
 // Splits the scene box into regionCount equal slabs (the source's midpoint subdivision,
 // generalised to any count), bins each ray into the first region it meets and each triangle into every
 // region whose widened box it overlaps. Counts first, then appends the id arrays to plan
-// and fills them, so the memory is known before anything is traced. onPlan returning
-// false stops before the fill.
+// (and what planTracer adds for the tracer's own buffers, from the counts) and fills them,
+// so the memory is known before anything is traced. onPlan returning false stops before the fill.
+using DivisionPlanHook = std::function<void(const Division&, MemoryPlan&)>;
 Division divideScene(const FrameGeometry& geometry, unsigned regionCount, int axis, ThreadPool& pool,
-                     MemoryPlan& plan, const PlanHook& onPlan = {});
+                     MemoryPlan& plan, const PlanHook& onPlan = {}, const DivisionPlanHook& planTracer = {});
 
 // Round s pairs region j's live rays with region j - s (first pass) or j + s (second pass),
 // only where region j has rays travelling that way: for rays leaving one camera this is the

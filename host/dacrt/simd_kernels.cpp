@@ -238,7 +238,8 @@ void IntersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::ui
     const VF zero = hn::Zero(df);
     const VF projectionSlack = hn::Set(df, shared::kProjectionSlack);
     alignas(64) float tLane[64], uLane[64], vLane[64];
-    std::uint8_t bits[8];
+    static_assert(HWY_LANES(float) <= 16, "the hit lanes are read as 16 mask bits");
+    std::uint8_t bits[8] = {};
     for (std::uint32_t r = 0; r < rayCount; ++r) {
         const std::uint32_t rayId = rayIds[r];
         const Ray& ray = rays[rayId];
@@ -265,13 +266,19 @@ void IntersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::ui
             MF m = hn::AndNot(hn::And(anyNegative, anyPositive), hn::FirstN(df, batch.count - j));
             const VF det = hn::Add(hn::Add(eu, ev), ew);
             m = hn::AndNot(det == zero, m);
-            const VF reach = maxLike(maxLike(maxLike(hn::Abs(a[0]), hn::Abs(a[1])), maxLike(hn::Abs(a[2]), hn::Abs(b[0]))),
-                                     maxLike(maxLike(hn::Abs(b[1]), hn::Abs(b[2])),
-                                             maxLike(maxLike(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
+            // Most triangles of a batch fail the edge test: the rest of the conjunction only
+            // where one passes.
+            if (hn::AllFalse(df, m)) continue;
+            // Max and Min rather than maxLike and minLike here: reach is a maximum of absolute
+            // values (no -0, no NaN: the same value whichever equal operand wins), and the
+            // extremes of the projected vertices are only compared, where +0 equals -0.
+            const VF reach = hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
+                                     hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
+                                             hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
             const VF slack = hn::Mul(reach, projectionSlack);
             const VF negSlack = hn::Neg(slack);
-            const MF outside = hn::Or(hn::Or(minLike(ax, minLike(bx, cx)) > slack, maxLike(ax, maxLike(bx, cx)) < negSlack),
-                                      hn::Or(minLike(ay, minLike(by, cy)) > slack, maxLike(ay, maxLike(by, cy)) < negSlack));
+            const MF outside = hn::Or(hn::Or(hn::Min(ax, hn::Min(bx, cx)) > slack, hn::Max(ax, hn::Max(bx, cx)) < negSlack),
+                                      hn::Or(hn::Min(ay, hn::Min(by, cy)) > slack, hn::Max(ay, hn::Max(by, cy)) < negSlack));
             m = hn::AndNot(outside, m);
             if (hn::AllFalse(df, m)) continue;
             const VF az = hn::Mul(sz, a[kz]), bz = hn::Mul(sz, b[kz]), cz = hn::Mul(sz, c[kz]);
@@ -286,8 +293,8 @@ void IntersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::ui
             hn::Store(hn::Div(ev, det), df, uLane);
             hn::Store(hn::Div(ew, det), df, vLane);
             hn::StoreMaskBits(df, m, bits);
-            for (std::size_t l = 0; l < n; ++l) {
-                if (!((bits[l / 8] >> (l % 8)) & 1)) continue;
+            for (std::uint32_t lanes = std::uint32_t(bits[0]) | std::uint32_t(bits[1]) << 8; lanes; lanes &= lanes - 1) {
+                const std::size_t l = std::size_t(__builtin_ctz(lanes));
                 // The no-area rule, last of the conjunction, only where the rest says hit.
                 if (triangleHasNoArea(batch, j + l)) continue;
                 const std::uint32_t prim = batch.prim[j + l];

@@ -13,6 +13,7 @@ namespace dacrt {
 
 struct Counters {
     std::uint64_t rayBoxTests = 0;
+    std::uint64_t packetBoxTests = 0;    // packets of rays tested at once against a box
     std::uint64_t rayTriangleTests = 0;
     std::uint64_t leaves = 0;
     std::uint64_t raysRetired = 0;       // finished by the parallel scheme without a further hit
@@ -25,6 +26,7 @@ struct Counters {
 
     void add(const Counters& o) {
         rayBoxTests += o.rayBoxTests;
+        packetBoxTests += o.packetBoxTests;
         rayTriangleTests += o.rayTriangleTests;
         leaves += o.leaves;
         raysRetired += o.raysRetired;

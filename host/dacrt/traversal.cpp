@@ -22,6 +22,42 @@ int longestAxis(const Box& b) {
 
 }  // namespace
 
+std::uint64_t packetTiles(const FrameGeometry& g) {
+    if (!g.imageWidth || !g.raysShareStart) return 0;
+    const std::uint64_t height = g.rays->size() / g.imageWidth;
+    return ((g.imageWidth + kPacketTile - 1) / kPacketTile) * ((height + kPacketTile - 1) / kPacketTile);
+}
+
+bool usesPackets(const FrameGeometry& g, const DacrtOptions& options) {
+    return options.packets && options.exactDefaults() && packetTiles(g) > 0;
+}
+
+void planPacketBuffers(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t scratchIds, unsigned workers,
+                       MemoryPlan& plan) {
+    if (!usesPackets(g, options)) return;
+    const std::uint64_t tiles = packetTiles(g);
+    plan.add("packet rays and flushed rays (per thread)", 2 * scratchIds * 4 * workers);
+    plan.add("packets (per thread)", tiles * (sizeof(RayPacket) + 8) * workers);
+    plan.add("ray finished flags", g.rays->size());
+}
+
+PacketStorage::PacketStorage(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t ids, unsigned workers)
+    : scratchIds(ids), tiles(usesPackets(g, options) ? packetTiles(g) : 0) {
+    if (!tiles) return;
+    packetRays.resize(ids * workers);
+    flushRays.resize(ids * workers);
+    packets.resize(tiles * workers);
+    packetIds.resize(tiles * workers);
+    tileCounts.resize((tiles + 1) * workers);
+    rayDone.assign(g.rays->size(), 0);
+}
+
+PacketBuffers PacketStorage::forWorker(unsigned w) {
+    if (!tiles) return {};
+    return {packetRays.data() + w * scratchIds, flushRays.data() + w * scratchIds, packets.data() + w * tiles,
+            packetIds.data() + w * tiles, tileCounts.data() + w * (tiles + 1), rayDone.data()};
+}
+
 std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange) {
     return std::max(rayRange, triRange) + simd::kScratchSlack;
 }
@@ -42,12 +78,19 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       raysShareStart_(g.raysShareStart),
       simd_(scratch_ && filterRays_ && options_.exactDefaults() && g.rays->size() <= simd::kMaxRays &&
             g.triangles->size() <= simd::kMaxTriangles),
+      packets_(simd_ && buffers.packets.packetRays && usesPackets(g, options_)),
+      packet_(buffers.packets),
+      imageWidth_(g.imageWidth),
+      tiles_(std::uint32_t(packetTiles(g))),
       counters_(counters) {}
 
 std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
                                     std::uint32_t triBegin, std::uint32_t triEnd, const RetireRule& retire) {
     const std::uint32_t crossing = filterRays(widen(box, margin_), terminated, rayEnd);
-    node(box, terminated, crossing, triBegin, triEnd, 0, 0);
+    if (packets_)
+        tracePackets(box, terminated, crossing, triBegin, triEnd);
+    else
+        node(box, terminated, crossing, triBegin, triEnd, 0, 0);
     if (retire.axis < 0) return crossing;
     const Box cell = widen(box, margin_);
     for (std::uint32_t k = terminated; k < rayEnd; ++k) {
@@ -145,6 +188,121 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
         const bool stalled = childRays == rayEnd && childTris == triEnd;
         node(*child, terminated, childRays, triBegin, childTris, depth + 1, stalled ? stalls + 1 : 0);
     }
+}
+
+// The rays of [terminated, crossing) in packets: traced down as packets to nodes with fewer
+// than packetFlush of them, one by one below. Finished rays are flagged, and moved before
+// `terminated` at the end as node() would have moved them.
+void DacrtTraversal::tracePackets(const Box& box, std::uint32_t& terminated, std::uint32_t crossing,
+                                  std::uint32_t triBegin, std::uint32_t triEnd) {
+    const std::uint32_t packetCount = buildPackets(terminated, crossing);
+    nodePackets(box, 0, packetCount, triBegin, triEnd, 0, 0);
+    for (std::uint32_t k = terminated; k < crossing; ++k)
+        if (packet_.rayDone[rayIds_[k]]) std::swap(rayIds_[k], rayIds_[terminated++]);
+}
+
+// A counting sort of the rays by 8x8 tile into packetRays, then each packet's bounds.
+std::uint32_t DacrtTraversal::buildPackets(std::uint32_t begin, std::uint32_t end) {
+    const std::uint32_t tilesX = (imageWidth_ + kPacketTile - 1) / kPacketTile;
+    auto tileOf = [&](std::uint32_t id) { return (id / imageWidth_ / kPacketTile) * tilesX + (id % imageWidth_) / kPacketTile; };
+    std::uint32_t* start = packet_.tileCounts;  // start[t]: where tile t's rays begin
+    std::fill(start, start + tiles_ + 1, 0u);
+    for (std::uint32_t k = begin; k < end; ++k) ++start[tileOf(rayIds_[k]) + 1];
+    for (std::uint32_t t = 0; t < tiles_; ++t) start[t + 1] += start[t];
+    for (std::uint32_t k = begin; k < end; ++k) packet_.packetRays[start[tileOf(rayIds_[k])]++] = rayIds_[k];
+    // start[t] is now where tile t's rays end.
+    std::uint32_t packets = 0, tileBegin = 0;
+    for (std::uint32_t t = 0; t < tiles_; tileBegin = start[t], ++t) {
+        if (start[t] == tileBegin) continue;
+        RayPacket& p = packet_.packets[packets];
+        p.begin = tileBegin;
+        p.end = start[t];
+        p.invLo = glm::vec3(kNoHitT);
+        p.invHi = glm::vec3(-kNoHitT);
+        p.unboundedAxes = 0;
+        for (std::uint32_t k = p.begin; k < p.end; ++k) {
+            const glm::vec3& inv = filterRays_[packet_.packetRays[k]].invDir;
+            for (int a = 0; a < 3; ++a) {
+                if (inv[a] == 0.0f) p.unboundedAxes |= 1u << a;
+                p.invLo[a] = std::min(p.invLo[a], inv[a]);
+                p.invHi[a] = std::max(p.invHi[a], inv[a]);
+            }
+        }
+        packet_.packetIds[packets] = packets;
+        ++packets;
+    }
+    return packets;
+}
+
+// Conservative for every ray of the packet (see RayPacket): false only where the ray filter
+// would reject each of them.
+bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin, const Box& cell) {
+    float tNear = -kNoHitT, tFar = kNoHitT;
+    for (int a = 0; a < 3; ++a) {
+        if ((p.unboundedAxes >> a) & 1u) continue;
+        const float d0 = cell.lo[a] - origin[a], d1 = cell.hi[a] - origin[a];  // the ray filter's own first factors
+        const float q0 = d0 * p.invLo[a], q1 = d0 * p.invHi[a], q2 = d1 * p.invLo[a], q3 = d1 * p.invHi[a];
+        tNear = std::max(tNear, std::min(std::min(q0, q1), std::min(q2, q3)));
+        tFar = std::min(tFar, std::max(std::max(q0, q1), std::max(q2, q3)));
+    }
+    return tNear <= tFar && tFar >= tmin;
+}
+
+std::uint32_t DacrtTraversal::filterPackets(const Box& cell, std::uint32_t begin, std::uint32_t end) {
+    counters_.packetBoxTests += end - begin;
+    const glm::vec3 origin = rays_[0].origin;  // every ray's (packets need raysShareStart)
+    const float tmin = rays_[0].tmin;
+    std::uint32_t* first = std::partition(packet_.packetIds + begin, packet_.packetIds + end, [&](std::uint32_t p) {
+        return packetMayCrossCell(packet_.packets[p], origin, tmin, cell);
+    });
+    return std::uint32_t(first - packet_.packetIds);
+}
+
+void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd,
+                                 std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
+                                 std::uint32_t stalls) {
+    if (packetBegin >= packetEnd || triBegin >= triEnd) return;
+    const int axis = longestAxis(box);
+    const float split = splitPosition(box, axis, triBegin, triEnd);
+    if (packetEnd - packetBegin < options_.packetFlush || triEnd - triBegin < options_.triLimit ||
+        depth >= options_.maxDepth || stalls >= DACRT_MAX_STALLED_SPLITS ||
+        !(split > box.lo[axis] && split < box.hi[axis])) {
+        flushPackets(box, packetBegin, packetEnd, triBegin, triEnd, depth);
+        return;
+    }
+    Box low = box, high = box;
+    low.hi[axis] = split;
+    high.lo[axis] = split;
+    const bool lowFirst = origin_[axis] <= split;
+    for (const Box* child : {lowFirst ? &low : &high, lowFirst ? &high : &low}) {
+        const Box cell = widen(*child, margin_);
+        const std::uint32_t childPackets = filterPackets(cell, packetBegin, packetEnd);
+        if (childPackets == packetBegin) continue;
+        const std::uint32_t childTris = filterTriangles(*child, cell, triBegin, triEnd, axis, child == &low);
+        const bool stalled = childPackets == packetEnd && childTris == triEnd;
+        nodePackets(*child, packetBegin, childPackets, triBegin, childTris, depth + 1, stalled ? stalls + 1 : 0);
+    }
+}
+
+// The node's unfinished rays go on one by one, from its own ray filter down.
+void DacrtTraversal::flushPackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd,
+                                  std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth) {
+    std::uint32_t count = 0;
+    for (std::uint32_t i = packetBegin; i < packetEnd; ++i) {
+        const RayPacket& p = packet_.packets[packet_.packetIds[i]];
+        for (std::uint32_t k = p.begin; k < p.end; ++k) {
+            const std::uint32_t id = packet_.packetRays[k];
+            if (!packet_.rayDone[id]) packet_.flushRays[count++] = id;
+        }
+    }
+    if (count == 0) return;
+    std::uint32_t* const regionRays = rayIds_;
+    rayIds_ = packet_.flushRays;
+    std::uint32_t terminated = 0;
+    const std::uint32_t crossing = filterRays(widen(box, margin_), 0, count);
+    node(box, terminated, crossing, triBegin, triEnd, depth, 0);
+    for (std::uint32_t k = 0; k < terminated; ++k) packet_.rayDone[rayIds_[k]] = 1;
+    rayIds_ = regionRays;
 }
 
 void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,

@@ -2,9 +2,11 @@
 // Sequential divide-and-conquer ray tracing (Mora 2011) over in-place id arrays: the
 // building block of both the cpu-seq backend and every work item of the parallel scheme.
 #include <cstdint>
+#include <vector>
 
 #include "dacrt/predicates.hpp"
 #include "dacrt/frame_geometry.hpp"
+#include "dacrt/memory_plan.hpp"
 #include "dacrt/simd_kernels.hpp"
 #include "dacrt/options.hpp"
 #include "dacrt/trace_result.hpp"
@@ -25,6 +27,50 @@ struct RetireRule {
 // longest ray or triangle id range it is given.
 std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange);
 
+// A packet: the live rays of one 8x8 pixel tile, and bounds of their direction reciprocals
+// per axis. Rays that share their start compute (lo - origin) * invDir with the same first
+// factor, and rounding is monotone, so the packet's four corner products bound every ray's
+// rounded slab values: a packet the bounds reject holds no ray the ray filter would keep.
+// An axis where some ray has invDir 0 (the filter's branch) is left unbounded.
+struct RayPacket {
+    std::uint32_t begin = 0, end = 0;  // its rays: packetRays[begin, end)
+    glm::vec3 invLo{0.0f}, invHi{0.0f};
+    std::uint32_t unboundedAxes = 0;   // bit per axis
+};
+constexpr std::uint32_t kPacketTile = 8;
+
+// Packets' working arrays, one set per worker: rays grouped by tile, the rays of a node's
+// packets when it goes on ray by ray, the packets and their ids (partitioned like ray ids),
+// and per-ray "finished" flags shared by all workers (each ray belongs to one work item).
+struct PacketBuffers {
+    std::uint32_t* packetRays = nullptr;  // partitionScratchIds ids
+    std::uint32_t* flushRays = nullptr;   // partitionScratchIds ids
+    RayPacket* packets = nullptr;         // packetTiles()
+    std::uint32_t* packetIds = nullptr;   // packetTiles()
+    std::uint32_t* tileCounts = nullptr;  // packetTiles() + 1
+    std::uint8_t* rayDone = nullptr;      // one per ray of the frame, zeroed
+};
+// The packet filter: false only where shared::rayMayCrossCell(ray, cell, tmax) is false for
+// every ray of p (origin and tmin: the rays' shared start).
+bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin, const Box& cell);
+// Tiles of the frame's image, 0 when the frame has no packets.
+std::uint64_t packetTiles(const FrameGeometry& geometry);
+// Whether a traversal of these options on this frame uses packets.
+bool usesPackets(const FrameGeometry& geometry, const DacrtOptions& options);
+// The memory one worker's packet buffers take (0 without packets), and the frame's flags.
+void planPacketBuffers(const FrameGeometry& geometry, const DacrtOptions& options, std::uint64_t scratchIds,
+                       unsigned workers, MemoryPlan& plan);
+
+// Owns what planPacketBuffers planned.
+struct PacketStorage {
+    std::vector<std::uint32_t> packetRays, flushRays, packetIds, tileCounts;
+    std::vector<RayPacket> packets;
+    std::vector<std::uint8_t> rayDone;
+    std::uint64_t scratchIds = 0, tiles = 0;
+    PacketStorage(const FrameGeometry& geometry, const DacrtOptions& options, std::uint64_t scratchIds, unsigned workers);
+    PacketBuffers forWorker(unsigned worker);
+};
+
 // The arrays a traversal permutes and updates. The last two serve the SIMD path of the
 // default options (without them the scalar path runs): scratch holds partitionScratchIds of
 // the ranges traced, filterRays one entry per ray (simd::fillFilterRays).
@@ -34,6 +80,7 @@ struct TraversalBuffers {
     std::uint32_t* triIds = nullptr;
     std::uint32_t* scratch = nullptr;
     simd::FilterRay* filterRays = nullptr;
+    PacketBuffers packets;  // used when usesPackets()
 };
 
 class DacrtTraversal {
@@ -55,6 +102,14 @@ private:
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd);
     std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);
+    void tracePackets(const Box& box, std::uint32_t& terminated, std::uint32_t crossing, std::uint32_t triBegin,
+                      std::uint32_t triEnd);
+    std::uint32_t buildPackets(std::uint32_t begin, std::uint32_t end);
+    void nodePackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,
+                     std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
+    std::uint32_t filterPackets(const Box& cell, std::uint32_t begin, std::uint32_t end);
+    void flushPackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,
+                      std::uint32_t triEnd, std::uint32_t depth);
     void leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
                   std::uint32_t triEnd);
     void endRaysHitInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd);
@@ -82,7 +137,11 @@ private:
     std::uint32_t* scratch_;
     simd::FilterRay* filterRays_;
     bool raysShareStart_;
-    bool simd_;  // the default options (bounds filter, watertight float32 test) on SIMD kernels
+    bool simd_;
+    bool packets_;
+    PacketBuffers packet_;
+    std::uint32_t imageWidth_;
+    std::uint32_t tiles_;  // the default options (bounds filter, watertight float32 test) on SIMD kernels
     simd::LeafTriangles batch_;
     Counters& counters_;
 };

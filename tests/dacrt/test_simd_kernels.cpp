@@ -258,6 +258,44 @@ TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
     });
 }
 
+// A packet's answer covers every one of its rays' answers (with no best hit yet), and it
+// still rejects: rays sharing a start, directions within a small cone, random cells.
+TEST(PacketFilter, NeverRejectsACellOneOfItsRaysMayCross) {
+    Random rng(15);
+    std::size_t rejected = 0, trials = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        const glm::vec3 origin{adversarialCoordinate(rng), adversarialCoordinate(rng), adversarialCoordinate(rng)};
+        const float tmin = rng.uniform() < 0.3 ? rng.uniformFloat(0.0f, 1.0f) : 0.0f;
+        const glm::dvec3 axis = rng.onSphere();
+        const double spread = rng.uniform() < 0.5 ? 0.05 : 0.5;
+        std::vector<Ray> rays(1 + rng.index(64));
+        for (Ray& r : rays) {
+            glm::dvec3 d = axis + spread * rng.onSphere();
+            for (int a = 0; a < 3; ++a)
+                if (rng.uniform() < 0.05) d[a] = 0.0;  // a component exactly 0: that axis goes unbounded
+            if (d == glm::dvec3(0.0)) d = axis;
+            r = makeRay(origin, d, tmin);
+        }
+        RayPacket p;
+        p.invLo = glm::vec3(kNoHitT);
+        p.invHi = glm::vec3(-kNoHitT);
+        for (const Ray& r : rays)
+            for (int a = 0; a < 3; ++a) {
+                if (r.invDir[a] == 0.0f) p.unboundedAxes |= 1u << a;
+                p.invLo[a] = std::min(p.invLo[a], r.invDir[a]);
+                p.invHi[a] = std::max(p.invHi[a], r.invDir[a]);
+            }
+        const Box cell = randomCell(rng);
+        bool anyRay = false;
+        for (const Ray& r : rays) anyRay |= shared::rayMayCrossCell(r, cell.lo, cell.hi, kNoHitT);
+        const bool packet = packetMayCrossCell(p, origin, tmin, cell);
+        if (anyRay) ASSERT_TRUE(packet) << "trial " << trial;
+        rejected += !packet;
+        ++trials;
+    }
+    EXPECT_GT(rejected, trials / 5) << "the packet test must reject cells, not only keep them";
+}
+
 TEST(SimdTargets, TheBestIsChosenByDefaultAndForcingAnUnknownOneIsAnError) {
     simd::forceTarget("");
     const std::vector<std::string> targets = simd::availableTargets();

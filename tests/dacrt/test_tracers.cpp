@@ -3,6 +3,7 @@
 
 #include "core/gltf_loader.hpp"
 #include "core/procedural.hpp"
+#include "dacrt/traversal.hpp"
 #include "support/frames.hpp"
 
 using namespace dacrt;
@@ -18,6 +19,15 @@ void expectAllBackendsAgree(const Frame& frame, std::initializer_list<unsigned> 
     const TraceResult reference = frame.trace(Backend::Brute, 0, 2);
     ASSERT_GT(hitCount(reference.hits), frame.rays.size() / 20) << "the view should show the scene";
     EXPECT_TRUE(identicalHits(reference.hits, frame.trace(Backend::CpuSeq).hits)) << "cpu-seq";
+    DacrtOptions noPackets, packetsToTheLeaves;
+    noPackets.packets = false;
+    packetsToTheLeaves.packetFlush = 1;  // packets never flushed early: the packet filter everywhere
+    EXPECT_TRUE(identicalHits(reference.hits, frame.trace(Backend::CpuSeq, 0, 1, axis, noPackets).hits))
+        << "cpu-seq without packets";
+    EXPECT_TRUE(identicalHits(reference.hits, frame.trace(Backend::CpuSeq, 0, 1, axis, packetsToTheLeaves).hits))
+        << "cpu-seq with packets down to the leaves";
+    EXPECT_TRUE(identicalHits(reference.hits, frame.trace(Backend::Cpu, 2, 2, axis, packetsToTheLeaves).hits))
+        << "cpu with packets down to the leaves";
     for (unsigned regions : regionCounts)
         for (unsigned threads : {1u, 2u})
             EXPECT_TRUE(identicalHits(reference.hits, frame.trace(Backend::Cpu, regions, threads, axis).hits))
@@ -142,6 +152,32 @@ TEST(BackendsAgree, StanfordBunnySmall) {
     const Camera cam = defaultCamera(s, 64, 48);
     const Frame frame(std::move(s), cam, 64, 48);
     expectAllBackendsAgree(frame, {1, 2, 3, 4, 8});
+}
+
+// Packets filter the top of the recursion: fewer ray tests, the same hits.
+TEST(Packets, TakeOverTheTopOfTheRecursionWithTheSameHits) {
+    const Scene s = test::shapesScene();
+    const Frame frame(test::shapesScene(), defaultCamera(s, 160, 120), 160, 120);
+    DacrtOptions off;
+    off.packets = false;
+    const TraceResult without = frame.trace(Backend::CpuSeq, 0, 1, DivisionAxis::Best, off);
+    const TraceResult with = frame.trace(Backend::CpuSeq);
+    EXPECT_TRUE(identicalHits(without.hits, with.hits));
+    EXPECT_EQ(without.counters.packetBoxTests, 0u);
+    EXPECT_GT(with.counters.packetBoxTests, 0u);
+    EXPECT_LT(with.counters.rayBoxTests, without.counters.rayBoxTests);
+    bool planned = false;
+    for (const auto& [name, bytes] : with.memory.buffers) planned |= name == "ray finished flags" && bytes == frame.rays.size();
+    EXPECT_TRUE(planned) << "the packet buffers are in the memory plan";
+}
+
+TEST(Packets, NeedAnImageAndASharedStart) {
+    const Scene s = test::shapesScene();
+    Frame frame(test::shapesScene(), defaultCamera(s, 32, 24), 32, 24);
+    EXPECT_GT(packetTiles(frame.geometry), 0u);
+    frame.geometry.imageWidth = 0;  // rays that are not an image's pixels
+    EXPECT_EQ(packetTiles(frame.geometry), 0u);
+    EXPECT_EQ(frame.trace(Backend::CpuSeq).counters.packetBoxTests, 0u);
 }
 
 TEST(ParallelScheme, CountersAndPlanAreConsistent) {

@@ -29,8 +29,9 @@ struct Frame {
     Frame(const Frame&) = delete;
 
     TraceResult trace(Backend backend, unsigned regions = 0, unsigned threads = 1,
-                      DivisionAxis axis = DivisionAxis::Best) const {
+                      DivisionAxis axis = DivisionAxis::Best, const DacrtOptions& dacrt = {}) const {
         TraceOptions o;
+        o.dacrt = dacrt;
         o.backend = backend;
         o.regions = regions;
         o.threads = threads;
@@ -43,7 +44,7 @@ private:
     void prepare(const Camera& camera) {
         bounds = allTriangleBounds(scene.triangles);
         rays = primaryRays(camera, width, height);
-        geometry = frameGeometry(scene.triangles, bounds, rays, sceneBounds(scene.triangles));
+        geometry = frameGeometry(scene.triangles, bounds, rays, sceneBounds(scene.triangles), std::uint32_t(width));
     }
 };
 

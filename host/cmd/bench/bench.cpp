@@ -142,7 +142,7 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
     std::vector<Bounds>& bounds = buffers.bounds;
     Box box;
     if (!peer) triangleBoundsInParallel(scene.triangles, pool, bounds, box);
-    const FrameGeometry g = frameGeometry(scene.triangles, bounds, rays, box);
+    const FrameGeometry g = frameGeometry(scene.triangles, bounds, rays, box, std::uint32_t(width));
     const double prepareMs = msSince(start);
     const auto traceStart = Clock::now();
     if (persistentRayQuery) {

@@ -85,11 +85,23 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         variant("split=centroid-mean", [](BenchConfig& c) { c.request.trace.dacrt.split = SplitMethod::CentroidMean; });
         variant("split=sampled-mean", [](BenchConfig& c) { c.request.trace.dacrt.split = SplitMethod::SampledMean; });
     }
-    const std::uint32_t defaultLimit = base.request.trace.dacrt.resolvedFor(b).rayLimit;
-    const std::vector<std::uint32_t> limits = cpu ? std::vector<std::uint32_t>{4, 8, 16, 32, 64} : std::vector<std::uint32_t>{8, 16, 32, 64, 128};
-    for (std::uint32_t l : limits)
-        if (l != defaultLimit)
-            variant("leaf-limits=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = c.request.trace.dacrt.triLimit = l; });
+    const DacrtOptions defaults = base.request.trace.dacrt.resolvedFor(b);
+    if (cpu) {
+        variant("packets=off", [](BenchConfig& c) { c.request.trace.dacrt.packets = false; });
+        for (std::uint32_t f : {4u, 64u, 256u})
+            if (f != defaults.packetFlush)
+                variant("packet-flush=" + std::to_string(f), [f](BenchConfig& c) { c.request.trace.dacrt.packetFlush = f; });
+        for (std::uint32_t l : {4u, 16u, 32u})
+            if (l != defaults.rayLimit)
+                variant("ray-limit=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = l; });
+        for (std::uint32_t l : {8u, 16u, 64u})
+            if (l != defaults.triLimit)
+                variant("tri-limit=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.triLimit = l; });
+    } else {
+        for (std::uint32_t l : {8u, 16u, 32u, 64u, 128u})
+            if (l != defaults.rayLimit)
+                variant("leaf-limits=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = c.request.trace.dacrt.triLimit = l; });
+    }
     if (b == Backend::CpuSeq) return out;
     const unsigned defaultRegions = b == Backend::Cpu ? hardwareThreads : gpuDefaultRegions;
     for (unsigned r : {1u, 2u, 4u, 8u, 16u, 64u})
