@@ -60,7 +60,6 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     result.memory.add("triangle ids", std::uint64_t(triCount) * 4);
     const std::uint64_t scratchIds = partitionScratchIds(rayCount, triCount);
     result.memory.add("partition scratch", scratchIds * 4);
-    result.memory.add("filter rays", std::uint64_t(rayCount) * sizeof(simd::FilterRay));
     const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
     planPacketBuffers(g, resolved, scratchIds, 1, result.memory);
     if (onPlan && !onPlan(result.memory)) return result;
@@ -70,12 +69,10 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     std::iota(rayIds.begin(), rayIds.end(), 0u);
     std::iota(triIds.begin(), triIds.end(), 0u);
     std::vector<std::uint32_t> scratch(scratchIds);
-    std::vector<simd::FilterRay> filterRays(rayCount);
-    simd::fillFilterRays(g.rays->data(), result.hits.data(), rayCount, filterRays.data());
     PacketStorage packets(g, resolved, scratchIds, 1);
     DacrtTraversal traversal(
         g, options,
-        {result.hits.data(), rayIds.data(), triIds.data(), scratch.data(), filterRays.data(), packets.forWorker(0)},
+        {result.hits.data(), rayIds.data(), triIds.data(), scratch.data(), packets.forWorker(0)},
         result.counters);
     std::uint32_t terminated = 0;
     const std::uint32_t crossing = traversal.trace(g.sceneBox, terminated, rayCount, 0, triCount);
@@ -91,7 +88,6 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     const unsigned regions = options.regions ? options.regions : pool.size();
     result.regions = regions;
     planFrameInputs(g, result.memory);
-    result.memory.add("filter rays", std::uint64_t(g.rays->size()) * sizeof(simd::FilterRay));
 
     auto start = Clock::now();
     const int axis = options.axis == DivisionAxis::Best ? chooseDivisionAxis(g, regions) : int(options.axis) - 1;
@@ -106,12 +102,6 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     Division division = divideScene(g, regions, axis, pool, result.memory, onPlan, planWorkers);
     if (!division.complete) return result;
     result.hits.assign(g.rays->size(), missHit());
-    std::vector<simd::FilterRay> filterRays(g.rays->size());
-    constexpr std::size_t kFillChunk = 65536;
-    pool.parallelFor((g.rays->size() + kFillChunk - 1) / kFillChunk, [&](std::size_t c, unsigned) {
-        const std::size_t begin = c * kFillChunk, count = std::min(g.rays->size() - begin, kFillChunk);
-        simd::fillFilterRays(g.rays->data() + begin, result.hits.data() + begin, count, filterRays.data() + begin);
-    });
     const std::vector<TransferRound> schedule = transferSchedule(division);
     result.phaseMs.emplace_back("divide", msSince(start));
     result.counters.raysCulled = division.culledRays;
@@ -127,7 +117,7 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
         const Region& tris = table[triRegion];
         DacrtTraversal traversal(g, options.dacrt,
                                  {result.hits.data(), division.rayIds.data(), division.triIds.data(),
-                                  scratch.data() + worker * scratchIds, filterRays.data(), packets.forWorker(worker)},
+                                  scratch.data() + worker * scratchIds, packets.forWorker(worker)},
                                  perWorker[worker]);
         const RetireRule retire{axis, triRegion == rayRegion ? 0 : (triRegion > rayRegion ? 1 : -1)};
         traversal.trace(regionBox(tris), rays.terminated, rays.rayEnd, tris.triBegin, tris.triEnd, retire);

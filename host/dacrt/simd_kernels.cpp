@@ -124,11 +124,11 @@ HWY_INLINE void slabInterval(VF origin, VF invDir, float lo, float hi, VF& tNear
 }
 
 template <bool kSharedStart>
-HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const FilterRay* filter, std::uint32_t* ids,
-                                       std::uint32_t count, const Box& cell, std::uint32_t* scratch) {
-    static_assert(sizeof(Ray) == 16 * sizeof(float));
+HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
+                                       const Box& cell, std::uint32_t* scratch) {
+    static_assert(sizeof(Ray) == 16 * sizeof(float) && sizeof(Hit) == 4 * sizeof(float));
     const float* ray = reinterpret_cast<const float*>(rays);
-    const float* packed = reinterpret_cast<const float*>(filter);
+    const float* hit = reinterpret_cast<const float*>(hits);
     const DF df;
     const DI di;
     const DU du;
@@ -139,30 +139,27 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const FilterRay* filter,
     const VF sharedTmin = hn::Set(df, rays[0].tmin);
     return stablePartition(ids, count, scratch, [&](VU id) {
         const auto index = hn::BitCast(di, id);
-        const auto base = hn::ShiftLeft<4>(index), packedBase = hn::ShiftLeft<2>(index);
+        const auto base = hn::ShiftLeft<4>(index);
         auto field = [&](int offset) { return hn::GatherIndex(df, ray, hn::Add(base, hn::Set(di, offset))); };
-        auto packedField = [&](int offset) {
-            return hn::GatherIndex(df, packed, hn::Add(packedBase, hn::Set(di, offset)));
-        };
-        // shared::rayMayCrossCell: origin at floats 0-2 of a Ray, tmin at 3; invDir and the
-        // best t so far from the FilterRay.
+        // shared::rayMayCrossCell: origin at floats 0-2 of a Ray, tmin at 3, invDir at 8-10;
+        // the best t so far is float 0 of the Hit. The leaf then finds both lines in cache.
         VF xn, xf, yn, yf, zn, zf;
-        slabInterval(kSharedStart ? sharedOrigin[0] : field(0), packedField(0), cell.lo.x, cell.hi.x, xn, xf);
-        slabInterval(kSharedStart ? sharedOrigin[1] : field(1), packedField(1), cell.lo.y, cell.hi.y, yn, yf);
-        slabInterval(kSharedStart ? sharedOrigin[2] : field(2), packedField(2), cell.lo.z, cell.hi.z, zn, zf);
+        slabInterval(kSharedStart ? sharedOrigin[0] : field(0), field(8), cell.lo.x, cell.hi.x, xn, xf);
+        slabInterval(kSharedStart ? sharedOrigin[1] : field(1), field(9), cell.lo.y, cell.hi.y, yn, yf);
+        slabInterval(kSharedStart ? sharedOrigin[2] : field(2), field(10), cell.lo.z, cell.hi.z, zn, zf);
         const VF tNear = maxLike(xn, maxLike(yn, zn));
         const VF tFar = minLike(xf, minLike(yf, zf));
         const VF tmin = kSharedStart ? sharedTmin : field(3);
-        const VF tmax = packedField(3);
+        const VF tmax = hn::GatherIndex(df, hit, hn::ShiftLeft<2>(index));
         const MF m = hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
         return hn::RebindMask(du, m);
     });
 }
 
-std::uint32_t PartitionRays(const Ray* rays, const FilterRay* filter, std::uint32_t* ids, std::uint32_t count,
+std::uint32_t PartitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
                             const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
-    return raysShareStart ? partitionRays<true>(rays, filter, ids, count, cell, scratch)
-                          : partitionRays<false>(rays, filter, ids, count, cell, scratch);
+    return raysShareStart ? partitionRays<true>(rays, hits, ids, count, cell, scratch)
+                          : partitionRays<false>(rays, hits, ids, count, cell, scratch);
 }
 
 std::uint32_t PartitionTriangles(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, const Box& cell,
@@ -230,8 +227,8 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 
 // shared::intersectWatertight for one ray and hn::Lanes triangles; the tie rule then runs
 // per hit lane in scalar code.
-void IntersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::uint32_t* rayIds,
-                    std::uint32_t rayCount, const LeafTriangles& batch) {
+void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                    const LeafTriangles& batch) {
     const DF df;
     const DU du;
     const std::size_t n = hn::Lanes(df);
@@ -302,7 +299,6 @@ void IntersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::ui
             }
         }
         hits[rayId] = best;
-        filter[rayId].tmax = best.t;
     }
 }
 
@@ -322,14 +318,9 @@ HWY_EXPORT(IntersectBatch);
 HWY_EXPORT(GatherLeafTriangles);
 HWY_EXPORT(CompiledTarget);
 
-void fillFilterRays(const Ray* rays, const Hit* hits, std::size_t count, FilterRay* filter) {
-    for (std::size_t i = 0; i < count; ++i) filter[i] = FilterRay{rays[i].invDir, hits[i].t};
-}
-
-std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const FilterRay* filter, std::uint32_t* ids,
-                                        std::uint32_t count, const Box& cell, bool raysShareStart,
-                                        std::uint32_t* scratch) {
-    return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, filter, ids, count, cell, raysShareStart, scratch);
+std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
+                                        const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
+    return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, hits, ids, count, cell, raysShareStart, scratch);
 }
 
 std::uint32_t partitionTrianglesOverlapCell(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
@@ -347,9 +338,9 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     HWY_DYNAMIC_DISPATCH(GatherLeafTriangles)(triangles, triIds, count, batch);
 }
 
-void intersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::uint32_t* rayIds,
-                    std::uint32_t rayCount, const LeafTriangles& batch) {
-    HWY_DYNAMIC_DISPATCH(IntersectBatch)(rays, hits, filter, rayIds, rayCount, batch);
+void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                    const LeafTriangles& batch) {
+    HWY_DYNAMIC_DISPATCH(IntersectBatch)(rays, hits, rayIds, rayCount, batch);
 }
 
 std::string activeTarget() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CompiledTarget)()); }

@@ -24,24 +24,13 @@ constexpr std::uint64_t kMaxTriangles = (std::uint64_t(1) << 31) / 16;
 // Room past the ids a partition may park in scratch, for whole-vector stores.
 constexpr std::uint32_t kScratchSlack = 64;
 
-// What the ray filter reads of ray id besides its start, 16 bytes where Ray and Hit take 80:
-// a node's rays then share cache lines. tmax is the ray's best hit t so far; intersectBatch
-// keeps it equal to hits[id].t.
-struct FilterRay {
-    glm::vec3 invDir;
-    float tmax;
-};
-static_assert(sizeof(FilterRay) == 16);
-void fillFilterRays(const Ray* rays, const Hit* hits, std::size_t count, FilterRay* filter);
-
 // Stable partitions of ids[0, count): the ids whose ray may cross the (already widened) cell
-// before its best hit so far (shared::rayMayCrossCell with filter[id]), or whose triangle
+// before its best hit so far (shared::rayMayCrossCell with hits[id].t), or whose triangle
 // bounds overlap the cell (shared::boundsOverlap), first, in their order; the others after
 // them, in theirs. Returns how many pass. scratch holds count + kScratchSlack ids. raysShareStart: every
 // ray has rays[0]'s origin and tmin bit for bit (raysShareStart() in frame_geometry.hpp).
-std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const FilterRay* filter, std::uint32_t* ids,
-                                        std::uint32_t count, const Box& cell, bool raysShareStart,
-                                        std::uint32_t* scratch);
+std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
+                                        const Box& cell, bool raysShareStart, std::uint32_t* scratch);
 std::uint32_t partitionTrianglesOverlapCell(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
                                             const Box& cell, std::uint32_t* scratch);
 
@@ -68,9 +57,9 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 // The watertight test of each ray rays[rayIds[r]], r < rayCount, against every triangle of
 // batch; its hit becomes the first under the tie rule (smaller t, then smaller id) of the
 // hit it had and the batch's hits with t > tmin: what testTriangle over the batch gives, in
-// any order, since the rule is a total order on distinct ids. filter[id].tmax follows.
-void intersectBatch(const Ray* rays, Hit* hits, FilterRay* filter, const std::uint32_t* rayIds,
-                    std::uint32_t rayCount, const LeafTriangles& batch);
+// any order, since the rule is a total order on distinct ids.
+void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                    const LeafTriangles& batch);
 
 // The instruction set the kernels run on now ("AVX3" is AVX-512), and every one this
 // binary holds that the machine supports, best first.

@@ -74,9 +74,8 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       rayIds_(buffers.rayIds),
       triIds_(buffers.triIds),
       scratch_(buffers.scratch),
-      filterRays_(buffers.filterRays),
       raysShareStart_(g.raysShareStart),
-      simd_(scratch_ && filterRays_ && options_.exactDefaults() && g.rays->size() <= simd::kMaxRays &&
+      simd_(scratch_ && options_.exactDefaults() && g.rays->size() <= simd::kMaxRays &&
             g.triangles->size() <= simd::kMaxTriangles),
       packets_(simd_ && buffers.packets.packetRays && usesPackets(g, options_)),
       packet_(buffers.packets),
@@ -111,7 +110,7 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
 
 [[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
     counters_.rayBoxTests += end - begin;
-    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, filterRays_, rayIds_ + begin, end - begin, cell, raysShareStart_,
+    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, hits_, rayIds_ + begin, end - begin, cell, raysShareStart_,
                                                             scratch_);
     std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
         return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
@@ -221,7 +220,7 @@ std::uint32_t DacrtTraversal::buildPackets(std::uint32_t begin, std::uint32_t en
         p.invHi = glm::vec3(-kNoHitT);
         p.unboundedAxes = 0;
         for (std::uint32_t k = p.begin; k < p.end; ++k) {
-            const glm::vec3& inv = filterRays_[packet_.packetRays[k]].invDir;
+            const glm::vec3& inv = rays_[packet_.packetRays[k]].invDir;
             for (int a = 0; a < 3; ++a) {
                 if (inv[a] == 0.0f) p.unboundedAxes |= 1u << a;
                 p.invLo[a] = std::min(p.invLo[a], inv[a]);
@@ -342,7 +341,7 @@ void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::ui
                               std::uint32_t triBegin, std::uint32_t triEnd) {
     for (std::uint32_t j = triBegin; j < triEnd; j += simd::kLeafBatch) {
         simd::gatherLeafTriangles(triangles_, triIds_ + j, std::min(triEnd - j, simd::kLeafBatch), batch_);
-        simd::intersectBatch(rays_, hits_, filterRays_, rayIds_ + terminated, rayEnd - terminated, batch_);
+        simd::intersectBatch(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_);
     }
     endRaysHitInBox(box, terminated, rayEnd);
 }

@@ -72,14 +72,13 @@ struct PacketStorage {
 };
 
 // The arrays a traversal permutes and updates. The last two serve the SIMD path of the
-// default options (without them the scalar path runs): scratch holds partitionScratchIds of
-// the ranges traced, filterRays one entry per ray (simd::fillFilterRays).
+// default options (without scratch the scalar path runs): scratch holds partitionScratchIds
+// of the ranges traced.
 struct TraversalBuffers {
     Hit* hits = nullptr;
     std::uint32_t* rayIds = nullptr;
     std::uint32_t* triIds = nullptr;
     std::uint32_t* scratch = nullptr;
-    simd::FilterRay* filterRays = nullptr;
     PacketBuffers packets;  // used when usesPackets()
 };
 
@@ -135,7 +134,6 @@ private:
     std::uint32_t* rayIds_;
     std::uint32_t* triIds_;
     std::uint32_t* scratch_;
-    simd::FilterRay* filterRays_;
     bool raysShareStart_;
     bool simd_;
     bool packets_;

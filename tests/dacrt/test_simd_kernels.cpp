@@ -110,10 +110,8 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
                 return shared::rayMayCrossCell(rays[id], cell.lo, cell.hi, hits[id].t);
             });
             std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
-            std::vector<simd::FilterRay> filter(rays.size());
-            simd::fillFilterRays(rays.data(), hits.data(), rays.size(), filter.data());
-            const std::uint32_t kept = simd::partitionRaysMayCrossCell(rays.data(), filter.data(), ids.data(), count,
-                                                                       cell, shareStart, scratch.data());
+            const std::uint32_t kept = simd::partitionRaysMayCrossCell(rays.data(), hits.data(), ids.data(), count, cell,
+                                                                       shareStart, scratch.data());
             ASSERT_EQ(kept, expectedKept) << "trial " << trial;
             ASSERT_EQ(ids, expected) << "trial " << trial;
             keptTotal += kept;
@@ -237,9 +235,7 @@ TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
                 for (std::uint32_t prim : triIds) testTriangle(rays[id], tris[prim], prim, expected[id]);
             simd::LeafTriangles batch;
             simd::gatherLeafTriangles(tris.data(), triIds.data(), std::uint32_t(triIds.size()), batch);
-            std::vector<simd::FilterRay> filter(rays.size());
-            simd::fillFilterRays(rays.data(), got.data(), rays.size(), filter.data());
-            simd::intersectBatch(rays.data(), got.data(), filter.data(), rayIds.data(), std::uint32_t(rayIds.size()), batch);
+            simd::intersectBatch(rays.data(), got.data(), rayIds.data(), std::uint32_t(rayIds.size()), batch);
             for (std::size_t i = 0; i < rays.size(); ++i) {
                 if (expected[i].prim != kMissPrim && expected[i].prim != 7) ++hitsFound;
                 for (std::uint32_t prim : triIds)
@@ -247,7 +243,6 @@ TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
                         std::memcmp(&tris[prim], &tris[expected[i].prim], sizeof(Triangle)) == 0)
                         ++tiesOnDuplicates;
             }
-            for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(filter[i].tmax, got[i].t) << "the filter's t follows";
             for (std::size_t i = 0; i < rays.size(); ++i)
                 ASSERT_TRUE(sameHit(got[i], expected[i]))
                     << "trial " << trial << " ray " << i << ": simd prim " << got[i].prim << " t " << got[i].t
