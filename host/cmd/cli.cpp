@@ -94,7 +94,8 @@ void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     const std::string gpu = ", " + std::to_string(kGpuLeafLimit) + " on gpu";
     cmd->add_option("--ray-limit", o.rayLimit, "leaf when fewer live rays (cpu-seq, cpu, gpu)")
         ->check(CLI::Range(1u, 1u << 30))
-        ->default_str(std::to_string(kCpuLeafLimit) + " on the cpu backends" + gpu);
+        ->default_str(std::to_string(kCpuSimdRayLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +
+                      " with a non-default intersector, filter or precision)" + gpu);
     cmd->add_option("--tri-limit", o.triLimit, "leaf when fewer triangles (cpu-seq, cpu, gpu)")
         ->check(CLI::Range(1u, 1u << 30))
         ->default_str(std::to_string(kCpuSimdTriangleLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +

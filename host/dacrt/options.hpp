@@ -62,11 +62,13 @@ struct EnumNames<Precision> {
 
 // Leaf limits of each backend when DacrtOptions leaves them 0, chosen by measurement
 // (docs/benchmarks.md): a leaf costs the CPU one test per pair, and the SIMD leaf of the
-// default options tests a vector of triangles at once, so it takes more triangles before a
-// split pays; on lavapipe a partition costs several times a leaf's test per element
-// (docs/gpu.md), so the gpu stops splitting earlier still.
+// default options tests a vector of triangles at once, so it takes more triangles (and,
+// with packets above it, more rays) before a split pays; on lavapipe a partition costs
+// several times a leaf's test per element (docs/gpu.md), so the gpu stops splitting
+// earlier still.
 constexpr std::uint32_t kCpuLeafLimit = 8;
-constexpr std::uint32_t kCpuSimdTriangleLimit = 32;
+constexpr std::uint32_t kCpuSimdRayLimit = 16;
+constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 constexpr std::uint32_t kPacketFlushDefault = 16;
 
@@ -87,8 +89,9 @@ struct DacrtOptions {
     DacrtOptions resolvedFor(Backend backend) const {
         DacrtOptions o = *this;
         const std::uint32_t limit = backend == Backend::Gpu ? kGpuLeafLimit : kCpuLeafLimit;
-        if (o.rayLimit == 0) o.rayLimit = limit;
-        if (o.triLimit == 0) o.triLimit = backend != Backend::Gpu && exactDefaults() ? kCpuSimdTriangleLimit : limit;
+        const bool simd = backend != Backend::Gpu && exactDefaults();
+        if (o.rayLimit == 0) o.rayLimit = simd ? kCpuSimdRayLimit : limit;
+        if (o.triLimit == 0) o.triLimit = simd ? kCpuSimdTriangleLimit : limit;
         if (o.packetFlush == 0) o.packetFlush = kPacketFlushDefault;
         return o;
     }

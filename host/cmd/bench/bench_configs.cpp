@@ -91,10 +91,10 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         for (std::uint32_t f : {4u, 64u, 256u})
             if (f != defaults.packetFlush)
                 variant("packet-flush=" + std::to_string(f), [f](BenchConfig& c) { c.request.trace.dacrt.packetFlush = f; });
-        for (std::uint32_t l : {4u, 16u, 32u})
+        for (std::uint32_t l : {4u, 8u, 16u, 32u, 64u})
             if (l != defaults.rayLimit)
                 variant("ray-limit=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = l; });
-        for (std::uint32_t l : {8u, 16u, 64u})
+        for (std::uint32_t l : {8u, 16u, 32u, 64u, 128u})
             if (l != defaults.triLimit)
                 variant("tri-limit=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.triLimit = l; });
     } else {
