@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -144,6 +145,34 @@ TEST(Cli, DevicesListsTheLimitsThatMatter) {
     for (const char* key : {"0: ", "driver:", "Vulkan:", "memory heaps:", "max storage buffer range:", "max allocation size:",
                             "compute shared memory:", "workgroup:", "subgroup size:"})
         EXPECT_NE(r.output.find(key), std::string::npos) << key << "\n" << r.output;
+}
+
+// Every instruction set this binary can run here renders the same image (the kernels' tests
+// compare them one kernel at a time; this is the whole frame, packets included); an unknown
+// one is refused before anything runs.
+TEST(Cli, EverySimdTargetRendersTheSameRoomAndAnUnknownOneIsRefused) {
+    const std::string scene = dacrt::test::fixture("../../scenes/room.glb");
+    const CommandResult devices = run("devices");
+    const std::size_t at = devices.output.find("this binary can run:");
+    ASSERT_NE(at, std::string::npos) << devices.output;
+    std::istringstream names(devices.output.substr(at + 20, devices.output.find(';', at) - at - 20));
+    const std::string reference = temp("simd_best.exr");
+    ASSERT_EQ(run("render " + scene + " --size 96x72 --aov " + reference).code, 0);
+    int targets = 0;
+    for (std::string name; names >> name; ++targets) {
+        const std::string aov = temp("simd_" + name + ".exr");
+        const CommandResult r = dacrt::test::runDacrt("render " + scene + " --size 96x72 --aov " + aov, "DACRT_SIMD_TARGET=" + name);
+        ASSERT_EQ(r.code, 0) << name << ": " << r.output;
+        const CommandResult same = run("compare " + reference + " " + aov + " --fail-on any");
+        EXPECT_EQ(same.code, 0) << name << ": " << same.output;
+    }
+    EXPECT_GE(targets, 2) << devices.output;
+    const std::string out = temp("simd_unknown.png");
+    std::filesystem::remove(out);
+    const CommandResult r = dacrt::test::runDacrt("render " + scene + " -o " + out, "DACRT_SIMD_TARGET=AVX9");
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("DACRT_SIMD_TARGET=AVX9 is not an instruction set"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 TEST(Cli, GpuRenderUnderValidationMatchesCpuSeq) {

@@ -81,7 +81,7 @@ void traceFrame(const Scene& scene) {
         if (verbose()) std::fprintf(stderr, "  camera refused: %s\n", e.what());
         return;  // a camera the scene cannot be seen from: refused, as the command line does
     }
-    const FrameGeometry geometry = frameGeometry(scene.triangles, bounds, rays, box);
+    const FrameGeometry geometry = frameGeometry(scene.triangles, bounds, rays, box, kWidth);
 
     TraceOptions brute;
     brute.backend = Backend::Brute;
@@ -91,10 +91,17 @@ void traceFrame(const Scene& scene) {
     parallel.backend = Backend::Cpu;
     parallel.threads = 1;
     parallel.regions = 4;
+    TraceOptions seqScalar = seq;  // the scalar filters and leaves (a non-default test) and no packets
+    seqScalar.dacrt.triangleFilter = TriangleFilter::Sat;
+    TraceOptions seqPacketsToLeaves = seq;
+    seqPacketsToLeaves.dacrt.packetFlush = 1;
 
     const TraceResult reference = traceCpu(geometry, brute, pool());
     compare("cpu-seq and brute", traceCpu(geometry, seq, pool()).hits, reference.hits);
     compare("cpu (4 regions) and brute", traceCpu(geometry, parallel, pool()).hits, reference.hits);
+    compare("cpu-seq (SAT filter, scalar) and brute", traceCpu(geometry, seqScalar, pool()).hits, reference.hits);
+    compare("cpu-seq (packets to the leaves) and brute", traceCpu(geometry, seqPacketsToLeaves, pool()).hits,
+            reference.hits);
     if (verbose()) {
         std::size_t hits = 0;
         for (const Hit& h : reference.hits) hits += h.prim != kMissPrim;

@@ -13,8 +13,10 @@ struct CommandResult {
     std::string output;  // stdout and stderr together
 };
 
-inline CommandResult runDacrt(const std::string& args) {
-    const std::string command = std::string(DACRT_BINARY) + " " + args + " 2>&1";
+// environment: assignments put before the command, e.g. "DACRT_SIMD_TARGET=SCALAR".
+inline CommandResult runDacrt(const std::string& args, const std::string& environment = "") {
+    const std::string command = (environment.empty() ? "" : "env " + environment + " ") + std::string(DACRT_BINARY) +
+                                " " + args + " 2>&1";
     CommandResult r;
     FILE* pipe = popen(command.c_str(), "r");
     if (!pipe) return r;
