@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the current figures of docs/benchmarks.md (after `bash .ci/setup`; needs
 # ../shared/scenes): the peers on both lavapipes, the gpu defaults on Mesa 25.0.7 and the
-# source's Table 5.1. About 15 minutes on the 2-core VM (the Bunny's ray queries take 6 of
-# them). Then `python3 tools/bench/tables.py update docs/benchmarks.md` refreshes the tables.
+# source's Table 5.1, the cpu backends' options and SIMD targets. About 30 minutes on the
+# 2-core VM (the Bunny's ray queries take 6 of them, the cpu sweep 9). Then `python3 tools/bench/tables.py update docs/benchmarks.md` refreshes the tables.
 # The older option sweeps and Figure 5.3 there came from the sweep commands at the end
 # (about 40 minutes more), run only with ALL=1.
 set -euo pipefail
@@ -24,6 +24,14 @@ tools/mesa25.sh build/dacrt bench $S/bunny.glb $S/dragon.glb --backends gpu --or
   --csv $out/gpu_sweep_mesa25.csv --json $out/gpu_sweep_mesa25.json | tee $out/gpu_sweep_mesa25.txt
 "${mesa22[@]}" build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --orbit 4 --repeat 2 \
   --csv $out/table51.csv --json $out/table51.json | tee $out/table51.txt
+# The cpu backends' options, each from the defaults, and their defaults on every SIMD target
+# this binary can run here (DACRT_SIMD_TARGET).
+build/dacrt bench $S/bunny.glb $S/dragon.glb --backends cpu-seq,cpu --orbit 8 \
+  --csv $out/cpu_sweep.csv --json $out/cpu_sweep.json | tee $out/cpu_sweep.txt
+for target in $(build/dacrt devices | sed -n 's/.*this binary can run: *\([^;]*\);.*/\1/p'); do
+  DACRT_SIMD_TARGET=$target build/dacrt bench $S/bunny.glb $S/dragon.glb --suite peers --backends cpu-seq,cpu \
+    --orbit 8 --csv $out/simd_$target.csv --json $out/simd_$target.json | tee $out/simd_$target.txt
+done
 if [ "${ALL:-0}" = 1 ]; then
   "${mesa22[@]}" build/dacrt bench $S/bunny.glb --backends cpu-seq,cpu,gpu --orbit 8 \
     --csv $out/bunny_sweep.csv --json $out/bunny_sweep.json | tee $out/bunny_sweep.txt

@@ -111,16 +111,35 @@ def peers(paths, scene):
             if r is cpu:
                 against = "-"
             elif ratio < 1:
-                against = f"{1 / ratio:.1f}x slower"
+                against = f"{1 / ratio:.2f}x slower"
             else:
-                against = f"{ratio:.1f}x faster"
+                against = f"{ratio:.2f}x faster"
             where = "CPU" if r["series"].startswith(("cpu", "embree")) else driver
             print(f"| {r['series']} | {r['config']} | {where} | {r['frame_ms_min']:.1f} | "
                   f"{'-' if build is None else f'{build:.1f}'} | {'-' if trace is None else f'{trace:.1f}'} | "
                   f"{r['real_errors']} | {r['near_ties']} | {r['leaks']} ({r['real_leaks']}) | {against} |")
 
 
-KINDS = {"peers": peers, "sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
+def targets(paths):
+    """The cpu backends' default frame on each SIMD target, one bench JSON per target."""
+    print("| SIMD target | model | cpu-seq frame ms (min) | cpu frame ms (min) | cpu against the best target |")
+    print("|---|---|---:|---:|---:|")
+    runs = [json.load(open(p)) for p in paths.split(",")]
+    best = {}
+    for j in runs:
+        for r in j["rows"]:
+            if r["series"] == "cpu":
+                best[r["scene"]] = min(best.get(r["scene"], 1e300), r["frame_ms_min"])
+    for j in runs:
+        target = j["machine"].get("simd_target", "?")
+        rows = {(r["scene"], r["series"]): r for r in j["rows"] if r["default"]}
+        for scene in dict.fromkeys(r["scene"] for r in j["rows"]):
+            seq, cpu = rows[(scene, "cpu-seq")], rows[(scene, "cpu")]
+            print(f"| {target} | {scene} | {seq['frame_ms_min']:.1f} | {cpu['frame_ms_min']:.1f} | "
+                  f"{cpu['frame_ms_min'] / best[scene]:.2f}x |")
+
+
+KINDS = {"targets": targets, "peers": peers, "sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
 
 
 def update(doc):
