@@ -58,9 +58,9 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     planFrameInputs(g, result.memory);
     result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
     result.memory.add("triangle ids", std::uint64_t(triCount) * 4);
-    const std::uint64_t scratchIds = partitionScratchIds(rayCount, triCount);
-    result.memory.add("partition scratch", scratchIds * 4);
     const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
+    const std::uint64_t scratchIds = usesSimd(g, resolved) ? partitionScratchIds(rayCount, triCount) : 0;
+    if (scratchIds) result.memory.add("partition scratch", scratchIds * 4);
     planPacketBuffers(g, resolved, scratchIds, 1, result.memory);
     if (onPlan && !onPlan(result.memory)) return result;
 
@@ -72,7 +72,7 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     PacketStorage packets(g, resolved, scratchIds, 1);
     DacrtTraversal traversal(
         g, options,
-        {result.hits.data(), rayIds.data(), triIds.data(), scratch.data(), packets.forWorker(0)},
+        {result.hits.data(), rayIds.data(), triIds.data(), scratchIds ? scratch.data() : nullptr, packets.forWorker(0)},
         result.counters);
     std::uint32_t terminated = 0;
     const std::uint32_t crossing = traversal.trace(g.sceneBox, terminated, rayCount, 0, triCount);
@@ -95,6 +95,7 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     const DacrtOptions resolved = options.dacrt.resolvedFor(Backend::Cpu);
     std::uint64_t scratchIds = 0;
     auto planWorkers = [&](const Division& d, MemoryPlan& plan) {
+        if (!usesSimd(g, resolved)) return;
         scratchIds = partitionScratchIds(d.mostRegionRays, d.mostRegionTriangles);
         plan.add("partition scratch (per thread)", scratchIds * 4 * pool.size());
         planPacketBuffers(g, resolved, scratchIds, pool.size(), plan);
@@ -117,7 +118,8 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
         const Region& tris = table[triRegion];
         DacrtTraversal traversal(g, options.dacrt,
                                  {result.hits.data(), division.rayIds.data(), division.triIds.data(),
-                                  scratch.data() + worker * scratchIds, packets.forWorker(worker)},
+                                  scratchIds ? scratch.data() + worker * scratchIds : nullptr,
+                                  packets.forWorker(worker)},
                                  perWorker[worker]);
         const RetireRule retire{axis, triRegion == rayRegion ? 0 : (triRegion > rayRegion ? 1 : -1)};
         traversal.trace(regionBox(tris), rays.terminated, rays.rayEnd, tris.triBegin, tris.triEnd, retire);

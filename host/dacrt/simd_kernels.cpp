@@ -90,10 +90,12 @@ HWY_INLINE std::uint32_t stablePartition(std::uint32_t* ids, std::uint32_t count
         moved += n - passing;
     }
     if (i < count) {
-        // The tail through zeroed copies: no access past the range (a neighbour's, or the end
-        // of the array), and id 0 in the idle lanes is a valid gather.
-        alignas(64) std::uint32_t tail[64] = {}, pass[64], fail[64];
+        // The tail through local copies: no access past the range (a neighbour's, or the end
+        // of the array); the idle lanes repeat the range's first tail id, which this caller
+        // owns (another worker may be writing the hit of any other ray, id 0's included).
+        alignas(64) std::uint32_t tail[64], pass[64], fail[64];
         const std::size_t rest = count - i;
+        std::fill(tail, tail + 64, ids[i]);
         std::copy(ids + i, ids + count, tail);
         const VU v = hn::Load(du, tail);
         const auto valid = hn::FirstN(du, rest);
@@ -213,8 +215,10 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     const std::size_t n = hn::Lanes(du);
     batch.count = count;
     for (std::size_t j = 0; j < count; j += n) {
-        // Past count: id 0, a valid triangle whose lanes the tests never read as hits.
-        alignas(64) std::uint32_t ids[64] = {};
+        // Past count: the batch's first triangle again, whose extra lanes the tests never read
+        // as hits (FirstN).
+        alignas(64) std::uint32_t ids[64];
+        std::fill(ids, ids + 64, triIds[j]);
         std::copy(triIds + j, triIds + std::min<std::size_t>(count, j + n), ids);
         const VU id = hn::Load(du, ids);
         hn::Store(id, du, &batch.prim[j]);

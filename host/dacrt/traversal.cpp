@@ -28,8 +28,12 @@ std::uint64_t packetTiles(const FrameGeometry& g) {
     return ((g.imageWidth + kPacketTile - 1) / kPacketTile) * ((height + kPacketTile - 1) / kPacketTile);
 }
 
+bool usesSimd(const FrameGeometry& g, const DacrtOptions& options) {
+    return options.exactDefaults() && g.rays->size() <= simd::kMaxRays && g.triangles->size() <= simd::kMaxTriangles;
+}
+
 bool usesPackets(const FrameGeometry& g, const DacrtOptions& options) {
-    return options.packets && options.exactDefaults() && packetTiles(g) > 0;
+    return options.packets && usesSimd(g, options) && packetTiles(g) > 0;
 }
 
 void planPacketBuffers(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t scratchIds, unsigned workers,
@@ -37,7 +41,7 @@ void planPacketBuffers(const FrameGeometry& g, const DacrtOptions& options, std:
     if (!usesPackets(g, options)) return;
     const std::uint64_t tiles = packetTiles(g);
     plan.add("packet rays and flushed rays (per thread)", 2 * scratchIds * 4 * workers);
-    plan.add("packets (per thread)", tiles * (sizeof(RayPacket) + 8) * workers);
+    plan.add("packets (per thread)", (tiles * (sizeof(RayPacket) + 8) + 4) * workers);
     plan.add("ray finished flags", g.rays->size());
 }
 
@@ -75,8 +79,7 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       triIds_(buffers.triIds),
       scratch_(buffers.scratch),
       raysShareStart_(g.raysShareStart),
-      simd_(scratch_ && options_.exactDefaults() && g.rays->size() <= simd::kMaxRays &&
-            g.triangles->size() <= simd::kMaxTriangles),
+      simd_(scratch_ && usesSimd(g, options_)),
       packets_(simd_ && buffers.packets.packetRays && usesPackets(g, options_)),
       packet_(buffers.packets),
       imageWidth_(g.imageWidth),
@@ -266,7 +269,7 @@ void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std:
     if (packetEnd - packetBegin < options_.packetFlush || triEnd - triBegin < options_.triLimit ||
         depth >= options_.maxDepth || stalls >= DACRT_MAX_STALLED_SPLITS ||
         !(split > box.lo[axis] && split < box.hi[axis])) {
-        flushPackets(box, packetBegin, packetEnd, triBegin, triEnd, depth);
+        flushPackets(box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls);
         return;
     }
     Box low = box, high = box;
@@ -285,7 +288,8 @@ void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std:
 
 // The node's unfinished rays go on one by one, from its own ray filter down.
 void DacrtTraversal::flushPackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd,
-                                  std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth) {
+                                  std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
+                                  std::uint32_t stalls) {
     std::uint32_t count = 0;
     for (std::uint32_t i = packetBegin; i < packetEnd; ++i) {
         const RayPacket& p = packet_.packets[packet_.packetIds[i]];
@@ -299,7 +303,7 @@ void DacrtTraversal::flushPackets(const Box& box, std::uint32_t packetBegin, std
     rayIds_ = packet_.flushRays;
     std::uint32_t terminated = 0;
     const std::uint32_t crossing = filterRays(widen(box, margin_), 0, count);
-    node(box, terminated, crossing, triBegin, triEnd, depth, 0);
+    node(box, terminated, crossing, triBegin, triEnd, depth, stalls);
     for (std::uint32_t k = 0; k < terminated; ++k) packet_.rayDone[rayIds_[k]] = 1;
     rayIds_ = regionRays;
 }

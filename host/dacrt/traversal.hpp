@@ -53,6 +53,9 @@ struct PacketBuffers {
 // The packet filter: false only where shared::rayMayCrossCell(ray, cell, tmax) is false for
 // every ray of p (origin and tmin: the rays' shared start).
 bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin, const Box& cell);
+// Whether a traversal of these (resolved) options on this frame runs the SIMD kernels: the
+// default tests, and counts whose ids fit the kernels' 32-bit gather offsets.
+bool usesSimd(const FrameGeometry& geometry, const DacrtOptions& options);
 // Tiles of the frame's image, 0 when the frame has no packets.
 std::uint64_t packetTiles(const FrameGeometry& geometry);
 // Whether a traversal of these options on this frame uses packets.
@@ -108,7 +111,7 @@ private:
                      std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
     std::uint32_t filterPackets(const Box& cell, std::uint32_t begin, std::uint32_t end);
     void flushPackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,
-                      std::uint32_t triEnd, std::uint32_t depth);
+                      std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
     void leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
                   std::uint32_t triEnd);
     void endRaysHitInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd);
