@@ -164,25 +164,6 @@ std::uint32_t PartitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids
                           : partitionRays<false>(rays, hits, ids, count, cell, scratch);
 }
 
-std::uint32_t PartitionTriangles(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, const Box& cell,
-                                 std::uint32_t* scratch) {
-    static_assert(sizeof(Bounds) == 8 * sizeof(float));
-    const float* b = reinterpret_cast<const float*>(bounds);
-    const DF df;
-    const DI di;
-    const DU du;
-    const VF cLoX = hn::Set(df, cell.lo.x), cLoY = hn::Set(df, cell.lo.y), cLoZ = hn::Set(df, cell.lo.z);
-    const VF cHiX = hn::Set(df, cell.hi.x), cHiY = hn::Set(df, cell.hi.y), cHiZ = hn::Set(df, cell.hi.z);
-    return stablePartition(ids, count, scratch, [&](VU id) {
-        const auto base = hn::ShiftLeft<3>(hn::BitCast(di, id));
-        auto field = [&](int offset) { return hn::GatherIndex(df, b, hn::Add(base, hn::Set(di, offset))); };
-        // shared::boundsOverlap: lo at floats 0-2, hi at 4-6.
-        const MF m = hn::And(hn::And(hn::And(field(0) <= cHiX, field(1) <= cHiY), hn::And(field(2) <= cHiZ, field(4) >= cLoX)),
-                             hn::And(field(5) >= cLoY, field(6) >= cLoZ));
-        return hn::RebindMask(du, m);
-    });
-}
-
 std::uint32_t PartitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
                                        bool lowSide, float bound, std::uint32_t* scratch) {
     const float* b = reinterpret_cast<const float*>(bounds) + (lowSide ? 0 : 4) + axis;
@@ -316,7 +297,6 @@ HWY_AFTER_NAMESPACE();
 namespace dacrt::simd {
 
 HWY_EXPORT(PartitionRays);
-HWY_EXPORT(PartitionTriangles);
 HWY_EXPORT(PartitionTrianglesOnFace);
 HWY_EXPORT(IntersectBatch);
 HWY_EXPORT(GatherLeafTriangles);
@@ -325,11 +305,6 @@ HWY_EXPORT(CompiledTarget);
 std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
                                         const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
     return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, hits, ids, count, cell, raysShareStart, scratch);
-}
-
-std::uint32_t partitionTrianglesOverlapCell(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
-                                            const Box& cell, std::uint32_t* scratch) {
-    return HWY_DYNAMIC_DISPATCH(PartitionTriangles)(bounds, ids, count, cell, scratch);
 }
 
 std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,

@@ -17,27 +17,25 @@
 namespace dacrt::simd {
 
 // Ids move through 32-bit gather offsets: the kernels take at most this many rays
-// (16 floats each) or triangles (8 floats of bounds each); larger frames use the scalar path.
+// (16 floats each) or triangles (12 floats each); larger frames use the scalar path.
 constexpr std::uint64_t kMaxRays = (std::uint64_t(1) << 31) / 16;
 constexpr std::uint64_t kMaxTriangles = (std::uint64_t(1) << 31) / 16;
 
 // Room past the ids a partition may park in scratch, for whole-vector stores.
 constexpr std::uint32_t kScratchSlack = 64;
 
-// Stable partitions of ids[0, count): the ids whose ray may cross the (already widened) cell
-// before its best hit so far (shared::rayMayCrossCell with hits[id].t), or whose triangle
-// bounds overlap the cell (shared::boundsOverlap), first, in their order; the others after
-// them, in theirs. Returns how many pass. scratch holds count + kScratchSlack ids. raysShareStart: every
-// ray has rays[0]'s origin and tmin bit for bit (raysShareStart() in frame_geometry.hpp).
+// Stable partition of ids[0, count): the ids whose ray may cross the (already widened) cell
+// before its best hit so far (shared::rayMayCrossCell with hits[id].t) first, in their order;
+// the others after them, in theirs. Returns how many pass. scratch holds count +
+// kScratchSlack ids. raysShareStart: every ray has rays[0]'s origin and tmin bit for bit
+// (raysShareStart() in frame_geometry.hpp).
 std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
                                         const Box& cell, bool raysShareStart, std::uint32_t* scratch);
-std::uint32_t partitionTrianglesOverlapCell(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
-                                            const Box& cell, std::uint32_t* scratch);
 
 // The same partition for triangles whose bounds are known to overlap a cell that differs
-// from this one only in one face, on `axis`: what boundsOverlap with this cell answers then
-// is the one comparison that face adds, lo[axis] <= bound for a new high face (lowSide) or
-// hi[axis] >= bound for a new low face. One gather per id instead of six.
+// from this one only in one face, on `axis`: what shared::boundsOverlap with this cell
+// answers then is the one comparison that face adds, lo[axis] <= bound for a new high face
+// (lowSide) or hi[axis] >= bound for a new low face. One gather per id instead of six.
 std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
                                        bool lowSide, float bound, std::uint32_t* scratch);
 

@@ -166,30 +166,46 @@ float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triB
     return s > box.lo[axis] && s < box.hi[axis] ? s : mid;
 }
 
-void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
-                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
-    if (terminated >= rayEnd || triBegin >= triEnd) return;
-    const std::uint32_t rayCount = rayEnd - terminated, triCount = triEnd - triBegin;
+// The split both recursions share (node over rays, nodePackets over packets): the longest
+// axis at the split position, then the two children front to back (every ray shares the
+// origin, so the child on its side is crossed first), each with its items and triangles
+// filtered from the node's. itemBegin is read again for the second child: a ray recursion
+// moves the rays the first child finished before it. False (nothing done) where the node
+// must end here instead: fewItems, too few triangles, too deep, stalled, or no split inside.
+template <typename FilterItems, typename Descend>
+bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, std::uint32_t itemEnd,
+                               std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
+                               std::uint32_t stalls, bool fewItems, FilterItems filterItems, Descend descend) {
     const int axis = longestAxis(box);
     const float split = splitPosition(box, axis, triBegin, triEnd);
-    if (rayCount < options_.rayLimit || triCount < options_.triLimit || depth >= options_.maxDepth ||
-        stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis])) {
-        leaf(box, terminated, rayEnd, triBegin, triEnd);
-        return;
-    }
+    if (fewItems || triEnd - triBegin < options_.triLimit || depth >= options_.maxDepth ||
+        stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis]))
+        return false;
     Box low = box, high = box;
     low.hi[axis] = split;
     high.lo[axis] = split;
-    // Front to back: every ray shares the origin, so the child on its side is crossed first.
     const bool lowFirst = origin_[axis] <= split;
     for (const Box* child : {lowFirst ? &low : &high, lowFirst ? &high : &low}) {
         const Box cell = widen(*child, margin_);
-        const std::uint32_t childRays = filterRays(cell, terminated, rayEnd);
-        if (childRays == terminated) continue;
+        const std::uint32_t childItems = filterItems(cell, itemBegin, itemEnd);
+        if (childItems == itemBegin) continue;
         const std::uint32_t childTris = filterTriangles(*child, cell, triBegin, triEnd, axis, child == &low);
-        const bool stalled = childRays == rayEnd && childTris == triEnd;
-        node(*child, terminated, childRays, triBegin, childTris, depth + 1, stalled ? stalls + 1 : 0);
+        const bool stalled = childItems == itemEnd && childTris == triEnd;
+        descend(*child, childItems, childTris, depth + 1, stalled ? stalls + 1 : 0);
     }
+    return true;
+}
+
+void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
+    if (terminated >= rayEnd || triBegin >= triEnd) return;
+    const bool split = splitNode(
+        box, terminated, rayEnd, triBegin, triEnd, depth, stalls, rayEnd - terminated < options_.rayLimit,
+        [&](const Box& cell, std::uint32_t begin, std::uint32_t end) { return filterRays(cell, begin, end); },
+        [&](const Box& child, std::uint32_t childRays, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
+            node(child, terminated, childRays, triBegin, childTris, d, s);
+        });
+    if (!split) leaf(box, terminated, rayEnd, triBegin, triEnd);
 }
 
 // The rays of [terminated, crossing) in packets: traced down as packets to nodes with fewer
@@ -264,26 +280,13 @@ void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std:
                                  std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
                                  std::uint32_t stalls) {
     if (packetBegin >= packetEnd || triBegin >= triEnd) return;
-    const int axis = longestAxis(box);
-    const float split = splitPosition(box, axis, triBegin, triEnd);
-    if (packetEnd - packetBegin < options_.packetFlush || triEnd - triBegin < options_.triLimit ||
-        depth >= options_.maxDepth || stalls >= DACRT_MAX_STALLED_SPLITS ||
-        !(split > box.lo[axis] && split < box.hi[axis])) {
-        flushPackets(box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls);
-        return;
-    }
-    Box low = box, high = box;
-    low.hi[axis] = split;
-    high.lo[axis] = split;
-    const bool lowFirst = origin_[axis] <= split;
-    for (const Box* child : {lowFirst ? &low : &high, lowFirst ? &high : &low}) {
-        const Box cell = widen(*child, margin_);
-        const std::uint32_t childPackets = filterPackets(cell, packetBegin, packetEnd);
-        if (childPackets == packetBegin) continue;
-        const std::uint32_t childTris = filterTriangles(*child, cell, triBegin, triEnd, axis, child == &low);
-        const bool stalled = childPackets == packetEnd && childTris == triEnd;
-        nodePackets(*child, packetBegin, childPackets, triBegin, childTris, depth + 1, stalled ? stalls + 1 : 0);
-    }
+    const bool split = splitNode(
+        box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls, packetEnd - packetBegin < options_.packetFlush,
+        [&](const Box& cell, std::uint32_t begin, std::uint32_t end) { return filterPackets(cell, begin, end); },
+        [&](const Box& child, std::uint32_t childPackets, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
+            nodePackets(child, packetBegin, childPackets, triBegin, childTris, d, s);
+        });
+    if (!split) flushPackets(box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls);
 }
 
 // The node's unfinished rays go on one by one, from its own ray filter down.

@@ -99,6 +99,10 @@ public:
                         std::uint32_t triEnd, const RetireRule& retire = {});
 
 private:
+    template <typename FilterItems, typename Descend>
+    bool splitNode(const Box& box, const std::uint32_t& itemBegin, std::uint32_t itemEnd, std::uint32_t triBegin,
+                   std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool fewItems,
+                   FilterItems filterItems, Descend descend);
     void node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,

@@ -80,6 +80,20 @@ std::vector<std::uint32_t> shuffledIds(Random& rng, std::uint32_t universe, std:
     return ids;
 }
 
+// A kernel's partition against the scalar one (same ids, same order), tallying both answers
+// so that a test can require both to be common.
+struct PartitionTally {
+    std::uint32_t kept = 0, rejected = 0;
+    ::testing::AssertionResult check(std::uint32_t kept_, std::uint32_t expectedKept, const std::vector<std::uint32_t>& ids,
+                                     const std::vector<std::uint32_t>& expected) {
+        if (kept_ != expectedKept || ids != expected)
+            return ::testing::AssertionFailure() << "kept " << kept_ << " ids against the scalar " << expectedKept;
+        kept += kept_;
+        rejected += std::uint32_t(ids.size()) - kept_;
+        return ::testing::AssertionSuccess();
+    }
+};
+
 bool sameHit(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit)) == 0; }
 
 }  // namespace
@@ -90,7 +104,7 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
       for (const bool shareStart : {false, true}) {
         SCOPED_TRACE(shareStart ? "rays share their start" : "rays start apart");
         Random rng(11);
-        std::uint32_t keptTotal = 0, rejectedTotal = 0;
+        PartitionTally tally;
         std::vector<Ray> rays(300);
         std::vector<Hit> hits(rays.size(), missHit());
         for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -112,45 +126,11 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
             std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
             const std::uint32_t kept = simd::partitionRaysMayCrossCell(rays.data(), hits.data(), ids.data(), count, cell,
                                                                        shareStart, scratch.data());
-            ASSERT_EQ(kept, expectedKept) << "trial " << trial;
-            ASSERT_EQ(ids, expected) << "trial " << trial;
-            keptTotal += kept;
-            rejectedTotal += count - kept;
+            ASSERT_TRUE(tally.check(kept, expectedKept, ids, expected)) << "trial " << trial;
         }
-        EXPECT_GT(keptTotal, 400u);  // both answers are common, so both are compared
-        EXPECT_GT(rejectedTotal, 1000u);
+        EXPECT_GT(tally.kept, 400u);  // both answers are common, so both are compared
+        EXPECT_GT(tally.rejected, 1000u);
       }
-    });
-}
-
-TEST_F(EveryTarget, TrianglePartitionKeepsTheScalarAnswerAndOrder) {
-    forEachTarget([] {
-        Random rng(12);
-        std::uint32_t keptTotal = 0, rejectedTotal = 0;
-        std::vector<Bounds> bounds(300);
-        for (Bounds& b : bounds) {
-            const Box box = randomCell(rng);
-            b.lo = box.lo;
-            b.hi = box.hi;
-        }
-        for (int trial = 0; trial < 400; ++trial) {
-            const Box cell = randomCell(rng);
-            const std::uint32_t count = std::uint32_t(rng.index(70));
-            std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(bounds.size()), count);
-            std::uint32_t expectedKept = 0;
-            const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
-                return shared::boundsOverlap(bounds[id].lo, bounds[id].hi, cell.lo, cell.hi);
-            });
-            std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
-            const std::uint32_t kept =
-                simd::partitionTrianglesOverlapCell(bounds.data(), ids.data(), count, cell, scratch.data());
-            ASSERT_EQ(kept, expectedKept) << "trial " << trial;
-            ASSERT_EQ(ids, expected) << "trial " << trial;
-            keptTotal += kept;
-            rejectedTotal += count - kept;
-        }
-        EXPECT_GT(keptTotal, 1000u);
-        EXPECT_GT(rejectedTotal, 1000u);
     });
 }
 
@@ -158,7 +138,7 @@ TEST_F(EveryTarget, TrianglePartitionKeepsTheScalarAnswerAndOrder) {
 TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCell) {
     forEachTarget([] {
         Random rng(14);
-        std::uint32_t keptTotal = 0, rejectedTotal = 0;
+        PartitionTally tally;
         for (int trial = 0; trial < 300; ++trial) {
             const Box parent = randomCell(rng);
             std::vector<Bounds> bounds(200);
@@ -183,13 +163,10 @@ TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCell) {
             std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
             const std::uint32_t kept =
                 simd::partitionTrianglesOnFace(bounds.data(), ids.data(), count, axis, lowSide, face, scratch.data());
-            ASSERT_EQ(kept, expectedKept) << "trial " << trial;
-            ASSERT_EQ(ids, expected) << "trial " << trial;
-            keptTotal += kept;
-            rejectedTotal += count - kept;
+            ASSERT_TRUE(tally.check(kept, expectedKept, ids, expected)) << "trial " << trial;
         }
-        EXPECT_GT(keptTotal, 1000u);
-        EXPECT_GT(rejectedTotal, 1000u);
+        EXPECT_GT(tally.kept, 1000u);
+        EXPECT_GT(tally.rejected, 1000u);
     });
 }
 
