@@ -33,6 +33,8 @@ std::vector<std::string> ignoredOptions(const BackendRequest& r) {
     given(d.intersector != defaults.intersector, b == Backend::CpuSeq || b == Backend::Cpu, "--intersector");
     given(d.triangleFilter != defaults.triangleFilter, b == Backend::CpuSeq || b == Backend::Cpu, "--triangle-filter");
     given(d.precision != defaults.precision, b == Backend::CpuSeq || b == Backend::Cpu, "--precision");
+    given(d.packets != defaults.packets, b == Backend::CpuSeq || b == Backend::Cpu, "--packets");
+    given(d.packetFlush != 0, b == Backend::CpuSeq || b == Backend::Cpu, "--packet-flush");
     given(r.gpuTuning.workgroupSize != 0, b == Backend::Gpu, "--workgroup-size");
     given(r.gpuTuning.rayGroups != 0, b == Backend::Gpu, "--ray-groups");
     given(!r.embree.robust, b == Backend::Embree, "--embree-fast");

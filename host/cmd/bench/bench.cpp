@@ -139,10 +139,14 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
     std::vector<Ray>& rays = buffers.rays;
     primaryRays(camera, width, height, pool, rays);
     const bool peer = isPeer(c.backend());
-    std::vector<Bounds>& bounds = buffers.bounds;
-    Box box;
-    if (!peer) triangleBoundsInParallel(scene.triangles, pool, bounds, box);
-    const FrameGeometry g = frameGeometry(scene.triangles, bounds, rays, box, std::uint32_t(width));
+    // Only dacrt's backends read the frame geometry (bounds, scene box, the scan for a shared
+    // ray start): the peers' frames do not pay for it.
+    FrameGeometry g;
+    if (!peer) {
+        Box box;
+        triangleBoundsInParallel(scene.triangles, pool, buffers.bounds, box);
+        g = frameGeometry(scene.triangles, buffers.bounds, rays, box, std::uint32_t(width));
+    }
     const double prepareMs = msSince(start);
     const auto traceStart = Clock::now();
     if (persistentRayQuery) {
