@@ -36,23 +36,43 @@ bool usesPackets(const FrameGeometry& g, const DacrtOptions& options) {
     return options.packets && usesSimd(g, options) && packetTiles(g) > 0;
 }
 
+namespace {
+
+// One worker's packet arrays, element by element: what the plan counts and the storage
+// allocates (plus one finished flag per ray of the frame, shared).
+struct PacketArrayCounts {
+    std::uint64_t rayIds = 0;      // packetRays, and flushRays as many
+    std::uint64_t packets = 0;     // packets, and packetIds as many
+    std::uint64_t tileStarts = 0;  // tileCounts
+};
+
+PacketArrayCounts packetArrayCounts(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t scratchIds) {
+    if (!usesPackets(g, options)) return {};
+    const std::uint64_t tiles = packetTiles(g);
+    return {scratchIds, tiles, tiles + 1};
+}
+
+}  // namespace
+
 void planPacketBuffers(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t scratchIds, unsigned workers,
                        MemoryPlan& plan) {
-    if (!usesPackets(g, options)) return;
-    const std::uint64_t tiles = packetTiles(g);
-    plan.add("packet rays and flushed rays (per thread)", 2 * scratchIds * 4 * workers);
-    plan.add("packets (per thread)", (tiles * (sizeof(RayPacket) + 8) + 4) * workers);
-    plan.add("ray finished flags", g.rays->size());
+    const PacketArrayCounts c = packetArrayCounts(g, options, scratchIds);
+    if (!c.packets) return;
+    plan.add("packet rays and flushed rays (per thread)", 2 * c.rayIds * sizeof(std::uint32_t) * workers);
+    plan.add("packets (per thread)",
+             (c.packets * (sizeof(RayPacket) + sizeof(std::uint32_t)) + c.tileStarts * sizeof(std::uint32_t)) * workers);
+    plan.add("ray finished flags", g.rays->size() * sizeof(std::uint8_t));
 }
 
 PacketStorage::PacketStorage(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t ids, unsigned workers)
-    : scratchIds(ids), tiles(usesPackets(g, options) ? packetTiles(g) : 0) {
+    : scratchIds(ids), tiles(packetArrayCounts(g, options, ids).packets) {
     if (!tiles) return;
-    packetRays.resize(ids * workers);
-    flushRays.resize(ids * workers);
-    packets.resize(tiles * workers);
-    packetIds.resize(tiles * workers);
-    tileCounts.resize((tiles + 1) * workers);
+    const PacketArrayCounts c = packetArrayCounts(g, options, ids);
+    packetRays.resize(c.rayIds * workers);
+    flushRays.resize(c.rayIds * workers);
+    packets.resize(c.packets * workers);
+    packetIds.resize(c.packets * workers);
+    tileCounts.resize(c.tileStarts * workers);
     rayDone.assign(g.rays->size(), 0);
 }
 
