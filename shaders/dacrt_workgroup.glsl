@@ -231,8 +231,9 @@ void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
                 vec3 v0 = subgroupShuffle(mine.v0, k);
                 vec3 v1 = subgroupShuffle(mine.v1, k);
                 vec3 v2 = subgroupShuffle(mine.v2, k);
+                bool cullBackFace = subgroupShuffle(mine.cullBackFace, k) != 0u;
                 if (rayActive && k < tileSize) {
-                    TriangleHit h = intersectWatertight(ray, v0, v1, v2);
+                    TriangleHit h = intersectWatertight(ray, v0, v1, v2, cullBackFace);
                     if (h.hit && h.t > ray.tmin && hitPrecedes(h.t, prim, best.t, best.prim)) {
                         best.t = h.t;
                         best.prim = prim;

@@ -19,7 +19,7 @@ struct Ray {
 
 struct Triangle {
     vec3 v0;
-    float pad0;
+    uint cullBackFace;  // 1: a ray that meets the back face does not hit it (backFaceIsCulled)
     vec3 v1;
     float pad1;
     vec3 v2;
@@ -209,6 +209,7 @@ static_assert(offsetof(Ray, origin) == 0 && offsetof(Ray, tmin) == 12);
 static_assert(offsetof(Ray, dir) == 16 && offsetof(Ray, axes) == 28);
 static_assert(offsetof(Ray, invDir) == 32 && offsetof(Ray, shear) == 48);
 static_assert(sizeof(Triangle) == 48);
+static_assert(offsetof(Triangle, cullBackFace) == 12);
 static_assert(offsetof(Triangle, v0) == 0 && offsetof(Triangle, v1) == 16 && offsetof(Triangle, v2) == 32);
 static_assert(sizeof(Bounds) == 32 && offsetof(Bounds, lo) == 0 && offsetof(Bounds, hi) == 16);
 static_assert(sizeof(Hit) == 16 && offsetof(Hit, t) == 0 && offsetof(Hit, prim) == 4);

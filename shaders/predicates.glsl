@@ -98,12 +98,13 @@ const float kProjectionSlack = 9.5367431640625e-07;
 // double-precision fallback so that every backend runs the same arithmetic. Edge values of
 // a shared edge are exact negations of each other (a*b - c*d versus c*d - a*b), and zero
 // counts as inside, so no ray passes between two triangles that share an edge.
-// Never a hit: triangles with no area (triangleHasNoArea), edge-on ones (det == 0), and those
+// Never a hit: triangles with no area (triangleHasNoArea), edge-on ones (det == 0), back faces
+// of single-sided triangles (backFaceIsCulled: cullBackFace is Triangle::cullBackFace), and those
 // whose projection along the ray leaves the ray outside the box of its projected vertices.
 // The last happens only through rounding: for a sliver seen nearly end-on, the edge values
 // are tiny products' differences whose rounding can pass the sign test while the ray passes
 // far from the triangle (docs/correctness.md, "Degenerate and sliver triangles").
-TriangleHit intersectWatertight(IN(Ray) ray, vec3 p0, vec3 p1, vec3 p2) {
+TriangleHit intersectWatertight(IN(Ray) ray, vec3 p0, vec3 p1, vec3 p2, bool cullBackFace) {
     TriangleHit h;
     h.hit = false;
     h.t = kNoHitT;
@@ -127,6 +128,7 @@ TriangleHit intersectWatertight(IN(Ray) ray, vec3 p0, vec3 p1, vec3 p2) {
     if ((eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0)) return h;
     precise float det = eu + ev + ew;
     if (det == 0.0) return h;
+    if (backFaceIsCulled(cullBackFace, det)) return h;
     precise float reach = max(max(max(abs(a.x), abs(a.y)), max(abs(a.z), abs(b.x))),
                               max(max(abs(b.y), abs(b.z)), max(max(abs(c.x), abs(c.y)), abs(c.z))));
     precise float slack = reach * kProjectionSlack;

@@ -13,10 +13,12 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 0) readonly buffer RayBuffer { Ray rays[]; };
 layout(std430, binding = 1) writeonly buffer HitBuffer { Hit hits[]; };
 layout(binding = 2) uniform accelerationStructureEXT scene;
+layout(std430, binding = 3) readonly buffer TriangleBuffer { Triangle triangles[]; };  // the BLAS's vertices
 
 layout(push_constant) uniform Push {
     uint rayCount;
     uint firstRay;
+    uint cullBackFaces;  // 1: some triangles are single-sided (Triangle::cullBackFace)
 } push;
 
 void main() {
@@ -24,9 +26,18 @@ void main() {
     if (i >= push.rayCount) return;
     Ray ray = rays[i];
     rayQueryEXT query;
-    // Opaque: the closest hit, no any-hit shaders; both faces (dacrt culls none).
-    rayQueryInitializeEXT(query, scene, gl_RayFlagsOpaqueEXT, 0xFFu, ray.origin, ray.tmin, ray.dir, kNoHitT);
+    // Opaque: the closest hit, no any-hit shaders. With single-sided triangles (dacrt's face
+    // rule), every candidate comes back here and is confirmed unless it is one's back face:
+    // per triangle, which the ray flag gl_RayFlagsCullBackFacingTrianglesEXT is not (and
+    // lavapipe, Mesa 25.0.7, ignores that flag: docs/skips.md).
+    bool cull = push.cullBackFaces != 0u;
+    rayQueryInitializeEXT(query, scene, cull ? gl_RayFlagsNoOpaqueEXT : gl_RayFlagsOpaqueEXT, 0xFFu, ray.origin,
+                          ray.tmin, ray.dir, kNoHitT);
     while (rayQueryProceedEXT(query)) {
+        if (rayQueryGetIntersectionTypeEXT(query, false) != gl_RayQueryCandidateIntersectionTriangleEXT) continue;
+        uint prim = uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, false));
+        if (triangles[prim].cullBackFace == 0u || rayQueryGetIntersectionFrontFaceEXT(query, false))
+            rayQueryConfirmIntersectionEXT(query);
     }
     Hit h;
     h.t = kNoHitT;

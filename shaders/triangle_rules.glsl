@@ -17,4 +17,12 @@ bool triangleHasNoArea(vec3 p0, vec3 p1, vec3 p2) {
     return nx == 0.0 && ny == 0.0 && nz == 0.0;
 }
 
+// The face rule of every backend (glTF 2.0, "doubleSided": a single-sided material's back
+// faces are culled). det is the intersection test's determinant, which every test here
+// computes with the sign of -dot(d, (v1 - v0) x (v2 - v0)): positive when the ray meets the
+// counter-clockwise (front) side. Zero never reaches this rule: such a triangle is edge-on.
+bool backFaceIsCulled(bool cullBackFace, float det) {
+    return cullBackFace && det < 0.0;
+}
+
 #endif

@@ -6,7 +6,9 @@
 
 #include "cmd/exit_codes.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "dacrt/cpu_tracers.hpp"
+#include "dacrt/triangle_skips.hpp"
 #include "oracle/embree_tracer.hpp"
 
 namespace dacrt {
@@ -92,6 +94,44 @@ ThreadPool& BackendDispatcher::pool(unsigned threads) {
 TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const BackendRequest& request,
                                      const PlanHook& onPlan, const ProgressHook& onProgress) {
     checkBackendRequest(request);
+    ThreadPool& threadPool = pool(threadsOf(request.trace));
+    if (isPeer(request.trace.backend)) return traceOnBackend(geometry, request, onPlan, onProgress);
+
+    // dacrt's backends trace the triangles no skip dropped; the plan starts with the skips.
+    const auto start = Clock::now();
+    const TriangleSkips skips = skipTriangles(geometry, request.trace.skips, threadPool);
+    MemoryPlan skipPlan;
+    planSkips(geometry, request.trace.skips, skips, skipPlan);
+    const double skipMs = msSince(start);
+    auto withSkipLines = [&](TraceResult r) {
+        r.memory.work.insert(r.memory.work.begin(), skipPlan.work.begin(), skipPlan.work.end());
+        r.phaseMs.insert(r.phaseMs.begin(), {"skips", skipMs});
+        return r;
+    };
+    if (skips.applied && skips.traced.empty()) {
+        // No triangle can be hit: every ray misses, with nothing to divide or upload.
+        TraceResult r;
+        r.threads = threadPool.size();
+        skipPlan.add("hits", std::uint64_t(geometry.rays->size()) * sizeof(Hit));
+        r.memory = skipPlan;
+        if (onPlan && !onPlan(r.memory)) return r;
+        r.hits.assign(geometry.rays->size(), missHit());
+        r.counters.raysCulled = geometry.rays->size();
+        r.memory.work.clear();
+        return withSkipLines(std::move(r));
+    }
+    const FrameGeometry traced = withSkips(geometry, skips);
+    const PlanHook planWithSkips = onPlan ? PlanHook([&](const MemoryPlan& plan) {
+        MemoryPlan whole = plan;
+        whole.work.insert(whole.work.begin(), skipPlan.work.begin(), skipPlan.work.end());
+        return onPlan(whole);
+    })
+                                          : PlanHook();
+    return withSkipLines(traceOnBackend(traced, request, planWithSkips, onProgress));
+}
+
+TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request,
+                                              const PlanHook& onPlan, const ProgressHook& onProgress) {
     const unsigned threads = threadsOf(request.trace);
     ThreadPool& threadPool = pool(threads);
     switch (request.trace.backend) {

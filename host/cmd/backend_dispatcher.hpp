@@ -56,7 +56,9 @@ public:
     gpu::PipelineCache* pipelines() { return pipelines_.get(); }
     const gpu::Context* gpuContext() const { return gpu_.get(); }
 
-    // Checks the request (checkBackendRequest), then traces one frame on its backend.
+    // Checks the request (checkBackendRequest), then traces one frame on its backend: for
+    // dacrt's backends, after the triangle skips the request allows (triangle_skips.hpp),
+    // whose counts open the plan's work lines.
     // onProgress is called by the backends that report progress (brute force).
     TraceResult trace(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan = {},
                       const ProgressHook& onProgress = {});
@@ -67,6 +69,10 @@ public:
     int validationEpilogue(std::ostream& err) const;
 
 private:
+    // The trace itself, on the triangles the skips left (dacrt's backends) or on every one.
+    TraceResult traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan,
+                               const ProgressHook& onProgress);
+
     DeviceChoice devices_;
     std::map<unsigned, std::unique_ptr<ThreadPool>> pools_;
     std::unique_ptr<gpu::Context> gpu_;

@@ -113,6 +113,24 @@ void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     addEnumOption(cmd, "--precision", o.precision, "leaf ray/triangle arithmetic (cpu, cpu-seq)");
 }
 
+// --no-skip LIST: the skips (options.hpp, Skip) to turn off, to measure what each saves.
+void addSkipListOption(CLI::App* cmd, SkipSwitches& skips) {
+    cmd->add_option_function<std::vector<std::string>>(
+           "--no-skip",
+           [&skips](const std::vector<std::string>& list) {
+               for (const std::string& name : list) {
+                   const Skip skip = *parseEnum<Skip>(name);
+                   if (skip == Skip::BackFaces) skips.backFaces = false;
+                   if (skip == Skip::Frustum) skips.frustum = false;
+                   if (skip == Skip::Uploads) skips.uploads = false;
+               }
+           },
+           "skips to turn off (each changes speed only): backfaces (single-sided triangles facing away from the "
+           "camera), frustum (triangles outside the view), uploads (gpu: triangle buffers kept across frames)")
+        ->check(CLI::IsMember(enumNameList<Skip>()))
+        ->delimiter(',');
+}
+
 // A subcommand: its options parse into state of its own, and run() is called when it is chosen.
 struct Subcommand {
     CLI::App* app = nullptr;
@@ -160,7 +178,10 @@ Subcommand addRenderCommand(CLI::App& app) {
     cmd->add_option("--fov", s->fov, "vertical field of view in degrees (default: the scene camera's, else 45)");
     cmd->add_option("--orbit", render.camera.orbit, "K cameras on a circle about the vertical axis through the scene's centre")
         ->check(CLI::Range(1, 100000))->default_str("1");
-    cmd->add_flag("--plan", render.planOnly, "print the memory plan and stop before tracing");
+    cmd->add_flag("--plan", render.planOnly, "print the work plan (what is traced and skipped) and the memory plan, and stop before tracing");
+    addEnumOption(cmd, "--cull", render.cull,
+                  "back faces no ray hits: the materials' (glTF doubleSided false: culled), none, or every triangle's");
+    addSkipListOption(cmd, render.request.trace.skips);
     addDeviceOptions(cmd, render.devices);
     cmd->add_option("--workgroup-size", render.request.gpuTuning.workgroupSize,
                     "invocations per workgroup (gpu; default: per device)")

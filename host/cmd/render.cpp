@@ -56,6 +56,7 @@ PreparedScene loadAndPrepare(const RenderOptions& o) {
     PreparedScene p;
     const auto start = Clock::now();
     p.scene = loadGltf(o.scenePath);
+    applyCullMode(p.scene, o.cull);
     p.loadMs = msSince(start);
     const auto prepareStart = Clock::now();
     p.triangleBounds = allTriangleBounds(p.scene.triangles);
@@ -70,9 +71,13 @@ PreparedScene loadAndPrepare(const RenderOptions& o) {
 PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t rays, int cameraIndex) {
     return [&o, &p, rays, cameraIndex](const MemoryPlan& plan) {
         if (o.planOnly) {
-            std::cout << "memory plan (" << toString(o.request.trace.backend) << ", " << p.scene.triangleCount()
-                      << " triangles, " << rays << " rays"
-                      << (p.cameras.size() > 1 ? ", camera " + std::to_string(cameraIndex) : std::string()) << "):\n"
+            const std::string frame = toString(o.request.trace.backend) + ", " + std::to_string(p.scene.triangleCount()) +
+                                      " triangles, " + std::to_string(rays) + " rays" +
+                                      (p.cameras.size() > 1 ? ", camera " + std::to_string(cameraIndex) : std::string());
+            std::cout << "work plan (" << frame << "):\n"
+                      << "  degenerate triangles dropped at load  " << p.scene.degenerateTrianglesDropped
+                      << "  (no area: never hit)\n"
+                      << plan.describeWork() << "memory plan (" << frame << "):\n"
                       << plan.describe();
             return false;
         }
@@ -97,7 +102,8 @@ std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScen
     for (int j = 0; j < k; ++j)
         for (int i = 0; i < k; ++i) {
             const std::vector<Ray> rays = primaryRays(camera, o.width, o.height, {(i + 0.5) / k, (j + 0.5) / k});
-            const FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
+            FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
+            g.frustum = viewFrustum(camera, o.width, o.height);
             const TraceResult r = backends.trace(g, o.request);
             accumulateShading(p.scene, HitImage{o.width, o.height, &rays, &r.hits}, 1.0f / float(k * k), sum);
         }
@@ -185,7 +191,8 @@ int runRender(const RenderOptions& o) {
         const Camera& camera = p.cameras[std::size_t(k)];
         const auto frameStart = Clock::now();
         const std::vector<Ray> rays = primaryRays(camera, o.width, o.height);
-        const FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
+        FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
+        g.frustum = viewFrustum(camera, o.width, o.height);
         const double prepareMs = p.prepareMs + msSince(frameStart);
 
         const auto traceStart = Clock::now();

@@ -17,7 +17,8 @@ struct RenderOptions {
     int samplesPerPixel = 1;  // shaded image only: k x k strata per pixel (a square); AOVs keep the centre
     int width = 640;
     int height = 480;
-    bool planOnly = false;    // print the memory plan and stop before tracing
+    bool planOnly = false;    // print the work and memory plans and stop before tracing
+    CullMode cull = CullMode::Material;
     DeviceChoice devices;     // gpu
     BackendRequest request;
     CameraOptions camera;

@@ -32,7 +32,11 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
                     {"max_depth", trace.dacrt.maxDepth}, {"split", toString(trace.dacrt.split)},
                     {"axis", toString(trace.axis)}, {"intersector", toString(trace.dacrt.intersector)},
                     {"triangle_filter", toString(trace.dacrt.triangleFilter)},
-                    {"precision", toString(trace.dacrt.precision)}};
+                    {"precision", toString(trace.dacrt.precision)},
+                    {"cull", toString(o.cull)},
+                    {"skip_backfaces", trace.skips.backFaces},
+                    {"skip_frustum", trace.skips.frustum},
+                    {"skip_uploads", trace.skips.uploads}};
     if (trace.backend == Backend::Embree)
         j["options"] = {{"robust", o.request.embree.robust}, {"build", toString(o.request.embree.build)},
                         {"packets", o.request.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
@@ -47,6 +51,11 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     for (const auto& [name, bytes] : r.memory.buffers) mem[jsonKey(name)] = bytes;
     mem["total"] = r.memory.total();
     j["memory_plan_bytes"] = mem;
+    nlohmann::ordered_json work = nlohmann::ordered_json::array();
+    work.push_back({{"name", "degenerate triangles dropped at load"}, {"count", frame.scene.degenerateTrianglesDropped},
+                    {"why", "no area: never hit"}});
+    for (const WorkLine& w : r.memory.work) work.push_back({{"name", w.name}, {"count", w.count}, {"why", w.why}});
+    j["work_plan"] = work;
     const Counters& c = r.counters;
     nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
     for (std::size_t i = 0; i < c.terminatedPerRound.size(); ++i)

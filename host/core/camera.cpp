@@ -84,6 +84,18 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
     return cameras;
 }
 
+ViewFrustum viewFrustum(const Camera& camera, int width, int height) {
+    // primaryRayRow's directions are forward + sx right + sy up with |sx| <= x and |sy| <= y;
+    // n . d is affine in (sx, sy), so the rectangle's edges bound it.
+    const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
+    const double y = std::tan(0.5 * camera.yfovRadians), x = y * double(width) / double(height);
+    ViewFrustum f;
+    f.apex = glm::dvec3(glm::vec3(camera.eye));
+    f.inward = {glm::normalize(x * camera.forward + right), glm::normalize(x * camera.forward - right),
+                glm::normalize(y * camera.forward + camera.up), glm::normalize(y * camera.forward - camera.up)};
+    return f;
+}
+
 Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
     if (!finite(glm::dvec3(origin)) || !finite(direction) || glm::length(direction) == 0.0)
         throw InputError("ray: origin " + str(glm::dvec3(origin)) + " and direction " + str(direction) +

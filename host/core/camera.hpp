@@ -1,6 +1,7 @@
 #pragma once
 // Cameras and primary rays. Ray directions are computed once here, in float32, and every
 // backend traces exactly these rays.
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -31,6 +32,16 @@ constexpr double kDefaultFovDegrees = 45.0;
 // options override it. With orbit K, the K cameras are the base camera rotated about the
 // vertical (y) axis through the box centre by 2 pi k / K. Throws InputError on bad values.
 std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const CameraOptions& options, double aspect);
+
+// The side planes of the pyramid every primary ray of `camera` at width x height lies in, for
+// any point of a pixel (primaryRays' offset in [0, 1]^2): planes through the rays' float32
+// origin, unit normals pointing inward. Exact in real arithmetic (the pixel rectangle's edges);
+// the rays' rounding to float32 moves them at most 2^-23 outside, which users must allow for.
+struct ViewFrustum {
+    glm::dvec3 apex{0.0};
+    std::array<glm::dvec3, 4> inward{};
+};
+ViewFrustum viewFrustum(const Camera& camera, int width, int height);
 
 // Canonical float32 ray from an origin and a direction of any length: normalized in double,
 // rounded to float, components below 2^-64 flushed to zero (so 1/dir <= 2^64), and the

@@ -325,6 +325,7 @@ public:
             Material mat;
             const std::vector<double>& f = m.pbrMetallicRoughness.baseColorFactor;
             if (f.size() == 4) mat.baseColor = glm::vec4(float(f[0]), float(f[1]), float(f[2]), float(f[3]));
+            mat.doubleSided = m.doubleSided;
             scene_.materials.push_back(mat);
         }
         defaultMaterial_ = std::uint32_t(scene_.materials.size());
@@ -493,9 +494,14 @@ private:
             material = std::uint32_t(prim.material);
         }
 
+        // glTF: a node whose global transform mirrors (negative determinant) turns its
+        // triangles' winding clockwise; swapping two corners keeps counter-clockwise the front.
+        const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+        const std::uint32_t cullBackFace = scene_.materials[material].doubleSided ? 0u : 1u;
         for (std::size_t t = 0; t * 3 < corners.size(); ++t) {
             Triangle tri{};
-            glm::vec3* v[3] = {&tri.v0, &tri.v1, &tri.v2};
+            tri.cullBackFace = cullBackFace;
+            glm::vec3* v[3] = {&tri.v0, mirrored ? &tri.v2 : &tri.v1, mirrored ? &tri.v1 : &tri.v2};
             for (int k = 0; k < 3; ++k) {
                 const std::uint32_t index = corners[t * 3 + std::size_t(k)];
                 if (index >= positions.count)

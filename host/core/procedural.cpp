@@ -114,12 +114,13 @@ Scene sceneFromMeshes(const std::vector<Mesh>& meshes, const std::string& name) 
     s.name = name;
     for (std::size_t mi = 0; mi < meshes.size(); ++mi) {
         const Mesh& m = meshes[mi];
-        s.materials.push_back(Material{m.color});
+        s.materials.push_back(Material{m.color, m.doubleSided});
         for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
             Triangle tri{};
             tri.v0 = m.positions.at(m.indices[t]);
             tri.v1 = m.positions.at(m.indices[t + 1]);
             tri.v2 = m.positions.at(m.indices[t + 2]);
+            tri.cullBackFace = m.doubleSided ? 0u : 1u;
             s.triangles.push_back(tri);
             s.sources.push_back(TriangleSource{std::uint32_t(mi), std::uint32_t(mi), 0, std::uint32_t(t / 3)});
             s.materialOfTriangle.push_back(std::uint32_t(mi));
@@ -166,6 +167,7 @@ void writeGltf(const std::string& path, const std::vector<Mesh>& meshes, const s
         tinygltf::Material mat;
         mat.name = m.name;
         mat.pbrMetallicRoughness.baseColorFactor = {m.color.r, m.color.g, m.color.b, m.color.a};
+        mat.doubleSided = m.doubleSided;
         model.materials.push_back(mat);
         tinygltf::Primitive prim;
         prim.attributes["POSITION"] = positions;

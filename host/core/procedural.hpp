@@ -16,7 +16,14 @@ struct Mesh {
     std::vector<glm::vec3> positions;
     std::vector<std::uint32_t> indices;  // three per triangle
     glm::vec4 color{0.8f, 0.8f, 0.8f, 1.0f};
+    bool doubleSided = false;  // its material's (glTF's default: single-sided)
 };
+
+// The mesh with a double-sided material: seen from both sides (a closed mesh from inside).
+inline Mesh doubleSided(Mesh m) {
+    m.doubleSided = true;
+    return m;
+}
 
 Mesh icosphere(const glm::vec3& centre, float radius, int subdivisions);
 Mesh torus(const glm::vec3& centre, float majorRadius, float minorRadius, int majorSegments, int minorSegments);

@@ -8,6 +8,21 @@
 
 namespace dacrt {
 
+void applyCullMode(Scene& scene, CullMode mode) {
+    for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
+        const bool materialCulls =
+            i < scene.materialOfTriangle.size() && !scene.materials[scene.materialOfTriangle[i]].doubleSided;
+        const bool cull = mode == CullMode::BackFaces || (mode == CullMode::Material && materialCulls);
+        scene.triangles[i].cullBackFace = cull ? 1u : 0u;
+    }
+}
+
+std::uint64_t singleSidedTriangles(const std::vector<Triangle>& triangles) {
+    std::uint64_t n = 0;
+    for (const Triangle& t : triangles) n += t.cullBackFace != 0u;
+    return n;
+}
+
 Bounds triangleBounds(const Triangle& t) {
     Bounds b{};
     b.lo = glm::min(t.v0, glm::min(t.v1, t.v2));

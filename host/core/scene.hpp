@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/enum_names.hpp"
 #include "core/shader_layout.hpp"
 #include "core/thread_pool.hpp"
 
@@ -18,6 +19,16 @@ constexpr float kMaxCoordinate = 1e9f;
 
 struct Material {
     glm::vec4 baseColor{1.0f};
+    bool doubleSided = false;  // glTF's default: single-sided, back faces culled
+};
+
+// Which back faces no ray hits (Triangle::cullBackFace): the materials' (glTF's rule, the
+// default), none, or every triangle's.
+enum class CullMode { Material, None, BackFaces };
+template <>
+struct EnumNames<CullMode> {
+    static constexpr std::array<std::pair<CullMode, std::string_view>, 3> table{
+        {{CullMode::Material, "material"}, {CullMode::None, "none"}, {CullMode::BackFaces, "backfaces"}}};
 };
 
 // Where a flattened triangle came from in the glTF file.
@@ -58,6 +69,10 @@ struct Box {
     glm::vec3 center() const { return (lo + hi) * 0.5f; }
     glm::vec3 extent() const { return hi - lo; }
 };
+
+// Sets every triangle's cullBackFace under `mode` (from its material under CullMode::Material).
+void applyCullMode(Scene& scene, CullMode mode);
+std::uint64_t singleSidedTriangles(const std::vector<Triangle>& triangles);
 
 Bounds triangleBounds(const Triangle& t);
 // Unit normal of the triangle's plane (winding order), in double before rounding; 0 when it

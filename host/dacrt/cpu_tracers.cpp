@@ -34,6 +34,7 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
     if (onPlan && !onPlan(result.memory)) return result;
     const std::vector<Ray>& rays = *g.rays;
     const std::vector<Triangle>& tris = *g.triangles;
+    const std::size_t traced = g.tracedTriangleCount();
     result.hits.assign(rays.size(), missHit());
     const std::size_t blocks = (rays.size() + 63) / 64;
     std::atomic<std::size_t> blocksDone{0};
@@ -41,12 +42,15 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
         const std::size_t end = std::min(rays.size(), (block + 1) * 64);
         for (std::size_t i = block * 64; i < end; ++i) {
             Hit best = missHit();
-            for (std::size_t p = 0; p < tris.size(); ++p) testTriangle(rays[i], tris[p], std::uint32_t(p), best);
+            for (std::size_t k = 0; k < traced; ++k) {
+                const std::uint32_t p = g.tracedTriangle(k);
+                testTriangle(rays[i], tris[p], p, best);
+            }
             result.hits[i] = best;
         }
         if (onProgress) onProgress(double(++blocksDone) / double(blocks));
     });
-    result.counters.rayTriangleTests = std::uint64_t(rays.size()) * tris.size();
+    result.counters.rayTriangleTests = std::uint64_t(rays.size()) * traced;
     result.threads = pool.size();
     return result;
 }
@@ -54,7 +58,7 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
 TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options, const PlanHook& onPlan) {
     TraceResult result;
     const std::uint32_t rayCount = std::uint32_t(g.rays->size());
-    const std::uint32_t triCount = std::uint32_t(g.triangles->size());
+    const std::uint32_t triCount = std::uint32_t(g.tracedTriangleCount());
     planFrameInputs(g, result.memory);
     result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
     result.memory.add("triangle ids", std::uint64_t(triCount) * 4);
@@ -67,7 +71,7 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     result.hits.assign(rayCount, missHit());
     std::vector<std::uint32_t> rayIds(rayCount), triIds(triCount);
     std::iota(rayIds.begin(), rayIds.end(), 0u);
-    std::iota(triIds.begin(), triIds.end(), 0u);
+    for (std::uint32_t i = 0; i < triCount; ++i) triIds[i] = g.tracedTriangle(i);
     std::vector<std::uint32_t> scratch(scratchIds);
     PacketStorage packets(g, resolved, scratchIds, 1);
     DacrtTraversal traversal(

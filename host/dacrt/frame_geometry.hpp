@@ -1,10 +1,12 @@
 #pragma once
 // Everything a tracer reads, prepared once per frame and shared by every backend.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "core/camera.hpp"
 #include "core/scene.hpp"
 
 namespace dacrt {
@@ -18,6 +20,14 @@ struct FrameGeometry {
     float margin = 0.0f;    // filter widening, see filterMargin()
     bool raysShareStart = false;  // see raysShareStart()
     std::uint32_t imageWidth = 0;  // rays are an image's pixels, row by row, this many a row (0: unknown)
+    // Primary rays of one camera: the pyramid they lie in (the view-frustum skip needs it).
+    std::optional<ViewFrustum> frustum;
+    // The triangles a ray can hit, ascending, when a skip dropped others (triangle_skips.hpp);
+    // null: every triangle. Ids keep indexing `triangles`.
+    const std::vector<std::uint32_t>* tracedTriangles = nullptr;
+
+    std::size_t tracedTriangleCount() const { return tracedTriangles ? tracedTriangles->size() : triangles->size(); }
+    std::uint32_t tracedTriangle(std::size_t i) const { return tracedTriangles ? (*tracedTriangles)[i] : std::uint32_t(i); }
 };
 
 // Whether every ray has the first ray's origin and tmin, bit for bit (primary rays do): the

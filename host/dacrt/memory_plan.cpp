@@ -33,4 +33,17 @@ std::string MemoryPlan::describe() const {
     return s.str();
 }
 
+std::string MemoryPlan::describeWork() const {
+    std::size_t width = 0;
+    for (const WorkLine& w : work) width = std::max(width, w.name.size());
+    std::ostringstream s;
+    for (const WorkLine& w : work) {
+        char count[32];
+        std::snprintf(count, sizeof count, "%12llu", (unsigned long long)w.count);
+        s << "  " << w.name << std::string(width - w.name.size() + 2, ' ') << count << (w.why.empty() ? "" : "  " + w.why)
+          << "\n";
+    }
+    return s.str();
+}
+
 }  // namespace dacrt

@@ -9,9 +9,23 @@
 
 namespace dacrt {
 
+// One line of a frame's work plan: a count of what the frame will do or skip, and why.
+struct WorkLine {
+    std::string name;
+    std::uint64_t count = 0;
+    std::string why;
+};
+
+// The frame's plan: its memory buffer by buffer, and (`work`) what it will trace and skip,
+// with counts, in the order the stages decide it.
 struct MemoryPlan {
     std::vector<std::pair<std::string, std::uint64_t>> buffers;
+    std::vector<WorkLine> work;
     void add(const std::string& name, std::uint64_t bytes) { buffers.emplace_back(name, bytes); }
+    void addWork(const std::string& name, std::uint64_t count, const std::string& why = {}) {
+        work.push_back({name, count, why});
+    }
+    std::string describeWork() const;
     std::uint64_t total() const {
         std::uint64_t t = 0;
         for (const auto& b : buffers) t += b.second;

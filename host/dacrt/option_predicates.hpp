@@ -18,13 +18,14 @@ namespace dacrt {
 // Neighbouring triangles compute their edge tests from different edge vectors, so a ray
 // through a shared edge can miss both: the leak the benchmark measures.
 inline shared::TriangleHit intersectMollerTrumbore(const Ray& ray, const glm::vec3& p0, const glm::vec3& p1,
-                                                   const glm::vec3& p2) {
+                                                   const glm::vec3& p2, bool cullBackFace) {
     shared::TriangleHit h{false, kNoHitT, 0.0f, 0.0f};
     if (shared::triangleHasNoArea(p0, p1, p2)) return h;
     const glm::vec3 e1 = p1 - p0, e2 = p2 - p0;
     const glm::vec3 p = glm::cross(ray.dir, e2);
     const float det = glm::dot(e1, p);
     if (det == 0.0f) return h;
+    if (shared::backFaceIsCulled(cullBackFace, det)) return h;  // det = -dot(d, e1 x e2), as the rule wants
     const float inv = 1.0f / det;
     const glm::vec3 s = ray.origin - p0;
     const float u = glm::dot(s, p) * inv;
@@ -71,7 +72,7 @@ struct TriangleHitF64 {
 // edge values (the same products in the other order), so it is watertight too; its rounding
 // is about 2^-29 of float32's, far inside the benchmark's near-tie band.
 inline TriangleHitF64 intersectWatertightF64(const RayF64& ray, const glm::vec3& p0, const glm::vec3& p1,
-                                             const glm::vec3& p2) {
+                                             const glm::vec3& p2, bool cullBackFace) {
     TriangleHitF64 h;
     const glm::dvec3 a = glm::dvec3(p0) - ray.origin, b = glm::dvec3(p1) - ray.origin, c = glm::dvec3(p2) - ray.origin;
     const double ax = a[ray.kx] - ray.shear.x * a[ray.kz], ay = a[ray.ky] - ray.shear.y * a[ray.kz];
@@ -81,6 +82,8 @@ inline TriangleHitF64 intersectWatertightF64(const RayF64& ray, const glm::vec3&
     if ((eu < 0.0 || ev < 0.0 || ew < 0.0) && (eu > 0.0 || ev > 0.0 || ew > 0.0)) return h;
     const double det = eu + ev + ew;
     if (det == 0.0) return h;
+    // shared::backFaceIsCulled in float64 (rounding a tiny det to float could lose its sign).
+    if (cullBackFace && det < 0.0) return h;
     // The float32 test's rules, with float64's slack: no area, or the ray outside the box of
     // the projected vertices (docs/correctness.md).
     const double reach = std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z), std::abs(b.x), std::abs(b.y),

@@ -102,8 +102,24 @@ struct DacrtOptions {
     }
 };
 
+// The frame's skips (docs/skips.md), each exact by construction, each on unless turned off
+// (--no-skip): they change speed only.
+enum class Skip { BackFaces, Frustum, Uploads };
+template <>
+struct EnumNames<Skip> {
+    static constexpr std::array<std::pair<Skip, std::string_view>, 3> table{
+        {{Skip::BackFaces, "backfaces"}, {Skip::Frustum, "frustum"}, {Skip::Uploads, "uploads"}}};
+};
+struct SkipSwitches {
+    bool backFaces = true;  // single-sided triangles facing away from the rays' shared origin
+    bool frustum = true;    // triangles outside the camera's view frustum
+    bool uploads = true;    // gpu: triangle buffers kept on the device while the triangles do not change
+    bool operator==(const SkipSwitches&) const = default;
+};
+
 struct TraceOptions {
     Backend backend = Backend::Cpu;
+    SkipSwitches skips;
     unsigned regions = 0;   // cpu: sub-scenes; 0 means one per thread (docs/cpu-reference.md)
     unsigned threads = 0;   // 0 means every core
     DivisionAxis axis = DivisionAxis::Best;

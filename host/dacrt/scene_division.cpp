@@ -72,7 +72,8 @@ int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
                                  [&](int a, int b) { return extent[a] < extent[b]; });
     }
     const std::vector<Bounds>& tb = *g.triangleBounds;
-    const std::size_t triStride = std::max<std::size_t>(1, tb.size() / 8192);
+    const std::size_t tracedCount = g.tracedTriangleCount();
+    const std::size_t triStride = std::max<std::size_t>(1, tracedCount / 8192);
     int bestAxis = candidates.front();
     double bestCost = 1e300;
     for (int a : candidates) {
@@ -80,8 +81,10 @@ int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
         std::vector<double> rayShare(regionCount, 0.0), triShare(regionCount, 0.0);
         for (const auto& e : entries) rayShare[std::size_t(slabOf(e.first[a], boundary))] += 1.0;
         std::size_t triSamples = 0;
-        for (std::size_t i = 0; i < tb.size(); i += triStride, ++triSamples)
-            triShare[std::size_t(slabOf(0.5f * (tb[i].lo[a] + tb[i].hi[a]), boundary))] += 1.0;
+        for (std::size_t i = 0; i < tracedCount; i += triStride, ++triSamples) {
+            const Bounds& b = tb[g.tracedTriangle(i)];
+            triShare[std::size_t(slabOf(0.5f * (b.lo[a] + b.hi[a]), boundary))] += 1.0;
+        }
         double cost = 0.0;
         for (unsigned k = 0; k < regionCount; ++k)
             cost = std::max(cost, rayShare[k] / double(entries.size()) + triShare[k] / double(triSamples));
@@ -155,19 +158,22 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
         std::copy(high.begin(), high.end(), chunkHigh.begin() + std::ptrdiff_t(c * n));
     });
 
-    // Pass 1 for triangles: the range of regions whose widened slab each triangle overlaps.
-    const std::size_t triChunks = std::max<std::size_t>(1, std::min<std::size_t>(64, tb.size() / 4096 + 1));
+    // Pass 1 for triangles: the range of regions whose widened slab each traced triangle
+    // overlaps (i indexes the traced triangles; their ids are g.tracedTriangle(i)).
+    const std::size_t traced = g.tracedTriangleCount();
+    const std::size_t triChunks = std::max<std::size_t>(1, std::min<std::size_t>(64, traced / 4096 + 1));
     std::vector<std::uint32_t> triCounts(triChunks * n, 0);
-    std::vector<std::uint32_t> triFirst(tb.size()), triLast(tb.size());
-    plan.add("triangle region range (binning)", std::uint64_t(tb.size()) * 8);
+    std::vector<std::uint32_t> triFirst(traced), triLast(traced);
+    plan.add("triangle region range (binning)", std::uint64_t(traced) * 8);
     auto triChunkRange = [&](std::size_t c) {
-        return std::pair<std::size_t, std::size_t>(tb.size() * c / triChunks, tb.size() * (c + 1) / triChunks);
+        return std::pair<std::size_t, std::size_t>(traced * c / triChunks, traced * (c + 1) / triChunks);
     };
     pool.parallelFor(triChunks, [&](std::size_t c, unsigned) {
         const auto [begin, end] = triChunkRange(c);
         std::vector<std::uint32_t> counts(n, 0);
         for (std::size_t i = begin; i < end; ++i) {
-            const float lo = tb[i].lo[axis], hi = tb[i].hi[axis];
+            const Bounds& b = tb[g.tracedTriangle(i)];
+            const float lo = b.lo[axis], hi = b.hi[axis];
             int first = std::clamp(slabOf(lo, boundary) - 1, 0, int(n) - 1);
             while (first + 1 < int(n) && lo > wideHi[std::size_t(first)][axis]) ++first;
             while (first > 0 && lo <= wideHi[std::size_t(first - 1)][axis]) --first;
@@ -209,7 +215,7 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
             d.raysTowardHigh[k] |= chunkHigh[c * n + k];
         }
     d.culledRays = rays.size() - rayTotal;
-    d.straddlerCopies = triTotal - tb.size();
+    d.straddlerCopies = triTotal - traced;
     plan.add("binning counters", std::uint64_t(chunks + triChunks) * n * 8 + std::uint64_t(chunks) * n * 2);
     plan.add("region table", std::uint64_t(n) * sizeof(Region));
     plan.add("ray ids", rayTotal * 4);
@@ -218,6 +224,13 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
         d.mostRegionRays = std::max<std::uint64_t>(d.mostRegionRays, r.rayEnd - r.rayBegin);
         d.mostRegionTriangles = std::max<std::uint64_t>(d.mostRegionTriangles, r.triEnd - r.triBegin);
     }
+    std::uint64_t pairs = 0;
+    for (const TransferRound& round : transferSchedule(d)) pairs += round.pairs.size();
+    plan.addWork("rays outside the scene box", d.culledRays, "culled before division");
+    plan.addWork("regions", n, "sub-scenes along " + std::string(1, "xyz"[axis]));
+    plan.addWork("triangle copies in more than one region", d.straddlerCopies);
+    plan.addWork("transfer pairs", pairs,
+                 "of " + std::to_string(std::uint64_t(n) * (n - 1)) + "; the others have no ray that can reach their triangles");
     if (planTracer) planTracer(d, plan);
     if (onPlan && !onPlan(plan)) return d;
 
@@ -234,7 +247,7 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
         const auto [begin, end] = triChunkRange(c);
         std::vector<std::uint32_t> offset(triOffset.begin() + std::ptrdiff_t(c * n), triOffset.begin() + std::ptrdiff_t(c * n + n));
         for (std::size_t i = begin; i < end; ++i)
-            for (std::uint32_t k = triFirst[i]; k <= triLast[i]; ++k) d.triIds[offset[k]++] = std::uint32_t(i);
+            for (std::uint32_t k = triFirst[i]; k <= triLast[i]; ++k) d.triIds[offset[k]++] = g.tracedTriangle(i);
     });
     d.complete = true;
     return d;

@@ -207,6 +207,8 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
         for (int k = 0; k < 3; ++k)
             for (int c = 0; c < 3; ++c)
                 hn::Store(hn::GatherIndex(df, tri, hn::Add(base, hn::Set(di, 4 * k + c))), df, &batch.vertex[k][c][j]);
+        static_assert(offsetof(Triangle, cullBackFace) == 3 * sizeof(float));
+        hn::Store(hn::BitCast(du, hn::GatherIndex(df, tri, hn::Add(base, hn::Set(di, 3)))), du, &batch.cullBackFace[j]);
     }
 }
 
@@ -248,6 +250,9 @@ void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
             MF m = hn::AndNot(hn::And(anyNegative, anyPositive), hn::FirstN(df, batch.count - j));
             const VF det = hn::Add(hn::Add(eu, ev), ew);
             m = hn::AndNot(det == zero, m);
+            // shared::backFaceIsCulled.
+            const MF cullBackFace = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
+            m = hn::AndNot(hn::And(cullBackFace, det < zero), m);
             // Most triangles of a batch fail the edge test: the rest of the conjunction only
             // where one passes.
             if (hn::AllFalse(df, m)) continue;

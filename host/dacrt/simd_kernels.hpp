@@ -45,6 +45,7 @@ constexpr std::uint32_t kLeafBatch = 64;
 struct LeafTriangles {
     alignas(64) float vertex[3][3][kLeafBatch];
     alignas(64) std::uint32_t prim[kLeafBatch];
+    alignas(64) std::uint32_t cullBackFace[kLeafBatch];  // Triangle::cullBackFace
     std::uint32_t count = 0;
 };
 

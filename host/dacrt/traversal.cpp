@@ -384,14 +384,14 @@ void DacrtTraversal::endRaysHitInBox(const Box& box, std::uint32_t& terminated, 
 }
 
 void testTriangleMollerTrumbore(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
-    const shared::TriangleHit h = intersectMollerTrumbore(ray, tri.v0, tri.v1, tri.v2);
+    const shared::TriangleHit h = intersectMollerTrumbore(ray, tri.v0, tri.v1, tri.v2, tri.cullBackFace != 0u);
     if (h.hit && h.t > ray.tmin && shared::hitPrecedes(h.t, prim, best.t, best.prim)) best = Hit{h.t, prim, h.u, h.v};
 }
 
 void testTriangleF64(const RayF64& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
     // The float64 hit is rounded to float32 for the tie rule and the result: hits closer than
     // half a float32 ulp in depth become ties (lowest id), which the benchmark counts as near ties.
-    const TriangleHitF64 h = intersectWatertightF64(ray, tri.v0, tri.v1, tri.v2);
+    const TriangleHitF64 h = intersectWatertightF64(ray, tri.v0, tri.v1, tri.v2, tri.cullBackFace != 0u);
     if (!h.hit || !(h.t > ray.tmin)) return;
     const float t = float(h.t);
     if (shared::hitPrecedes(t, prim, best.t, best.prim)) best = Hit{t, prim, float(h.u), float(h.v)};

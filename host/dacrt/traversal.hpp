@@ -153,7 +153,7 @@ private:
 
 // Tests one ray against one triangle and keeps the better hit under the tie rule.
 inline void testTriangle(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
-    const shared::TriangleHit h = shared::intersectWatertight(ray, tri.v0, tri.v1, tri.v2);
+    const shared::TriangleHit h = shared::intersectWatertight(ray, tri.v0, tri.v1, tri.v2, tri.cullBackFace != 0u);
     if (h.hit && h.t > ray.tmin && shared::hitPrecedes(h.t, prim, best.t, best.prim)) best = Hit{h.t, prim, h.u, h.v};
 }
 

@@ -102,7 +102,8 @@ void requireRayQuery(const DeviceInfo& info) {
 }
 
 TriangleAccelerationStructure::TriangleAccelerationStructure(const Context& context, const Buffer& vertices,
-                                                             std::uint64_t triangleCount, AccelerationBuild mode) {
+                                                             std::uint64_t triangleCount, AccelerationBuild mode,
+                                                             Faces faces) {
     requireRayQuery(context.info());
     if (triangleCount == 0 || triangleCount > std::numeric_limits<std::uint32_t>::max() / 3)
         throw InputError("the rayquery backend takes 1 to " + std::to_string(std::numeric_limits<std::uint32_t>::max() / 3) +
@@ -137,7 +138,10 @@ TriangleAccelerationStructure::TriangleAccelerationStructure(const Context& cont
     m.vk.buildSizes(m.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &bottomInfo, &m.triangles, &bottomSizes);
     m.bottom = m.createStructure(context, false, bottomSizes.accelerationStructureSize, m.bottomBuffer);
 
-    // Top level: the bottom level once, untransformed, both faces.
+    // Top level: the bottom level once, untransformed; both faces, or culling allowed. Vulkan's
+    // front face is glTF's (counter-clockwise in a right-handed frame; measured on lavapipe by
+    // Cli.EveryBackendCullsTheSameBackFacesAndTheSkipsChangeNoPixel, which fails with the
+    // facing flipped), so no VK_GEOMETRY_INSTANCE_TRIANGLE_FLIP_FACING_BIT_KHR.
     m.instances = std::make_unique<Buffer>(context, sizeof(VkAccelerationStructureInstanceKHR), "instances",
                                            BufferUse::AccelerationInput);
     VkAccelerationStructureDeviceAddressInfoKHR addressInfo{};
@@ -146,7 +150,7 @@ TriangleAccelerationStructure::TriangleAccelerationStructure(const Context& cont
     VkAccelerationStructureInstanceKHR instance{};
     instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
     instance.mask = 0xFF;
-    instance.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
+    instance.flags = faces == Faces::Both ? VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR : 0u;
     instance.accelerationStructureReference = m.vk.address(m.device, &addressInfo);
     m.instances->upload(&instance, sizeof(instance));
     m.topGeometry.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR;

@@ -13,6 +13,10 @@ namespace dacrt::gpu {
 // every frame), updatable (refitted every frame), fast trace (built once).
 enum class AccelerationBuild { FastBuild, Updatable, FastTrace };
 
+// Whether the instance reports facing (FrontOnly: culling allowed, facing as glTF's
+// counter-clockwise front) or disables it (Both).
+enum class Faces { Both, FrontOnly };
+
 // Throws InputError naming the extensions the device lacks for ray queries.
 void requireRayQuery(const DeviceInfo& info);
 
@@ -22,7 +26,7 @@ public:
     // `vertices` (which must outlive the structure). Throws InputError naming what the device
     // lacks when it has no ray query.
     TriangleAccelerationStructure(const Context& context, const Buffer& vertices, std::uint64_t triangleCount,
-                                  AccelerationBuild mode);
+                                  AccelerationBuild mode, Faces faces);
     ~TriangleAccelerationStructure();
     TriangleAccelerationStructure(const TriangleAccelerationStructure&) = delete;
     TriangleAccelerationStructure& operator=(const TriangleAccelerationStructure&) = delete;

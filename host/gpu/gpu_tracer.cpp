@@ -78,6 +78,17 @@ void planMemory(GpuFrame& frame, const gpu::DeviceInfo& device, const MemoryPlan
     for (const auto& [name, bytes] : hostPlan.buffers) result.memory.add("host: " + name, bytes);
     result.memory.add("host: triangle ids per ray group", triIdCount * 4);
     gpu::addToMemoryPlan(frame.buffers, device, result.memory);
+    result.memory.work.insert(result.memory.work.end(), hostPlan.work.begin(), hostPlan.work.end());
+    const FrameGeometry& g = frame.geometry;
+    result.memory.addWork("gpu work items", frame.work.items.size(), "Step 1 and transfer pairs, per ray group");
+    const std::uint64_t uploaded = std::uint64_t(g.rays->size()) * (sizeof(Ray) + sizeof(Hit)) +
+                                   std::uint64_t(g.triangles->size()) * (sizeof(Triangle) + sizeof(Bounds)) +
+                                   std::uint64_t(frame.division.rayIds.size()) * 4 + triIdCount * 4 +
+                                   frame.work.slots.size() * sizeof(Region) + frame.work.items.size() *
+                                   (sizeof(WorkItem) + sizeof(TraversalState)) + sizeof(GpuCounters);
+    result.memory.addWork("bytes uploaded", uploaded, "rays, misses, triangles and bounds, ids, regions, work items");
+    result.memory.addWork("bytes read back", std::uint64_t(g.rays->size()) * sizeof(Hit) + frame.work.slots.size() * sizeof(Region),
+                          "hits and regions");
 }
 
 // Creates the frame's buffers and fills them.

@@ -57,8 +57,8 @@ ComputePipeline& PipelineCache::rayQuery() {
         rayQuery_ = std::make_unique<ComputePipeline>(
             context_, rayQuerySpirv(),
             std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                          VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
-            2 * sizeof(std::uint32_t), std::vector<std::uint32_t>{}, "rayquery");
+                                          VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+            3 * sizeof(std::uint32_t), std::vector<std::uint32_t>{}, "rayquery");
     return *rayQuery_;
 }
 

@@ -32,12 +32,19 @@ struct RayQueryScene::Impl {
     gpu::Buffer vertices;
     gpu::TriangleAccelerationStructure structure;
     std::unique_ptr<gpu::Buffer> rays, hits;
+    gpu::Faces faces;
     bool built = false;
 
     Impl(gpu::Context& c, gpu::PipelineCache& p, const std::vector<Triangle>& t, RayQueryBuild b)
         : context(c), pipelines(p), triangles(t), build(b),
           vertices(c, t.size() * sizeof(Triangle), "rayquery vertices", gpu::BufferUse::AccelerationInput),
-          structure(c, vertices, t.size(), accelerationBuildOf(b)) {}
+          faces(facesOf(t)), structure(c, vertices, t.size(), accelerationBuildOf(b), faces) {}
+
+    // With single-sided triangles the shader decides per candidate, from the facing the
+    // instance reports (so it must not disable facing).
+    static gpu::Faces facesOf(const std::vector<Triangle>& t) {
+        return singleSidedTriangles(t) ? gpu::Faces::FrontOnly : gpu::Faces::Both;
+    }
 };
 
 RayQueryScene::RayQueryScene(gpu::Context& context, gpu::PipelineCache& pipelines, const std::vector<Triangle>& triangles,
@@ -68,7 +75,7 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays) {
     result.phaseMs.emplace_back("upload", msSince(start));
 
     gpu::ComputePipeline& pipeline = m.pipelines.rayQuery();
-    pipeline.bind({m.rays.get(), m.hits.get(), nullptr});
+    pipeline.bind({m.rays.get(), m.hits.get(), nullptr, &m.vertices});
     pipeline.bindAccelerationStructure(2, m.structure.topLevel());
 
     // lavapipe compiles a pipeline at its first dispatch (seconds without Mesa's shader cache),
@@ -85,7 +92,8 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays) {
             recorder.buildAccelerationStructures(refit ? "refit" : "build",
                                                  [&](VkCommandBuffer commands) { m.structure.record(commands, refit); });
         for (std::uint32_t done = 0; traceSteps && done < groups; done += perDispatch) {
-            const std::uint32_t push[2] = {std::uint32_t(rays.size()), done * kRaysPerWorkgroup};
+            const std::uint32_t push[3] = {std::uint32_t(rays.size()), done * kRaysPerWorkgroup,
+                                           m.faces == gpu::Faces::FrontOnly ? 1u : 0u};
             recorder.dispatch("trace", pipeline, std::min(perDispatch, groups - done), push);
         }
         recorder.submitAndWait();
@@ -96,7 +104,7 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays) {
         if (rebuild || refit) runSteps(true, false);
         const auto compileStart = Clock::now();
         gpu::DispatchRecorder recorder(m.context, 1);
-        const std::uint32_t noRays[2] = {0, 0};
+        const std::uint32_t noRays[3] = {0, 0, 0};
         recorder.dispatch("prime", pipeline, 1, noRays);
         recorder.submitAndWait();
         m.pipelines.markRayQueryPrimed();

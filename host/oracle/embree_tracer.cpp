@@ -115,6 +115,23 @@ RTCBuildQuality geometryQualityOf(EmbreeBuild build) {
     return RTC_BUILD_QUALITY_MEDIUM;
 }
 
+// dacrt's face rule (shaders/triangle_rules.glsl) as Embree 3 users apply it without a build
+// of their own (EMBREE_BACKFACE_CULLING is a compile-time option, off in Debian's): an
+// intersection filter that rejects the back faces of single-sided triangles. Called only for
+// candidate hits, so a frame pays for it per hit found, not per test.
+void rejectCulledBackFaces(const RTCFilterFunctionNArguments* args) {
+    const auto& triangles = *static_cast<const std::vector<Triangle>*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const Triangle& t = triangles[RTCHitN_primID(args->hit, args->N, i)];
+        if (!t.cullBackFace) continue;
+        const glm::dvec3 n = glm::cross(glm::dvec3(t.v1) - glm::dvec3(t.v0), glm::dvec3(t.v2) - glm::dvec3(t.v0));
+        const glm::dvec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                           RTCRayN_dir_z(args->ray, args->N, i));
+        if (glm::dot(n, d) >= 0.0) args->valid[i] = 0;
+    }
+}
+
 Hit hitOf(float tfar, unsigned geomID, unsigned primID, float u, float v) {
     if (geomID == RTC_INVALID_GEOMETRY_ID) return Hit{kNoHitT, kMissPrim, 0.0f, 0.0f};
     return Hit{tfar, primID, u, v};  // Embree's u and v weight v1 and v2, as dacrt's do
@@ -194,6 +211,11 @@ EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOpt
                                    identityIndices(triangles.size()).data(), 0, 3 * sizeof(std::uint32_t),
                                    triangles.size());
         impl_->check("rtcSetSharedGeometryBuffer(index)");
+        if (singleSidedTriangles(triangles) > 0) {
+            rtcSetGeometryUserData(geometry.get(), const_cast<std::vector<Triangle>*>(&triangles));
+            rtcSetGeometryIntersectFilterFunction(geometry.get(), &rejectCulledBackFaces);
+            impl_->check("rtcSetGeometryIntersectFilterFunction");
+        }
         rtcCommitGeometry(geometry.get());
         impl_->check("rtcCommitGeometry");
         rtcAttachGeometry(impl_->scene, geometry.get());

@@ -123,7 +123,7 @@ private:
             for (std::size_t j = triBegin; j < triEnd; ++j) {
                 const std::uint32_t prim = triIds_[j];
                 const Triangle& t = triangles_[prim];
-                const TriangleHitF64 h = intersectWatertightF64(ray, t.v0, t.v1, t.v2);
+                const TriangleHitF64 h = intersectWatertightF64(ray, t.v0, t.v1, t.v2, t.cullBackFace != 0u);
                 if (h.hit && h.t > ray.tmin && (h.t < best.t || (h.t == best.t && prim < best.prim)))
                     best = ReferenceHit{h.t, prim};
             }
@@ -196,7 +196,7 @@ std::vector<ReferenceHit> traceReferenceBrute(const std::vector<Triangle>& trian
         ReferenceHit best{kInf, kMissPrim};
         for (std::uint32_t prim = 0; prim < triangles.size(); ++prim) {
             const Triangle& t = triangles[prim];
-            const TriangleHitF64 h = intersectWatertightF64(ray, t.v0, t.v1, t.v2);
+            const TriangleHitF64 h = intersectWatertightF64(ray, t.v0, t.v1, t.v2, t.cullBackFace != 0u);
             if (h.hit && h.t > ray.tmin && (h.t < best.t || (h.t == best.t && prim < best.prim)))
                 best = ReferenceHit{h.t, prim};
         }

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include "support/cli_support.hpp"
 #include "support/hostile_gltf.hpp"
 #include "support/frames.hpp"
+#include "core/procedural.hpp"
 
 namespace {
 
@@ -368,4 +370,64 @@ TEST(Cli, SamplesPerPixelAntialiasTheShadedImageOnly) {
     const CommandResult bad = run("render " + scene + " --size 8x6 --spp 3 -o " + temp("spp3.png"));
     EXPECT_EQ(bad.code, 2) << bad.output;
     EXPECT_NE(bad.output.find("a square"), std::string::npos) << bad.output;
+}
+
+// An open box seen from inside (its walls face outward, so the camera sees their backs) with
+// shapes in front of the camera and one behind it: glTF's default material is single-sided.
+static std::string insideOutScene() {
+    const std::string path = temp("inside_out.glb");
+    dacrt::SceneCamera camera;
+    camera.eye = glm::dvec3(0.1, 0.05, 0.2);
+    camera.forward = glm::normalize(glm::dvec3(-0.1, -0.25, -1.0));
+    camera.up = glm::normalize(glm::cross(glm::cross(camera.forward, glm::dvec3(0, 1, 0)), camera.forward));
+    camera.yfovRadians = 1.2;
+    dacrt::writeGltf(path,
+                     {dacrt::box({-3, -2, -4}, {3, 2, 4}), dacrt::icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2),
+                      dacrt::torus({-1.0f, -0.5f, -2.5f}, 0.6f, 0.2f, 24, 12), dacrt::icosphere({0.0f, 0.0f, 2.5f}, 0.5f, 1)},
+                     camera);
+    return path;
+}
+
+// Every backend culls the same back faces (glTF's rule), with the skips on, as brute force
+// does with them off: cpu-seq, cpu and gpu bit for bit, the peers within their own rounding.
+TEST(Cli, EveryBackendCullsTheSameBackFacesAndTheSkipsChangeNoPixel) {
+    const std::string scene = insideOutScene(), ref = temp("cull_ref.exr");
+    ASSERT_EQ(run("render " + scene + " --size 48x32 --backend brute --no-skip backfaces,frustum --aov " + ref).code, 0);
+    const std::string none = temp("cull_none.exr");
+    ASSERT_EQ(run("render " + scene + " --size 48x32 --backend cpu --cull none --aov " + none).code, 0);
+    EXPECT_EQ(run("compare " + ref + " " + none + " --fail-on any").code, 1) << "the walls' backs show without the rule";
+    const bool vulkan = run("devices").code == 0;
+    for (const std::string backend : {"brute", "cpu-seq", "cpu", "gpu", "embree", "rayquery"}) {
+        if (!vulkan && (backend == "gpu" || backend == "rayquery")) continue;
+        const std::string out = temp("cull_" + backend + ".exr");
+        std::filesystem::remove(out);
+        const CommandResult r = run("render " + scene + " --size 48x32 --backend " + backend +
+                                    (backend == "gpu" || backend == "rayquery" ? " --validate" : "") + " --aov " + out);
+        if (backend == "rayquery" && r.code == 2 && r.output.find("VK_KHR_ray_query") != std::string::npos) continue;
+        ASSERT_EQ(r.code, 0) << backend << ": " << r.output;
+        const bool peer = backend == "embree" || backend == "rayquery";
+        const CommandResult c =
+            run("compare " + ref + " " + out + (peer ? " --fail-on differ --depth-tolerance 1e-5" : " --fail-on any"));
+        EXPECT_EQ(c.code, 0) << backend << ": " << c.output;
+    }
+}
+
+TEST(Cli, PlanAndStatsListEverySkipWithItsCounts) {
+    const std::string scene = insideOutScene(), stats = temp("skips.json");
+    const CommandResult plan = run("render " + scene + " --size 48x32 --plan");
+    ASSERT_EQ(plan.code, 0) << plan.output;
+    for (const char* line : {"work plan", "skipped: back-facing", "skipped: outside the view frustum", "triangles traced",
+                             "rays outside the scene box", "transfer pairs", "memory plan"})
+        EXPECT_NE(plan.output.find(line), std::string::npos) << line << "\n" << plan.output;
+    ASSERT_EQ(run("render " + scene + " --size 48x32 --stats " + stats).code, 0);
+    std::ifstream f(stats);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    std::map<std::string, std::uint64_t> counts;
+    for (const auto& line : j["work_plan"]) counts[line["name"]] = line["count"];
+    EXPECT_GT(counts["skipped: back-facing"], 12u) << "the box's walls and the spheres' far sides";
+    EXPECT_GT(counts["skipped: outside the view frustum"], 0u) << "the sphere behind the camera";
+    EXPECT_EQ(counts["triangles traced"] + counts["skipped: back-facing"] + counts["skipped: outside the view frustum"],
+              counts["triangles"]);
+    const CommandResult off = run("render " + scene + " --size 48x32 --plan --no-skip backfaces,frustum");
+    EXPECT_NE(off.output.find("skip off (--no-skip)"), std::string::npos) << off.output;
 }

@@ -30,13 +30,13 @@ TEST(OptionPredicates, MollerTrumboreAgreesWithWatertightAwayFromEdges) {
     const Triangle left{{-1, -1, -2}, 0, {0, -1, -2}, 0, {0, 1, -2}, 0};
     const Triangle right{{0, -1, -2}, 0, {1, -1, -2}, 0, {0, 1, -2}, 0};
     const Ray ray = makeRay(glm::vec3(0.0f), {-0.5, -0.2, -2});
-    const shared::TriangleHit mt = intersectMollerTrumbore(ray, left.v0, left.v1, left.v2);
-    const shared::TriangleHit wt = shared::intersectWatertight(ray, left.v0, left.v1, left.v2);
+    const shared::TriangleHit mt = intersectMollerTrumbore(ray, left.v0, left.v1, left.v2, false);
+    const shared::TriangleHit wt = shared::intersectWatertight(ray, left.v0, left.v1, left.v2, false);
     ASSERT_TRUE(mt.hit && wt.hit);
     EXPECT_NEAR(mt.t, wt.t, 1e-6 * wt.t);
     EXPECT_NEAR(mt.u, wt.u, 1e-5);
     EXPECT_NEAR(mt.v, wt.v, 1e-5);
-    EXPECT_FALSE(intersectMollerTrumbore(ray, right.v0, right.v1, right.v2).hit);
+    EXPECT_FALSE(intersectMollerTrumbore(ray, right.v0, right.v1, right.v2, false).hit);
 }
 
 }  // namespace

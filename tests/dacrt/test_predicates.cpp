@@ -117,7 +117,7 @@ TEST(Watertight, RaysThroughSharedEdgesAndVerticesAlwaysHit) {
         const glm::vec3 target = i % 2 ? t.v0 : t.v0 + rng.uniformFloat(0.0f, 1.0f) * (t.v1 - t.v0);
         const Ray r = makeRay(origin, glm::dvec3(target) - glm::dvec3(origin));
         bool hit = false;
-        for (const Triangle& f : fan) hit |= shared::intersectWatertight(r, f.v0, f.v1, f.v2).hit;
+        for (const Triangle& f : fan) hit |= shared::intersectWatertight(r, f.v0, f.v1, f.v2, false).hit;
         ASSERT_TRUE(hit) << "ray " << i << " leaked through the fan";
     }
 }
@@ -126,11 +126,11 @@ TEST(Watertight, DegenerateTrianglesNeverHitAndNeverGiveNaN) {
     const Ray r = makeRay({0.2f, 0.2f, 5.0f}, {0.0, 0.0, -1.0});
     const glm::vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
     for (const auto& [p, q, s] : std::vector<std::array<glm::vec3, 3>>{{a, a, a}, {a, b, b}, {a, b, 0.5f * (a + b)}}) {
-        const shared::TriangleHit h = shared::intersectWatertight(r, p, q, s);
+        const shared::TriangleHit h = shared::intersectWatertight(r, p, q, s, false);
         EXPECT_FALSE(h.hit);
         EXPECT_FALSE(std::isnan(h.t));
     }
-    const shared::TriangleHit h = shared::intersectWatertight(r, a, b, c);
+    const shared::TriangleHit h = shared::intersectWatertight(r, a, b, c, false);
     ASSERT_TRUE(h.hit);
     EXPECT_FLOAT_EQ(h.t, 5.0f);
     EXPECT_FLOAT_EQ(h.u, 0.2f);
@@ -148,7 +148,7 @@ TEST(Watertight, AZeroAreaTriangleOnTheRaysLineIsNeverHit) {
     const glm::vec3 p2{-0x1.880e0ap-2f, -0x1.a2212cp-4f, 0x1.da265p-2f};
     const Ray ray = makeRay(origin, glm::dvec3(p0) - glm::dvec3(origin));
     EXPECT_TRUE(shared::triangleHasNoArea(p0, p1, p2));
-    EXPECT_FALSE(shared::intersectWatertight(ray, p0, p1, p2).hit);
+    EXPECT_FALSE(shared::intersectWatertight(ray, p0, p1, p2, false).hit);
 }
 
 // The defect found on a scanned mesh: a sliver one unit in the last place wide, seen end-on
@@ -168,7 +168,7 @@ TEST(Watertight, AnEndOnSliverFarFromTheRayIsNeverHit) {
     const glm::vec3 p1{0x1.91c302p+3f, 0x1.10341p+2f, 0x1.1a03fp-3f};
     const glm::vec3 p2{0x1.91c3p+3f, 0x1.10341p+2f, -0x1.6e537p-4f};
     EXPECT_FALSE(shared::triangleHasNoArea(p0, p1, p2));
-    EXPECT_FALSE(shared::intersectWatertight(rays[4848], p0, p1, p2).hit);
+    EXPECT_FALSE(shared::intersectWatertight(rays[4848], p0, p1, p2, false).hit);
 }
 
 // The same search at scale: segments along the view axis (x and y shared exactly, zero area)
@@ -193,7 +193,7 @@ TEST(Watertight, EndOnSegmentsAndSliversAreHitOnlyWhereTheRayMeetsThem) {
         slivers += !noArea;
         const glm::vec3 lo = glm::min(p0, glm::min(p1, p2)), hi = glm::max(p0, glm::max(p1, p2));
         for (const Ray& r : rays) {
-            const shared::TriangleHit h = shared::intersectWatertight(r, p0, p1, p2);
+            const shared::TriangleHit h = shared::intersectWatertight(r, p0, p1, p2, false);
             if (!h.hit) continue;
             zeroAreaHits += noArea;
             const glm::dvec3 at = glm::dvec3(r.origin) + double(h.t) * glm::dvec3(r.dir);

@@ -191,6 +191,7 @@ TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
                 t.v0 = rng.uniform() < 0.6 ? hub : offset + rng.vec3(-1.0f, 1.0f) * scale;
                 t.v1 = offset + rng.vec3(-1.0f, 1.0f) * scale;
                 t.v2 = rng.uniform() < 0.1 ? t.v1 : offset + rng.vec3(-1.0f, 1.0f) * scale;  // some have no area
+                t.cullBackFace = rng.uniform() < 0.5 ? 1u : 0u;  // the face rule in half the lanes
             }
             std::vector<Ray> rays(40);
             for (Ray& r : rays) {

@@ -110,7 +110,7 @@ TEST(BackendsAgree, ProceduralShapesOrbit) {
 
 TEST(BackendsAgree, CameraInsideTheScene) {
     // A closed box around the camera: every ray must hit, in every backend.
-    std::vector<Mesh> meshes = {box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2),
+    std::vector<Mesh> meshes = {doubleSided(box({-3, -2, -4}, {3, 2, 4})), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2),
                                 torus({-1.0f, -0.5f, 1.5f}, 0.6f, 0.2f, 24, 12)};
     CameraOptions o;
     o.eye = glm::dvec3(0.1, 0.05, 0.2);
@@ -203,8 +203,8 @@ TEST(BackendsAgree, NearlyCoincidentWallsAcrossASplitPlane) {
     // gap, so the far wall sometimes wins by t. A cell must then still test the far wall,
     // which is what the filter margin guarantees (docs/correctness.md).
     const float below = std::nextafter(1.0f, 0.0f), above = std::nextafter(1.0f, 2.0f);
-    std::vector<Mesh> meshes = {grid({below, -4, -4}, {0, 8, 0}, {0, 0, 8}, 9, 7),
-                                grid({above, -4, -4}, {0, 8, 0}, {0, 0, 8}, 7, 9),
+    std::vector<Mesh> meshes = {doubleSided(grid({below, -4, -4}, {0, 8, 0}, {0, 0, 8}, 9, 7)),
+                                doubleSided(grid({above, -4, -4}, {0, 8, 0}, {0, 0, 8}, 7, 9)),
                                 grid({0, -4, -4}, {0, 0.1f, 0}, {0, 0, 0.1f}, 1, 1),   // pins the bounds at x = 0
                                 grid({2, 3.9f, 3.9f}, {0, 0.1f, 0}, {0, 0, 0.1f}, 1, 1)};  // and x = 2
     const Scene s = sceneFromMeshes(meshes);

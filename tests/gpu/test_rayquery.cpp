@@ -52,7 +52,7 @@ std::size_t unconfirmedPrimitives(const std::vector<Ray>& rays, const std::vecto
             continue;
         }
         const Triangle& t = triangles[h.prim];
-        const shared::TriangleHit w = shared::intersectWatertight(rays[i], t.v0, t.v1, t.v2);
+        const shared::TriangleHit w = shared::intersectWatertight(rays[i], t.v0, t.v1, t.v2, t.cullBackFace != 0u);
         n += !w.hit || std::abs(double(w.t) - double(h.t)) > 1e-4 * double(h.t);
     }
     return n;

@@ -157,7 +157,7 @@ TEST(EmbreeAgreesWithBrute, PixelCentresOnSharedEdges) {
 
 TEST(EmbreeAgreesWithBrute, InsideClosedMeshesLookingAtEdgesAndCorners) {
     // From inside a closed mesh every ray must hit: a miss is a leak through an edge or vertex.
-    std::vector<Mesh> meshes = {box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)};
+    std::vector<Mesh> meshes = {doubleSided(box({-3, -2, -4}, {3, 2, 4})), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)};
     const Scene s = sceneFromMeshes(meshes);
     // Towards a corner of the box (where three faces meet) and the middles of two of its edges.
     for (const glm::dvec3& target : {glm::dvec3(3, 2, 4), glm::dvec3(-3, 0, -4), glm::dvec3(0, -2, 4)}) {
@@ -168,7 +168,7 @@ TEST(EmbreeAgreesWithBrute, InsideClosedMeshesLookingAtEdgesAndCorners) {
     }
     // A closed curved mesh from its centre, the centre ray aimed at one of the icosahedron's
     // original vertices, where five triangles meet.
-    const std::vector<Mesh> sphere = {icosphere({0, 0, 0}, 1.0f, 4)};
+    const std::vector<Mesh> sphere = {doubleSided(icosphere({0, 0, 0}, 1.0f, 4))};
     const Scene sphereScene = sceneFromMeshes(sphere);
     const double golden = (1.0 + std::sqrt(5.0)) / 2.0;
     const Frame inside(sceneFromMeshes(sphere),

@@ -22,7 +22,7 @@ using test::sameReference;
 
 Scene shapesWithFloorGrid() {
     return sceneFromMeshes({icosphere({0, 0, 0}, 1.0f, 3), torus({2.5f, 0, 0}, 1.0f, 0.3f, 24, 12),
-                            box({-3.5f, -1, -1}, {-2, 1, 1}), grid({-4, -1.2f, -2}, {8, 0, 0}, {0, 0, 4}, 16, 8)},
+                            box({-3.5f, -1, -1}, {-2, 1, 1}), doubleSided(grid({-4, -1.2f, -2}, {8, 0, 0}, {0, 0, 4}, 16, 8))},
                            "shapes");
 }
 

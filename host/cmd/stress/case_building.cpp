@@ -19,7 +19,7 @@ std::vector<Triangle> trianglesOf(const std::vector<Mesh>& meshes) {
     std::vector<Triangle> out;
     for (const Mesh& m : meshes)
         for (std::size_t i = 0; i + 2 < m.indices.size(); i += 3)
-            out.push_back(Triangle{m.positions[m.indices[i]], 0.0f, m.positions[m.indices[i + 1]], 0.0f,
+            out.push_back(Triangle{m.positions[m.indices[i]], 0u, m.positions[m.indices[i + 1]], 0.0f,
                                    m.positions[m.indices[i + 2]], 0.0f});
     return out;
 }
