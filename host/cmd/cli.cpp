@@ -113,6 +113,31 @@ void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     addEnumOption(cmd, "--precision", o.precision, "leaf ray/triangle arithmetic (cpu, cpu-seq)");
 }
 
+// The camera options of render and bench, as text until the command runs.
+struct CameraText {
+    std::string eye, target, up;
+    double fov = 0.0;
+};
+
+void addCameraOptions(CLI::App* cmd, CameraText& t) {
+    cmd->add_option("--eye", t.eye, "camera position x,y,z (default: the scene's camera, else a front view framing the scene)");
+    cmd->add_option("--target", t.target, "point the camera looks at x,y,z");
+    cmd->add_option("--up", t.up, "camera up vector x,y,z (default: the scene camera's, else +y)");
+    cmd->add_option("--fov", t.fov, "vertical field of view in degrees (default: the scene camera's, else 45)");
+}
+
+void applyCameraOptions(const CLI::App& cmd, const CameraText& t, CameraOptions& o) {
+    if (!t.eye.empty()) o.eye = parseVec3("--eye", t.eye);
+    if (!t.target.empty()) o.target = parseVec3("--target", t.target);
+    if (!t.up.empty()) o.up = parseVec3("--up", t.up);
+    if (cmd.count("--fov")) {
+        if (!(t.fov > 0.0 && t.fov < 180.0))
+            throw InputError("--fov: the vertical field of view must lie strictly between 0 and 180 degrees, got " +
+                             std::to_string(t.fov));
+        o.fovDegrees = t.fov;
+    }
+}
+
 // --no-skip LIST: the skips (options.hpp, Skip) to turn off, to measure what each saves.
 void addSkipListOption(CLI::App* cmd, SkipSwitches& skips) {
     cmd->add_option_function<std::vector<std::string>>(
@@ -145,8 +170,8 @@ void addDeviceOptions(CLI::App* cmd, DeviceChoice& devices) {
 Subcommand addRenderCommand(CLI::App& app) {
     struct State {
         RenderOptions render;
-        std::string size = "640x480", eye, target, up;
-        double fov = 0.0;
+        std::string size = "640x480";
+        CameraText camera;
         bool embreeFast = false, embreeSingleRays = false;
     };
     auto s = std::make_shared<State>();
@@ -172,10 +197,7 @@ Subcommand addRenderCommand(CLI::App& app) {
     cmd->add_flag("--embree-fast", s->embreeFast, "without RTC_SCENE_FLAG_ROBUST: faster, leaks through edges (embree)");
     cmd->add_flag("--embree-single-rays", s->embreeSingleRays,
                   "one rtcIntersect1 per ray instead of 16-wide packets on 4x4 tiles (embree)");
-    cmd->add_option("--eye", s->eye, "camera position x,y,z (default: the scene's camera, else a front view framing the scene)");
-    cmd->add_option("--target", s->target, "point the camera looks at x,y,z");
-    cmd->add_option("--up", s->up, "camera up vector x,y,z (default: the scene camera's, else +y)");
-    cmd->add_option("--fov", s->fov, "vertical field of view in degrees (default: the scene camera's, else 45)");
+    addCameraOptions(cmd, s->camera);
     cmd->add_option("--orbit", render.camera.orbit, "K cameras on a circle about the vertical axis through the scene's centre")
         ->check(CLI::Range(1, 100000))->default_str("1");
     cmd->add_flag("--plan", render.planOnly, "print the work plan (what is traced and skipped) and the memory plan, and stop before tracing");
@@ -194,15 +216,7 @@ Subcommand addRenderCommand(CLI::App& app) {
     return {cmd, [s, cmd] {
                 RenderOptions& r = s->render;
                 parseSize(s->size, r.width, r.height);
-                if (!s->eye.empty()) r.camera.eye = parseVec3("--eye", s->eye);
-                if (!s->target.empty()) r.camera.target = parseVec3("--target", s->target);
-                if (!s->up.empty()) r.camera.up = parseVec3("--up", s->up);
-                if (cmd->count("--fov")) {
-                    if (!(s->fov > 0.0 && s->fov < 180.0))
-                        throw InputError("--fov: the vertical field of view must lie strictly between 0 and 180 "
-                                         "degrees, got " + std::to_string(s->fov));
-                    r.camera.fovDegrees = s->fov;
-                }
+                applyCameraOptions(*cmd, s->camera, r.camera);
                 r.request.embree.robust = !s->embreeFast;
                 r.request.embree.packets = !s->embreeSingleRays;
                 r.request.embree.imageWidth = std::uint32_t(r.width);
@@ -299,6 +313,7 @@ Subcommand addBenchCommand(CLI::App& app) {
     struct State {
         BenchCommand bench;
         std::string size = "640x480";
+        CameraText camera;
         bool noCache = false;
     };
     auto s = std::make_shared<State>();
@@ -309,9 +324,10 @@ Subcommand addBenchCommand(CLI::App& app) {
                          "backends (default: cpu-seq,cpu,gpu,embree,rayquery; gpu with a Vulkan device, "
                          "rayquery with one that has ray query)", enumNameList<Backend>());
     addEnumOption(cmd, "--suite", bench.suite,
-                  "sweep (every option value), peers (each DACRT default against every embree and rayquery mode) "
-                  "or table51 (the source's Table 5.1 and Figure 5.3)");
+                  "sweep (every option value), peers (each DACRT default against every embree and rayquery mode), "
+                  "skips (each skip of the work plan off in turn) or table51 (the source's Table 5.1 and Figure 5.3)");
     cmd->add_option("--orbit", bench.orbit, "K cameras on a circle about the vertical axis")->check(CLI::Range(1, 1000))->default_str("1");
+    addCameraOptions(cmd, s->camera);
     cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
     cmd->add_option("--repeat", bench.repeat, "timed frames per camera and configuration")->check(CLI::Range(1, 1000))->default_str("3");
     cmd->add_option("--warmup", bench.warmup, "untimed frames first")->check(CLI::Range(0, 1000))->default_str("1");
@@ -322,8 +338,9 @@ Subcommand addBenchCommand(CLI::App& app) {
     cmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
     cmd->add_flag("--no-cache", s->noCache, "always recompute the float64 reference");
     addDeviceOptions(cmd, bench.devices);
-    return {cmd, [s] {
+    return {cmd, [s, cmd] {
                 parseSize(s->size, s->bench.width, s->bench.height);
+                applyCameraOptions(*cmd, s->camera, s->bench.camera);
                 s->bench.useCache = !s->noCache;
                 return runBenchCommand(s->bench);
             }};

@@ -292,6 +292,70 @@ void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
     }
 }
 
+// facesAwayFrom in float32 with a bound on its rounding (docs/correctness.md, "Skips"):
+// side = ((v1 - v0) x (v2 - v0)) . (v0 - o) is within 10 u |e1|_1 |e2|_1 |a|_1 of the float64
+// value, taken as 32 u; q > 480 u L + 200 u^2 R is certified with a factor 1.001 for the
+// roundings of q, the square roots and the bound.
+// Lanes whose lengths fall below 1e-10 (where float32 products could underflow) stay undecided.
+void ClassifyFacing(const Triangle* triangles, std::uint32_t count, const glm::vec3& origin, std::uint8_t* verdict) {
+    const DF df;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    const float* tri = reinterpret_cast<const float*>(triangles);
+    const VF zero = hn::Zero(df);
+    const VF o[3] = {hn::Set(df, origin.x), hn::Set(df, origin.y), hn::Set(df, origin.z)};
+    constexpr float u = 0x1p-24f;
+    const VF errorScale = hn::Set(df, 32.0f * u), tiny = hn::Set(df, 1e-10f), margin = hn::Set(df, 1.001f);
+    const VF perEdge = hn::Set(df, 480.0f * u), perReach = hn::Set(df, 200.0f * u * u);
+    // Consecutive triangles, so plain loads into lanes: gathers are the slower way here
+    // (AMD Zen 5: this kernel ran 1.5x faster on SSE4's emulated gathers than on AVX-512's).
+    alignas(64) float soa[10][64];
+    for (std::uint32_t j = 0; j < count; j += std::uint32_t(n)) {
+        const std::uint32_t here = std::min<std::uint32_t>(std::uint32_t(n), count - j);
+        for (std::uint32_t l = 0; l < n; ++l) {
+            const float* t = tri + std::size_t(j + std::min(l, here - 1)) * 12;
+            for (int f = 0; f < 3; ++f) soa[f][l] = t[f], soa[3 + f][l] = t[4 + f], soa[6 + f][l] = t[8 + f];
+            soa[9][l] = t[3];
+        }
+        VF v[3][3];
+        for (int k = 0; k < 3; ++k)
+            for (int c = 0; c < 3; ++c) v[k][c] = hn::Load(df, soa[3 * k + c]);
+        const auto single = hn::RebindMask(df, hn::BitCast(du, hn::Load(df, soa[9])) != hn::Zero(du));
+        VF a[3], b[3], c[3], e1[3], e2[3], e3[3];
+        for (int k = 0; k < 3; ++k) {
+            a[k] = hn::Sub(v[0][k], o[k]);
+            b[k] = hn::Sub(v[1][k], o[k]);
+            c[k] = hn::Sub(v[2][k], o[k]);
+            e1[k] = hn::Sub(v[1][k], v[0][k]);
+            e2[k] = hn::Sub(v[2][k], v[0][k]);
+            e3[k] = hn::Sub(v[2][k], v[1][k]);
+        }
+        const VF nx = hn::Sub(hn::Mul(e1[1], e2[2]), hn::Mul(e1[2], e2[1]));
+        const VF ny = hn::Sub(hn::Mul(e1[2], e2[0]), hn::Mul(e1[0], e2[2]));
+        const VF nz = hn::Sub(hn::Mul(e1[0], e2[1]), hn::Mul(e1[1], e2[0]));
+        const VF side = hn::Add(hn::Add(hn::Mul(nx, a[0]), hn::Mul(ny, a[1])), hn::Mul(nz, a[2]));
+        auto norm1 = [](const VF (&x)[3]) { return hn::Add(hn::Add(hn::Abs(x[0]), hn::Abs(x[1])), hn::Abs(x[2])); };
+        auto dot = [](const VF (&x)[3]) { return hn::Add(hn::Add(hn::Mul(x[0], x[0]), hn::Mul(x[1], x[1])), hn::Mul(x[2], x[2])); };
+        const VF n1 = norm1(e1), n2 = norm1(e2), na = norm1(a);
+        const VF error = hn::Mul(errorScale, hn::Mul(hn::Mul(n1, n2), na));
+        const MF inRange = hn::And(hn::And(n1 >= tiny, n2 >= tiny), na >= tiny);
+        const VF r2 = hn::Max(hn::Max(dot(a), dot(b)), dot(c));
+        const VF l2 = hn::Max(hn::Max(dot(e1), dot(e2)), dot(e3));
+        const MF keep = hn::Or(hn::Not(single), hn::And(inRange, hn::Add(side, error) < zero));
+        const VF low = hn::Sub(side, error);
+        const VF q = hn::Div(low, r2);
+        const VF bound = hn::Mul(margin, hn::Add(hn::Mul(perEdge, hn::Sqrt(l2)), hn::Mul(perReach, hn::Sqrt(r2))));
+        const MF drop = hn::AndNot(hn::Not(single), hn::And(inRange, hn::And(low > zero, q > bound)));
+        alignas(64) std::uint8_t keepBits[8] = {}, dropBits[8] = {};
+        hn::StoreMaskBits(df, keep, keepBits);
+        hn::StoreMaskBits(df, drop, dropBits);
+        const std::uint32_t keepMask = std::uint32_t(keepBits[0]) | std::uint32_t(keepBits[1]) << 8;
+        const std::uint32_t dropMask = std::uint32_t(dropBits[0]) | std::uint32_t(dropBits[1]) << 8;
+        for (std::uint32_t l = 0; l < here; ++l)
+            verdict[j + l] = (keepMask >> l & 1u) ? kKeep : (dropMask >> l & 1u) ? kDrop : kUndecided;
+    }
+}
+
 std::int64_t CompiledTarget() { return HWY_TARGET; }
 
 }  // namespace HWY_NAMESPACE
@@ -306,6 +370,11 @@ HWY_EXPORT(PartitionTrianglesOnFace);
 HWY_EXPORT(IntersectBatch);
 HWY_EXPORT(GatherLeafTriangles);
 HWY_EXPORT(CompiledTarget);
+HWY_EXPORT(ClassifyFacing);
+
+void classifyFacing(const Triangle* triangles, std::uint32_t count, const glm::vec3& origin, std::uint8_t* verdict) {
+    HWY_DYNAMIC_DISPATCH(ClassifyFacing)(triangles, count, origin, verdict);
+}
 
 std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
                                         const Box& cell, bool raysShareStart, std::uint32_t* scratch) {

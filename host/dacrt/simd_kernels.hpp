@@ -60,6 +60,13 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                     const LeafTriangles& batch);
 
+// The back-face skip's verdict on triangles[0, count) seen from origin, certified in float32
+// lanes: kKeep where facesAwayFrom (triangle_skips.hpp, float64) is false (front-facing, or not
+// single-sided), kDrop where it is true, kUndecided where float32 cannot tell within its
+// error bound (the caller then asks facesAwayFrom). Never kKeep or kDrop against it.
+enum FacingVerdict : std::uint8_t { kKeep = 0, kDrop = 1, kUndecided = 2 };
+void classifyFacing(const Triangle* triangles, std::uint32_t count, const glm::vec3& origin, std::uint8_t* verdict);
+
 // The instruction set the kernels run on now ("AVX3" is AVX-512), and every one this
 // binary holds that the machine supports, best first.
 std::string activeTarget();

@@ -17,9 +17,10 @@ struct TriangleSkips {
     bool applied = false;                // false: nothing dropped, every triangle traced
     std::vector<std::uint32_t> traced;   // the kept ids, ascending (when applied)
     Box tracedBox;                       // their exact bounds (when applied)
-    std::uint64_t singleSided = 0;       // triangles whose back face is culled (Triangle::cullBackFace)
+    std::uint64_t singleSided = 0;       // triangles whose back face is culled (counted when applied)
     std::uint64_t backFacing = 0;        // dropped: single-sided, facing away from the shared origin
     std::uint64_t outsideFrustum = 0;    // dropped: outside the view frustum (and not back-facing)
+    bool frustumTested = false;          // false where the scene box lies inside the view
 };
 
 // Whether a single-sided triangle faces away from `origin` by a margin that no rounding of the

@@ -1,6 +1,7 @@
 // The SIMD kernels against the scalar predicates they replace, on every instruction set this
 // binary holds that the machine runs: same ids in the same order, same hits bit for bit.
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -13,6 +14,7 @@
 #include "dacrt/predicates.hpp"
 #include "dacrt/simd_kernels.hpp"
 #include "dacrt/traversal.hpp"
+#include "dacrt/triangle_skips.hpp"
 
 using namespace dacrt;
 
@@ -277,4 +279,47 @@ TEST(SimdTargets, TheBestIsChosenByDefaultAndForcingAnUnknownOneIsAnError) {
     EXPECT_THROW(simd::forceTarget("no-such-target"), std::invalid_argument);
     simd::forceTarget("");
     EXPECT_EQ(simd::activeTarget(), targets.front());
+}
+
+TEST_F(EveryTarget, FacingVerdictsNeverContradictTheFloat64Skip) {
+    // Triangles at every distance, size and slant (nearly edge-on ones, tiny and huge ones,
+    // some double-sided): a certified verdict is always facesAwayFrom's, and most are certified.
+    forEachTarget([] {
+        Random rng(5);
+        std::size_t certified = 0, dropped = 0, total = 0;
+        for (int round = 0; round < 40; ++round) {
+            const glm::vec3 origin = rng.vec3(-10.0f, 10.0f) * (round % 4 == 3 ? 1e6f : 1.0f);
+            std::vector<Triangle> tris(std::size_t(rng.index(200)) + 1);
+            for (Triangle& t : tris) {
+                const double distance = std::pow(10.0, rng.uniform(-12.0, 8.0));
+                const glm::dvec3 centre = glm::dvec3(origin) + distance * glm::normalize(rng.inBox(-1.0, 1.0) + 1e-9);
+                const double size = distance * std::pow(10.0, rng.uniform(-7.0, 0.5));
+                glm::dvec3 p[3];
+                for (glm::dvec3& q : p) q = centre + size * rng.inBox(-1.0, 1.0);
+                if (rng.uniform() < 0.3) {  // nearly edge-on from the origin
+                    const glm::dvec3 n = glm::normalize(glm::cross(centre - glm::dvec3(origin), p[1] - p[0]));
+                    const double squeeze = std::pow(10.0, rng.uniform(-9.0, -1.0));
+                    for (glm::dvec3& q : p) q -= (1.0 - squeeze) * glm::dot(q - glm::dvec3(origin), n) * n;
+                }
+                t.v0 = glm::vec3(p[0]);
+                t.v1 = glm::vec3(p[1]);
+                t.v2 = glm::vec3(p[2]);
+                t.cullBackFace = rng.uniform() < 0.9 ? 1u : 0u;
+            }
+            std::vector<std::uint8_t> verdict(tris.size(), 0xFF);
+            simd::classifyFacing(tris.data(), std::uint32_t(tris.size()), origin, verdict.data());
+            for (std::size_t i = 0; i < tris.size(); ++i) {
+                const bool away = tris[i].cullBackFace && facesAwayFrom(tris[i], glm::dvec3(origin));
+                ASSERT_NE(verdict[i], 0xFF) << "every verdict written";
+                if (verdict[i] == simd::kUndecided) continue;
+                ++certified;
+                dropped += away;
+                ASSERT_EQ(verdict[i] == simd::kDrop, away) << "round " << round << ", triangle " << i;
+            }
+            total += tris.size();
+        }
+        // This mix is mostly extreme on purpose (lengths down to 1e-12, edge-on slivers).
+        EXPECT_GT(certified, total * 4 / 10);
+        EXPECT_GT(dropped, total / 10);
+    });
 }

@@ -105,6 +105,7 @@ std::vector<BenchConfig> chooseConfigs(const BenchCommand& cmd, const std::vecto
         const std::vector<BenchConfig> more =
             cmd.suite == BenchSuite::Sweep   ? sweepConfigs(b, hardwareThreads, gpuDefaultRegions, gpuDefaultRayGroups)
             : cmd.suite == BenchSuite::Peers ? peerConfigs(b, hardwareThreads)
+            : cmd.suite == BenchSuite::Skips ? skipConfigs(b, hardwareThreads)
                                              : table51Configs(b, hardwareThreads);
         configs.insert(configs.end(), more.begin(), more.end());
     }
@@ -146,6 +147,7 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
         Box box;
         triangleBoundsInParallel(scene.triangles, pool, buffers.bounds, box);
         g = frameGeometry(scene.triangles, buffers.bounds, rays, box, std::uint32_t(width));
+        g.frustum = viewFrustum(camera, width, height);
     }
     const double prepareMs = msSince(start);
     const auto traceStart = Clock::now();
@@ -202,7 +204,7 @@ BenchScene loadBenchScene(const std::string& path, const BenchCommand& cmd, cons
     for (int copy = 2; std::any_of(rows.begin(), rows.end(), [&](const BenchRow& r) { return r.scene == s.name; }); ++copy)
         s.name = stem + "_" + std::to_string(copy);
     s.bounds = allTriangleBounds(s.scene.triangles);
-    CameraOptions orbit;
+    CameraOptions orbit = cmd.camera;
     orbit.orbit = cmd.orbit;
     s.cameras = makeCameras(s.scene, sceneBounds(s.scene.triangles), orbit, double(cmd.width) / double(cmd.height));
     s.trianglesDigest = digestOf(s.scene.triangles.data(), s.scene.triangles.size() * sizeof(Triangle));

@@ -12,12 +12,14 @@ namespace dacrt {
 // sweep: every backend's default, then each option value changed one at a time.
 // peers: each DACRT default against every mode of the peers (embree, rayquery).
 // table51: the source's Table 5.1 and Figure 5.3 (threads, regions per thread, axes).
-enum class BenchSuite { Sweep, Peers, Table51 };
+enum class BenchSuite { Sweep, Peers, Skips, Table51 };
 
 template <>
 struct EnumNames<BenchSuite> {
-    static constexpr std::array<std::pair<BenchSuite, std::string_view>, 3> table{
-        {{BenchSuite::Sweep, "sweep"}, {BenchSuite::Peers, "peers"}, {BenchSuite::Table51, "table51"}}};
+    static constexpr std::array<std::pair<BenchSuite, std::string_view>, 4> table{{{BenchSuite::Sweep, "sweep"},
+                                                                                    {BenchSuite::Peers, "peers"},
+                                                                                    {BenchSuite::Skips, "skips"},
+                                                                                    {BenchSuite::Table51, "table51"}}};
 };
 
 struct BenchCommand {
@@ -25,6 +27,7 @@ struct BenchCommand {
     std::vector<Backend> backends;  // empty: cpu-seq, cpu, gpu (when a device exists), embree
     BenchSuite suite = BenchSuite::Sweep;
     int orbit = 1;
+    CameraOptions camera;      // the base camera (the orbit's first); orbit is taken from `orbit`
     int width = 640;
     int height = 480;
     int repeat = 3;

@@ -21,6 +21,9 @@ std::string optionText(const BenchConfig& c) {
       << " threads=" << c.threads();
     if (c.backend() == Backend::Gpu)
         s << " ray_groups=" << (c.request.gpuTuning.rayGroups ? std::to_string(c.request.gpuTuning.rayGroups) : "auto");
+    const SkipSwitches& k = c.request.trace.skips;
+    if (!(k == SkipSwitches{}))
+        s << " no_skip=" << (k.backFaces ? "" : "backfaces,") << (k.frustum ? "" : "frustum,") << (k.uploads ? "" : "uploads,");
     return s.str();
 }
 
@@ -113,6 +116,23 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         for (std::uint32_t groups : {1u, 2u, 4u})
             if (groups != gpuDefaultRayGroups)
                 variant("ray-groups=" + std::to_string(groups), [groups](BenchConfig& c) { c.request.gpuTuning.rayGroups = groups; });
+    return out;
+}
+
+std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads) {
+    if (isPeer(b)) return {baseConfig(b, hardwareThreads)};
+    std::vector<BenchConfig> out = {baseConfig(b, hardwareThreads)};
+    auto off = [&](const std::string& name, auto&& change) {
+        BenchConfig c = out.front();
+        c.name = "no-skip=" + name;
+        c.isDefault = false;
+        change(c.request.trace.skips);
+        out.push_back(c);
+    };
+    off("backfaces", [](SkipSwitches& s) { s.backFaces = false; });
+    off("frustum", [](SkipSwitches& s) { s.frustum = false; });
+    if (b == Backend::Gpu) off("uploads", [](SkipSwitches& s) { s.uploads = false; });
+    off("all", [](SkipSwitches& s) { s = SkipSwitches{false, false, false}; });
     return out;
 }
 

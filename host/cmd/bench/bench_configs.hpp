@@ -22,6 +22,10 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
 // the quick, fair comparison, in one run.
 std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads);
 
+// skips: each DACRT backend's default, then each skip of the work plan off alone, then all
+// off; the peers' defaults beside them.
+std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads);
+
 // The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
 std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads);
 
