@@ -39,6 +39,7 @@ std::vector<std::string> ignoredOptions(const BackendRequest& r) {
     given(d.packetFlush != 0, b == Backend::CpuSeq || b == Backend::Cpu, "--packet-flush");
     given(r.gpuTuning.workgroupSize != 0, b == Backend::Gpu, "--workgroup-size");
     given(r.gpuTuning.rayGroups != 0, b == Backend::Gpu, "--ray-groups");
+    given(!(r.trace.skips == SkipSwitches{}), !isPeer(b), "--no-skip");
     given(!r.embree.robust, b == Backend::Embree, "--embree-fast");
     given(!r.embree.packets, b == Backend::Embree, "--embree-single-rays");
     return out;
@@ -75,6 +76,7 @@ BackendDispatcher::BackendDispatcher(const DeviceChoice& devices, const std::vec
     if (usesVulkan(backends)) {
         gpu_ = std::make_unique<gpu::Context>(gpu::ContextOptions{devices.device, devices.validate});
         pipelines_ = std::make_unique<gpu::PipelineCache>(*gpu_);
+        resident_ = std::make_unique<gpu::ResidentTriangles>();
     }
 }
 
@@ -137,7 +139,8 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
     switch (request.trace.backend) {
         case Backend::Gpu:
             if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
-            return traceGpu(geometry, request.trace, request.gpuTuning, *gpu_, threadPool, onPlan, pipelines_.get());
+            return traceGpu(geometry, request.trace, request.gpuTuning, *gpu_, threadPool, onPlan, pipelines_.get(),
+                            resident_.get());
         case Backend::Embree:
             // Embree allocates its BVH itself: there is no plan to show or check.
         {

@@ -77,6 +77,7 @@ private:
     std::map<unsigned, std::unique_ptr<ThreadPool>> pools_;
     std::unique_ptr<gpu::Context> gpu_;
     std::unique_ptr<gpu::PipelineCache> pipelines_;
+    std::unique_ptr<gpu::ResidentTriangles> resident_;  // gpu: the triangles kept on the device
 };
 
 }  // namespace dacrt

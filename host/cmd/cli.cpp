@@ -148,10 +148,12 @@ void addSkipListOption(CLI::App* cmd, SkipSwitches& skips) {
                    if (skip == Skip::BackFaces) skips.backFaces = false;
                    if (skip == Skip::Frustum) skips.frustum = false;
                    if (skip == Skip::Uploads) skips.uploads = false;
+                   if (skip == Skip::SubScenes) skips.subScenes = false;
                }
            },
            "skips to turn off (each changes speed only): backfaces (single-sided triangles facing away from the "
-           "camera), frustum (triangles outside the view), uploads (gpu: triangle buffers kept across frames)")
+           "camera), frustum (triangles outside the view), uploads (gpu: triangle buffers kept across frames), "
+           "subscenes (cpu: small frames traced as one sequential DACRT)")
         ->check(CLI::IsMember(enumNameList<Skip>()))
         ->delimiter(',');
 }

@@ -104,6 +104,7 @@ std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScen
             const std::vector<Ray> rays = primaryRays(camera, o.width, o.height, {(i + 0.5) / k, (j + 0.5) / k});
             FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
             g.frustum = viewFrustum(camera, o.width, o.height);
+            g.trianglesVersion = p.scene.trianglesVersion;
             const TraceResult r = backends.trace(g, o.request);
             accumulateShading(p.scene, HitImage{o.width, o.height, &rays, &r.hits}, 1.0f / float(k * k), sum);
         }
@@ -193,6 +194,7 @@ int runRender(const RenderOptions& o) {
         const std::vector<Ray> rays = primaryRays(camera, o.width, o.height);
         FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
         g.frustum = viewFrustum(camera, o.width, o.height);
+        g.trianglesVersion = p.scene.trianglesVersion;
         const double prepareMs = p.prepareMs + msSince(frameStart);
 
         const auto traceStart = Clock::now();

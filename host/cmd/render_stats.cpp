@@ -36,7 +36,8 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
                     {"cull", toString(o.cull)},
                     {"skip_backfaces", trace.skips.backFaces},
                     {"skip_frustum", trace.skips.frustum},
-                    {"skip_uploads", trace.skips.uploads}};
+                    {"skip_uploads", trace.skips.uploads},
+                    {"skip_subscenes", trace.skips.subScenes}};
     if (trace.backend == Backend::Embree)
         j["options"] = {{"robust", o.request.embree.robust}, {"build", toString(o.request.embree.build)},
                         {"packets", o.request.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};

@@ -519,6 +519,7 @@ private:
             scene_.sources.push_back(TriangleSource{node, meshIndex, primIndex, std::uint32_t(t)});
             scene_.materialOfTriangle.push_back(material);
         }
+        touchTriangles(scene_);
     }
 
     std::string name_;

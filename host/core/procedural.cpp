@@ -126,6 +126,7 @@ Scene sceneFromMeshes(const std::vector<Mesh>& meshes, const std::string& name) 
             s.materialOfTriangle.push_back(std::uint32_t(mi));
         }
     }
+    touchTriangles(s);
     return s;
 }
 

@@ -1,5 +1,7 @@
 #include "core/scene.hpp"
 
+#include <atomic>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -8,7 +10,13 @@
 
 namespace dacrt {
 
+void touchTriangles(Scene& scene) {
+    static std::atomic<std::uint64_t> next{1};
+    scene.trianglesVersion = next++;
+}
+
 void applyCullMode(Scene& scene, CullMode mode) {
+    touchTriangles(scene);
     for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
         const bool materialCulls =
             i < scene.materialOfTriangle.size() && !scene.materials[scene.materialOfTriangle[i]].doubleSided;

@@ -54,6 +54,10 @@ struct Scene {
     std::vector<Material> materials;
     std::optional<SceneCamera> camera;              // the first perspective camera found
     std::uint64_t degenerateTrianglesDropped = 0;   // no area (triangleHasNoArea), dropped at load
+    // Changes whenever `triangles` does (load, applyCullMode): a frame's FrameGeometry
+    // trianglesVersion, unique in the process. Code that edits `triangles` itself calls
+    // touchTriangles(*this).
+    std::uint64_t trianglesVersion = 0;
 
     std::size_t triangleCount() const { return triangles.size(); }
 };
@@ -69,6 +73,9 @@ struct Box {
     glm::vec3 center() const { return (lo + hi) * 0.5f; }
     glm::vec3 extent() const { return hi - lo; }
 };
+
+// A new trianglesVersion, unique in the process, for a scene whose triangles changed.
+void touchTriangles(Scene& scene);
 
 // Sets every triangle's cullBackFace under `mode` (from its material under CullMode::Material).
 void applyCullMode(Scene& scene, CullMode mode);

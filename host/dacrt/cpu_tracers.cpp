@@ -188,7 +188,26 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
     switch (options.backend) {
         case Backend::Brute: return traceBrute(g, pool, onPlan, onProgress);
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);
-        case Backend::Cpu: return traceParallel(g, options, pool, onPlan);
+        case Backend::Cpu: {
+            const std::uint64_t pairs = std::uint64_t(g.rays->size()) * g.tracedTriangleCount();
+            if (options.regions == 0 && options.skips.subScenes && pairs < kSequentialBelowPairs) {
+                const WorkLine line{"sub-scenes", 0,
+                                    "none: " + std::to_string(pairs) + " ray-triangle pairs, below " +
+                                        std::to_string(kSequentialBelowPairs) + ", trace faster as one sequential DACRT"};
+                const PlanHook planWithLine = onPlan ? PlanHook([&](const MemoryPlan& plan) {
+                    MemoryPlan whole = plan;
+                    whole.work.push_back(line);
+                    return onPlan(whole);
+                })
+                                                     : PlanHook();
+                TraceResult r = traceSequential(g, options.dacrt, planWithLine);
+                r.threads = 1;
+                r.regions = 1;
+                r.memory.work.push_back(line);
+                return r;
+            }
+            return traceParallel(g, options, pool, onPlan);
+        }
         case Backend::Gpu:
         case Backend::Embree:
         case Backend::RayQuery: break;

@@ -25,6 +25,9 @@ struct FrameGeometry {
     // The triangles a ray can hit, ascending, when a skip dropped others (triangle_skips.hpp);
     // null: every triangle. Ids keep indexing `triangles`.
     const std::vector<std::uint32_t>* tracedTriangles = nullptr;
+    // Nonzero: frames with the same value have the same triangles and bounds, bit for bit (the
+    // gpu keeps them on the device: gpu/resident_triangles.hpp). 0: unknown.
+    std::uint64_t trianglesVersion = 0;
 
     std::size_t tracedTriangleCount() const { return tracedTriangles ? tracedTriangles->size() : triangles->size(); }
     std::uint32_t tracedTriangle(std::size_t i) const { return tracedTriangles ? (*tracedTriangles)[i] : std::uint32_t(i); }

@@ -71,6 +71,10 @@ constexpr std::uint32_t kCpuSimdRayLimit = 16;
 constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 constexpr std::uint32_t kPacketFlushDefault = 16;
+// Below this many rays x traced triangles, the cpu backend traces the frame as one sequential
+// DACRT: the parallel scheme's division and hand-off cost more than a second core saves there
+// (measured: docs/skips.md).
+constexpr std::uint64_t kSequentialBelowPairs = std::uint64_t(1) << 22;
 
 struct DacrtOptions {
     std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default
@@ -104,16 +108,20 @@ struct DacrtOptions {
 
 // The frame's skips (docs/skips.md), each exact by construction, each on unless turned off
 // (--no-skip): they change speed only.
-enum class Skip { BackFaces, Frustum, Uploads };
+enum class Skip { BackFaces, Frustum, Uploads, SubScenes };
 template <>
 struct EnumNames<Skip> {
-    static constexpr std::array<std::pair<Skip, std::string_view>, 3> table{
-        {{Skip::BackFaces, "backfaces"}, {Skip::Frustum, "frustum"}, {Skip::Uploads, "uploads"}}};
+    static constexpr std::array<std::pair<Skip, std::string_view>, 4> table{{{Skip::BackFaces, "backfaces"},
+                                                                             {Skip::Frustum, "frustum"},
+                                                                             {Skip::Uploads, "uploads"},
+                                                                             {Skip::SubScenes, "subscenes"}}};
 };
 struct SkipSwitches {
     bool backFaces = true;  // single-sided triangles facing away from the rays' shared origin
     bool frustum = true;    // triangles outside the camera's view frustum
     bool uploads = true;    // gpu: triangle buffers kept on the device while the triangles do not change
+    bool subScenes = true;  // cpu: one sequential DACRT instead of sub-scenes for frames too small to pay
+                            // for a division (kSequentialBelowPairs), unless --regions is given
     bool operator==(const SkipSwitches&) const = default;
 };
 

@@ -34,15 +34,22 @@ void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, M
     }
 }
 
-DacrtBindingSet::DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan) {
-    buffers_.reserve(plan.size());
-    for (const PlannedBuffer& b : plan) buffers_.emplace_back(context, b.bytes, b.name);
+DacrtBindingSet::DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan, const ResidentBuffers& resident) {
+    owned_.reserve(plan.size());  // no reallocation: bound_ points into it
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+        if (resident[k]) {
+            if (resident[k]->size() < plan[k].bytes)
+                throw InternalError(std::string("the resident buffer of ") + plan[k].name + " is smaller than planned");
+            bound_[k] = resident[k];
+            continue;
+        }
+        owned_.emplace_back(context, plan[k].bytes, plan[k].name);
+        bound_[k] = &owned_.back();
+    }
 }
 
 void DacrtBindingSet::bindTo(ComputePipeline& pipeline) const {
-    std::vector<const Buffer*> bound;
-    for (const Buffer& b : buffers_) bound.push_back(&b);
-    pipeline.bind(bound);
+    pipeline.bind(std::vector<const Buffer*>(bound_.begin(), bound_.end()));
 }
 
 }  // namespace dacrt::gpu

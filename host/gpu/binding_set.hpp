@@ -38,17 +38,21 @@ DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& counts);
 // exceeds the device's maxStorageBufferRange, with the limit and the excess.
 void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, MemoryPlan& plan);
 
+// Buffers that outlive a binding set, for the bindings that name one (null: the set makes it).
+using ResidentBuffers = std::array<Buffer*, DACRT_BINDING_COUNT>;
+
 class DacrtBindingSet {
 public:
-    DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan);
+    DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan, const ResidentBuffers& resident = {});
 
-    Buffer& operator[](std::uint32_t binding) { return buffers_[binding]; }
-    const Buffer& operator[](std::uint32_t binding) const { return buffers_[binding]; }
+    Buffer& operator[](std::uint32_t binding) { return *bound_[binding]; }
+    const Buffer& operator[](std::uint32_t binding) const { return *bound_[binding]; }
     // Points every binding of the pipeline's set at its buffer.
     void bindTo(ComputePipeline& pipeline) const;
 
 private:
-    std::vector<Buffer> buffers_;  // index = binding
+    std::vector<Buffer> owned_;   // the bindings without a resident buffer
+    ResidentBuffers bound_{};     // index = binding; into owned_ (its storage moves with it) or resident
 };
 
 }  // namespace dacrt::gpu

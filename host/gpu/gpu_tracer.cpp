@@ -21,6 +21,8 @@ struct GpuFrame {
     gpu::WorkPlan work;
     std::uint32_t workgroupSize = 0;
     gpu::DacrtBufferPlan buffers{};
+    gpu::ResidentTriangles* resident = nullptr;  // the uploads skip: triangles kept on the device
+    bool trianglesOnDevice = false;              // resident holds this frame's already
 };
 
 void describeDevice(const gpu::DeviceInfo& device, TraceResult& result) {
@@ -81,12 +83,16 @@ void planMemory(GpuFrame& frame, const gpu::DeviceInfo& device, const MemoryPlan
     result.memory.work.insert(result.memory.work.end(), hostPlan.work.begin(), hostPlan.work.end());
     const FrameGeometry& g = frame.geometry;
     result.memory.addWork("gpu work items", frame.work.items.size(), "Step 1 and transfer pairs, per ray group");
+    const std::uint64_t triangleBytes = std::uint64_t(g.triangles->size()) * (sizeof(Triangle) + sizeof(Bounds));
     const std::uint64_t uploaded = std::uint64_t(g.rays->size()) * (sizeof(Ray) + sizeof(Hit)) +
-                                   std::uint64_t(g.triangles->size()) * (sizeof(Triangle) + sizeof(Bounds)) +
+                                   (frame.trianglesOnDevice ? 0 : triangleBytes) +
                                    std::uint64_t(frame.division.rayIds.size()) * 4 + triIdCount * 4 +
                                    frame.work.slots.size() * sizeof(Region) + frame.work.items.size() *
                                    (sizeof(WorkItem) + sizeof(TraversalState)) + sizeof(GpuCounters);
     result.memory.addWork("bytes uploaded", uploaded, "rays, misses, triangles and bounds, ids, regions, work items");
+    result.memory.addWork("skipped: triangle and bounds upload (bytes)", frame.trianglesOnDevice ? triangleBytes : 0,
+                          frame.resident ? (frame.trianglesOnDevice ? "on the device since an earlier frame" : "uploaded, kept for the next frame")
+                                         : g.trianglesVersion ? "skip off (--no-skip uploads)" : "the triangles' version is unknown");
     result.memory.addWork("bytes read back", std::uint64_t(g.rays->size()) * sizeof(Hit) + frame.work.slots.size() * sizeof(Region),
                           "hits and regions");
 }
@@ -94,7 +100,13 @@ void planMemory(GpuFrame& frame, const gpu::DeviceInfo& device, const MemoryPlan
 // Creates the frame's buffers and fills them.
 gpu::DacrtBindingSet uploadFrame(const GpuFrame& frame, const gpu::Context& context, TraceResult& result) {
     const auto start = Clock::now();
-    gpu::DacrtBindingSet set(context, frame.buffers);
+    gpu::ResidentBuffers resident{};
+    if (frame.resident) {
+        frame.resident->prepare(context, frame.geometry);
+        resident[DACRT_BINDING_TRIANGLES] = &frame.resident->triangles();
+        resident[DACRT_BINDING_TRIANGLE_BOUNDS] = &frame.resident->bounds();
+    }
+    gpu::DacrtBindingSet set(context, frame.buffers, resident);
     const FrameGeometry& g = frame.geometry;
     const std::vector<std::uint32_t> slotTriIds = gpu::groupTriangleIds(frame.division, frame.work.groups);
     const std::vector<Hit> misses(g.rays->size(), missHit());
@@ -102,8 +114,10 @@ gpu::DacrtBindingSet uploadFrame(const GpuFrame& frame, const gpu::Context& cont
     const std::vector<TraversalState> fresh(frame.work.items.size(), TraversalState{});
     auto upload = [&](std::uint32_t binding, const auto& v) { set[binding].upload(v.data(), v.size() * sizeof(v[0])); };
     upload(DACRT_BINDING_RAYS, *g.rays);
-    upload(DACRT_BINDING_TRIANGLES, *g.triangles);
-    upload(DACRT_BINDING_TRIANGLE_BOUNDS, *g.triangleBounds);
+    if (!frame.resident) {
+        upload(DACRT_BINDING_TRIANGLES, *g.triangles);
+        upload(DACRT_BINDING_TRIANGLE_BOUNDS, *g.triangleBounds);
+    }
     upload(DACRT_BINDING_HITS, misses);
     upload(DACRT_BINDING_RAY_IDS, frame.division.rayIds);
     upload(DACRT_BINDING_TRI_IDS, slotTriIds);
@@ -256,7 +270,8 @@ void checkGpuOptions(const TraceOptions& options) {
 }
 
 TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
-                     gpu::Context& context, ThreadPool& pool, const PlanHook& onPlan, gpu::PipelineCache* pipelines) {
+                     gpu::Context& context, ThreadPool& pool, const PlanHook& onPlan, gpu::PipelineCache* pipelines,
+                     gpu::ResidentTriangles* resident) {
     const gpu::DeviceInfo& device = context.info();
     checkGpuOptions(options);
     if (!device.subgroupOperations)
@@ -267,6 +282,10 @@ TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options,
     describeDevice(device, result);
 
     GpuFrame frame{geometry, {}, {}, {}, 0, {}};
+    if (resident && options.skips.uploads && geometry.trianglesVersion != 0) {
+        frame.resident = resident;
+        frame.trianglesOnDevice = resident->holds(geometry);
+    }
     MemoryPlan hostPlan;
     planWorkItems(frame, options, tuning, device, pool, hostPlan, result);
     chooseWorkgroupSize(frame, tuning, device, result);

@@ -10,6 +10,7 @@
 #include "dacrt/trace_result.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
+#include "gpu/resident_triangles.hpp"
 
 namespace dacrt {
 
@@ -28,8 +29,10 @@ void checkGpuOptions(const TraceOptions& options);
 
 // Traces one frame on the context's device. Pipelines come from `pipelines` when given (kept
 // across frames), else are made for this frame alone.
+// With `resident` (and options.skips.uploads), the triangles and bounds stay on the device
+// between frames of the same FrameGeometry::trianglesVersion.
 TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
                      gpu::Context& context, ThreadPool& pool, const PlanHook& onPlan = {},
-                     gpu::PipelineCache* pipelines = nullptr);
+                     gpu::PipelineCache* pipelines = nullptr, gpu::ResidentTriangles* resident = nullptr);
 
 }  // namespace dacrt

@@ -113,6 +113,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCommand{"ZeroRayGroups", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend gpu --ray-groups 0", "--ray-groups"},
         BadCommand{"RayGroupsOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu --ray-groups 2",
                    "--ray-groups is not an option of --backend cpu"},
+        BadCommand{"UnknownSkip", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --no-skip everything", "--no-skip"},
+        BadCommand{"UnknownCull", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --cull sideways", "--cull"},
+        BadCommand{"NoSkipOnAPeer", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend embree --no-skip frustum",
+                   "--no-skip is not an option of --backend embree"},
         BadCommand{"TruncatedFile", "render " + dacrt::test::fixture("bad_truncated.glb"), "bad_truncated.glb"},
         BadCommand{"NanVertex", "render " + dacrt::test::fixture("bad_nan_position.gltf"), "non-finite"},
         BadCommand{"NoSubcommand", "", "subcommand"},
@@ -402,7 +406,8 @@ TEST(Cli, EveryBackendCullsTheSameBackFacesAndTheSkipsChangeNoPixel) {
         const std::string out = temp("cull_" + backend + ".exr");
         std::filesystem::remove(out);
         const CommandResult r = run("render " + scene + " --size 48x32 --backend " + backend +
-                                    (backend == "gpu" || backend == "rayquery" ? " --validate" : "") + " --aov " + out);
+                                    (backend == "gpu" || backend == "rayquery" ? " --validate" : "") +
+                                    (backend == "cpu" ? " --regions 2" : "") + " --aov " + out);
         if (backend == "rayquery" && r.code == 2 && r.output.find("VK_KHR_ray_query") != std::string::npos) continue;
         ASSERT_EQ(r.code, 0) << backend << ": " << r.output;
         const bool peer = backend == "embree" || backend == "rayquery";
@@ -414,7 +419,7 @@ TEST(Cli, EveryBackendCullsTheSameBackFacesAndTheSkipsChangeNoPixel) {
 
 TEST(Cli, PlanAndStatsListEverySkipWithItsCounts) {
     const std::string scene = insideOutScene(), stats = temp("skips.json");
-    const CommandResult plan = run("render " + scene + " --size 48x32 --plan");
+    const CommandResult plan = run("render " + scene + " --size 48x32 --regions 2 --plan");
     ASSERT_EQ(plan.code, 0) << plan.output;
     for (const char* line : {"work plan", "skipped: back-facing", "skipped: outside the view frustum", "triangles traced",
                              "rays outside the scene box", "transfer pairs", "memory plan"})
@@ -430,4 +435,10 @@ TEST(Cli, PlanAndStatsListEverySkipWithItsCounts) {
               counts["triangles"]);
     const CommandResult off = run("render " + scene + " --size 48x32 --plan --no-skip backfaces,frustum");
     EXPECT_NE(off.output.find("skip off (--no-skip)"), std::string::npos) << off.output;
+    // Without --regions a frame this small is one sequential DACRT, and the plan says so.
+    const CommandResult small = run("render " + scene + " --size 48x32 --plan");
+    EXPECT_NE(small.output.find("sub-scenes"), std::string::npos) << small.output;
+    EXPECT_EQ(small.output.find("transfer pairs"), std::string::npos) << small.output;
+    const CommandResult forced = run("render " + scene + " --size 48x32 --plan --no-skip subscenes");
+    EXPECT_NE(forced.output.find("transfer pairs"), std::string::npos) << forced.output;
 }

@@ -158,3 +158,45 @@ TEST(GpuImages, ABufferOverTheDeviceLimitIsAClearError) {
         EXPECT_NE(what.find("over by"), std::string::npos) << what;
     }
 }
+
+TEST(GpuImages, TrianglesStayOnTheDeviceAcrossFramesUntilTheyChange) {
+    // The uploads skip: frames of one trianglesVersion upload the triangles once, and a frame
+    // whose triangles moved (a new version) uploads them again: the hits are always the ones
+    // of this frame's triangles.
+    DACRT_REQUIRE_GPU(context);
+    Frame frame(shapes(), 48, 32, CameraOptions{});
+    frame.geometry.trianglesVersion = frame.scene.trianglesVersion;
+    TraceOptions o;
+    o.backend = Backend::Gpu;
+    o.regions = 2;
+    ThreadPool pool(2);
+    gpu::ResidentTriangles resident;
+    auto skippedBytes = [](const TraceResult& r) {
+        for (const WorkLine& w : r.memory.work)
+            if (w.name.find("skipped: triangle and bounds upload") == 0) return w.count;
+        return std::uint64_t(~0ull);
+    };
+    const TraceResult first = traceGpu(frame.geometry, o, GpuTuning{}, *context, pool, {}, nullptr, &resident);
+    const TraceResult second = traceGpu(frame.geometry, o, GpuTuning{}, *context, pool, {}, nullptr, &resident);
+    EXPECT_EQ(skippedBytes(first), 0u);
+    EXPECT_EQ(skippedBytes(second), frame.scene.triangles.size() * (sizeof(Triangle) + sizeof(Bounds)));
+    EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, first.hits));
+    EXPECT_TRUE(identicalHits(first.hits, second.hits));
+
+    // Every triangle moved along x: a new version, uploaded again.
+    for (Triangle& t : frame.scene.triangles)
+        for (glm::vec3* v : {&t.v0, &t.v1, &t.v2}) v->x += 0.25f;
+    touchTriangles(frame.scene);
+    frame.bounds = allTriangleBounds(frame.scene.triangles);
+    frame.geometry = frameGeometry(frame.scene.triangles, frame.bounds, frame.rays, sceneBounds(frame.scene.triangles), 48);
+    frame.geometry.trianglesVersion = frame.scene.trianglesVersion;
+    const TraceResult moved = traceGpu(frame.geometry, o, GpuTuning{}, *context, pool, {}, nullptr, &resident);
+    EXPECT_EQ(skippedBytes(moved), 0u);
+    EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, moved.hits));
+    EXPECT_FALSE(identicalHits(first.hits, moved.hits)) << "the scene moved";
+    o.skips.uploads = false;  // off: every frame uploads, nothing is kept
+    const TraceResult off = traceGpu(frame.geometry, o, GpuTuning{}, *context, pool, {}, nullptr, &resident);
+    EXPECT_EQ(skippedBytes(off), 0u);
+    EXPECT_TRUE(identicalHits(moved.hits, off.hits));
+    EXPECT_TRUE(noValidationErrors(*context));
+}

@@ -148,6 +148,7 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
         triangleBoundsInParallel(scene.triangles, pool, buffers.bounds, box);
         g = frameGeometry(scene.triangles, buffers.bounds, rays, box, std::uint32_t(width));
         g.frustum = viewFrustum(camera, width, height);
+        g.trianglesVersion = scene.trianglesVersion;  // an orbit: the triangles stay as they are
     }
     const double prepareMs = msSince(start);
     const auto traceStart = Clock::now();

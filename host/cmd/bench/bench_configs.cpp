@@ -23,7 +23,7 @@ std::string optionText(const BenchConfig& c) {
         s << " ray_groups=" << (c.request.gpuTuning.rayGroups ? std::to_string(c.request.gpuTuning.rayGroups) : "auto");
     const SkipSwitches& k = c.request.trace.skips;
     if (!(k == SkipSwitches{}))
-        s << " no_skip=" << (k.backFaces ? "" : "backfaces,") << (k.frustum ? "" : "frustum,") << (k.uploads ? "" : "uploads,");
+        s << " no_skip=" << (k.backFaces ? "" : "backfaces,") << (k.frustum ? "" : "frustum,") << (k.uploads ? "" : "uploads,") << (k.subScenes ? "" : "subscenes,");
     return s.str();
 }
 
@@ -132,7 +132,8 @@ std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads) {
     off("backfaces", [](SkipSwitches& s) { s.backFaces = false; });
     off("frustum", [](SkipSwitches& s) { s.frustum = false; });
     if (b == Backend::Gpu) off("uploads", [](SkipSwitches& s) { s.uploads = false; });
-    off("all", [](SkipSwitches& s) { s = SkipSwitches{false, false, false}; });
+    if (b == Backend::Cpu) off("subscenes", [](SkipSwitches& s) { s.subScenes = false; });
+    off("all", [](SkipSwitches& s) { s = SkipSwitches{false, false, false, false}; });
     return out;
 }
 

@@ -1,0 +1,25 @@
+#include "gpu/resident_triangles.hpp"
+
+namespace dacrt::gpu {
+
+bool ResidentTriangles::holds(const FrameGeometry& g) const {
+    return triangles_ && g.trianglesVersion != 0 && g.trianglesVersion == version_ && g.triangles->size() == count_;
+}
+
+std::uint64_t ResidentTriangles::prepare(const Context& context, const FrameGeometry& g) {
+    if (holds(g)) return 0;
+    const std::uint64_t n = g.triangles->size();
+    if (!triangles_ || count_ != n) {
+        triangles_.reset();
+        bounds_.reset();
+        triangles_ = std::make_unique<Buffer>(context, n * sizeof(Triangle), "triangles");
+        bounds_ = std::make_unique<Buffer>(context, n * sizeof(Bounds), "triangle bounds");
+    }
+    triangles_->upload(g.triangles->data(), n * sizeof(Triangle));
+    bounds_->upload(g.triangleBounds->data(), n * sizeof(Bounds));
+    version_ = g.trianglesVersion;
+    count_ = n;
+    return n * (sizeof(Triangle) + sizeof(Bounds));
+}
+
+}  // namespace dacrt::gpu
