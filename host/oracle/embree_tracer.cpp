@@ -211,7 +211,7 @@ EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOpt
                                    identityIndices(triangles.size()).data(), 0, 3 * sizeof(std::uint32_t),
                                    triangles.size());
         impl_->check("rtcSetSharedGeometryBuffer(index)");
-        if (singleSidedTriangles(triangles) > 0) {
+        if (options.faceFilter && singleSidedTriangles(triangles) > 0) {
             rtcSetGeometryUserData(geometry.get(), const_cast<std::vector<Triangle>*>(&triangles));
             rtcSetGeometryIntersectFilterFunction(geometry.get(), &rejectCulledBackFaces);
             impl_->check("rtcSetGeometryIntersectFilterFunction");

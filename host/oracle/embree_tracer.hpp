@@ -35,6 +35,10 @@ struct EmbreeOptions {
     // rtcIntersect1 per ray.
     bool packets = true;
     std::uint32_t imageWidth = 0;  // the rays' image width, for the tiles; 0: runs of 16 rays
+    // The face rule as an intersection filter where some triangles are single-sided (the
+    // rule every backend applies); false: both faces hit, Embree's fastest, which gives the
+    // same image wherever no back face is visible (closed meshes seen from outside).
+    bool faceFilter = true;
 };
 
 // One Embree device (per thread count, for the whole process) and one committed scene over

@@ -139,7 +139,29 @@ def targets(paths):
                   f"{cpu['frame_ms_min'] / best[scene]:.2f}x |")
 
 
-KINDS = {"targets": targets, "peers": peers, "sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
+def skips(path, scene):
+    """One scene of a `--suite skips` run: each backend's default (every skip on), then each
+    skip off alone and all off, with what that skip saves (the frame with it off minus the
+    default frame, in the same run)."""
+    j = json.load(open(path))
+    rows = [r for r in j["rows"] if r["scene"] == scene]
+    print("| series | config | frame ms (min) | skip pass ms | upload ms | real errors | near ties | what the skip saves |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|")
+    for r in rows:
+        base = next(d for d in rows if d["series"] == r["series"] and d["default"])
+        parts = r.get("parts_ms", {})
+        if r is base:
+            saves = "-"
+        else:
+            diff = r["frame_ms_min"] - base["frame_ms_min"]
+            saves = f"{diff:+.1f} ms ({100 * diff / r['frame_ms_min']:+.0f}%)"
+        skip = parts.get("skips")
+        upload = parts.get("upload")
+        print(f"| {r['series']} | {r['config']} | {r['frame_ms_min']:.1f} | {'-' if skip is None else f'{skip:.1f}'} | "
+              f"{'-' if upload is None else f'{upload:.1f}'} | {r['real_errors']} | {r['near_ties']} | {saves} |")
+
+
+KINDS = {"skips": skips, "targets": targets, "peers": peers, "sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
 
 
 def update(doc):

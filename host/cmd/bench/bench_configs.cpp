@@ -11,7 +11,8 @@ std::string optionText(const BenchConfig& c) {
     if (c.backend() == Backend::RayQuery) return "build=" + toString(c.request.rayQueryBuild);
     if (c.backend() == Backend::Embree) {
         s << "build=" << toString(c.request.embree.build) << " robust=" << (c.request.embree.robust ? "on" : "off")
-          << " rays=" << (c.request.embree.packets ? "rtcIntersect16_4x4" : "rtcIntersect1") << " threads=" << c.threads();
+          << " rays=" << (c.request.embree.packets ? "rtcIntersect16_4x4" : "rtcIntersect1") << " threads=" << c.threads()
+          << " face_filter=" << (c.request.embree.faceFilter ? "on" : "off");
         return s.str();
     }
     const DacrtOptions d = c.request.trace.dacrt.resolvedFor(c.backend());
@@ -75,6 +76,9 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         }
         variant("rtcIntersect1", [](BenchConfig& c) { c.request.embree.packets = false; });
         out.back().series = "embree dynamic";
+        // Without the face rule's filter: what a user whose meshes show no back face runs.
+        variant("face-filter=off", [](BenchConfig& c) { c.request.embree.faceFilter = false; });
+        out.back().series = "embree dynamic";
         return out;
     }
     out.push_back(base);
@@ -120,6 +124,13 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
 }
 
 std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads) {
+    if (b == Backend::Embree) {
+        BenchConfig noFilter = baseConfig(b, hardwareThreads);
+        noFilter.name = "face-filter=off";
+        noFilter.isDefault = false;
+        noFilter.request.embree.faceFilter = false;
+        return {baseConfig(b, hardwareThreads), noFilter};
+    }
     if (isPeer(b)) return {baseConfig(b, hardwareThreads)};
     std::vector<BenchConfig> out = {baseConfig(b, hardwareThreads)};
     auto off = [&](const std::string& name, auto&& change) {
