@@ -190,10 +190,11 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);
         case Backend::Cpu: {
             const std::uint64_t pairs = std::uint64_t(g.rays->size()) * g.tracedTriangleCount();
-            if (options.regions == 0 && options.skips.subScenes && pairs < kSequentialBelowPairs) {
+            const bool small = g.rays->size() < kSequentialBelowRays && pairs < kSequentialBelowPairs;
+            if (options.regions == 0 && options.skips.subScenes && small) {
                 const WorkLine line{"sub-scenes", 0,
-                                    "none: " + std::to_string(pairs) + " ray-triangle pairs, below " +
-                                        std::to_string(kSequentialBelowPairs) + ", trace faster as one sequential DACRT"};
+                                    "none: " + std::to_string(g.rays->size()) + " rays and " + std::to_string(pairs) +
+                                        " ray-triangle pairs trace faster as one sequential DACRT"};
                 const PlanHook planWithLine = onPlan ? PlanHook([&](const MemoryPlan& plan) {
                     MemoryPlan whole = plan;
                     whole.work.push_back(line);

@@ -71,10 +71,11 @@ constexpr std::uint32_t kCpuSimdRayLimit = 16;
 constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 constexpr std::uint32_t kPacketFlushDefault = 16;
-// Below this many rays x traced triangles, the cpu backend traces the frame as one sequential
-// DACRT: the parallel scheme's division and hand-off cost more than a second core saves there
-// (measured: docs/skips.md).
-constexpr std::uint64_t kSequentialBelowPairs = std::uint64_t(1) << 22;
+// Below this many rays, and this many rays x traced triangles, the cpu backend traces the
+// frame as one sequential DACRT: the parallel scheme's division and hand-off cost more than a
+// second core saves there (measured: docs/skips.md, "The sub-scene crossover").
+constexpr std::uint64_t kSequentialBelowRays = 16384;
+constexpr std::uint64_t kSequentialBelowPairs = std::uint64_t(1) << 28;
 
 struct DacrtOptions {
     std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default
@@ -121,7 +122,7 @@ struct SkipSwitches {
     bool frustum = true;    // triangles outside the camera's view frustum
     bool uploads = true;    // gpu: triangle buffers kept on the device while the triangles do not change
     bool subScenes = true;  // cpu: one sequential DACRT instead of sub-scenes for frames too small to pay
-                            // for a division (kSequentialBelowPairs), unless --regions is given
+                            // for a division (kSequentialBelowRays), unless --regions is given
     bool operator==(const SkipSwitches&) const = default;
 };
 

@@ -126,9 +126,32 @@ TEST(Bench, PeersSuiteRunsEachDefaultAgainstEveryPeerMode) {
     for (const auto& row : j["rows"]) configs.insert(row["series"].get<std::string>() + " " + row["config"].get<std::string>());
     const std::set<std::string> expected = {"cpu-seq default",       "cpu default",          "embree dynamic default",
                                             "embree dynamic robust=off", "embree refit default", "embree refit robust=off",
-                                            "embree static default", "embree static robust=off", "embree dynamic rtcIntersect1"};
+                                            "embree static default", "embree static robust=off", "embree dynamic rtcIntersect1",
+                                            "embree dynamic face-filter=off"};
     EXPECT_EQ(configs, expected);
     expectDefaultsExact(j, {"cpu-seq", "cpu", "embree"});
+}
+
+TEST(Bench, SkipsSuiteTurnsEachSkipOffAndEveryRowIsExact) {
+    // The room from its own camera, inside it: the view cuts the scene, so the frustum skip
+    // drops triangles, and with every skip on or off the hits are the reference's.
+    const BenchOutputs out("skips");
+    const test::CommandResult r = test::runDacrt("bench " + roomScene() +
+                                                 " --suite skips --backends cpu-seq,cpu,embree --size 32x24 --repeat 1 --warmup 0" +
+                                                 out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json j = out.json();
+    std::set<std::string> configs;
+    for (const auto& row : j["rows"]) {
+        configs.insert(row["series"].get<std::string>() + " " + row["config"].get<std::string>());
+        if (row["backend"] != "embree" || row["default"].get<bool>())
+            EXPECT_EQ(row["real_errors"].get<std::uint64_t>(), 0u) << row["series"] << " " << row["config"];
+    }
+    const std::set<std::string> expected = {"cpu-seq default", "cpu-seq no-skip=backfaces", "cpu-seq no-skip=frustum",
+                                            "cpu-seq no-skip=all", "cpu default", "cpu no-skip=backfaces",
+                                            "cpu no-skip=frustum", "cpu no-skip=subscenes", "cpu no-skip=all",
+                                            "embree default", "embree face-filter=off"};
+    EXPECT_EQ(configs, expected);
 }
 
 TEST(Bench, OutputsDefaultToOneDirectoryAndAreCheckedFirst) {
