@@ -123,13 +123,7 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
         return withSkipLines(std::move(r));
     }
     const FrameGeometry traced = withSkips(geometry, skips);
-    const PlanHook planWithSkips = onPlan ? PlanHook([&](const MemoryPlan& plan) {
-        MemoryPlan whole = plan;
-        whole.work.insert(whole.work.begin(), skipPlan.work.begin(), skipPlan.work.end());
-        return onPlan(whole);
-    })
-                                          : PlanHook();
-    return withSkipLines(traceOnBackend(traced, request, planWithSkips, onProgress));
+    return withSkipLines(traceOnBackend(traced, request, withWorkLines(onPlan, skipPlan.work, true), onProgress));
 }
 
 TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request,

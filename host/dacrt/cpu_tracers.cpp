@@ -192,19 +192,14 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
             const std::uint64_t pairs = std::uint64_t(g.rays->size()) * g.tracedTriangleCount();
             const bool small = g.rays->size() < kSequentialBelowRays && pairs < kSequentialBelowPairs;
             if (options.regions == 0 && options.skips.subScenes && small) {
-                const WorkLine line{"sub-scenes", 0,
-                                    "none: " + std::to_string(g.rays->size()) + " rays and " + std::to_string(pairs) +
-                                        " ray-triangle pairs trace faster as one sequential DACRT"};
-                const PlanHook planWithLine = onPlan ? PlanHook([&](const MemoryPlan& plan) {
-                    MemoryPlan whole = plan;
-                    whole.work.push_back(line);
-                    return onPlan(whole);
-                })
-                                                     : PlanHook();
-                TraceResult r = traceSequential(g, options.dacrt, planWithLine);
+                const std::vector<WorkLine> line{{"sub-scenes", 0,
+                                                  "none: " + std::to_string(g.rays->size()) + " rays and " +
+                                                      std::to_string(pairs) +
+                                                      " ray-triangle pairs trace faster as one sequential DACRT"}};
+                TraceResult r = traceSequential(g, options.dacrt, withWorkLines(onPlan, line, false));
                 r.threads = 1;
                 r.regions = 1;
-                r.memory.work.push_back(line);
+                r.memory.work.insert(r.memory.work.end(), line.begin(), line.end());
                 return r;
             }
             return traceParallel(g, options, pool, onPlan);

@@ -39,4 +39,16 @@ struct MemoryPlan {
 // then holds the plan and no hits. It may also throw (a plan that does not fit).
 using PlanHook = std::function<bool(const MemoryPlan&)>;
 
+// onPlan seeing the plan with `lines` added to its work (before the stage's own lines, or
+// after): how a stage that decided something before the tracer plans puts it in the plan.
+// Empty when onPlan is; `lines` must outlive the hook.
+inline PlanHook withWorkLines(const PlanHook& onPlan, const std::vector<WorkLine>& lines, bool before) {
+    if (!onPlan) return {};
+    return [&onPlan, &lines, before](const MemoryPlan& plan) {
+        MemoryPlan whole = plan;
+        whole.work.insert(before ? whole.work.begin() : whole.work.end(), lines.begin(), lines.end());
+        return onPlan(whole);
+    };
+}
+
 }  // namespace dacrt
