@@ -56,6 +56,7 @@ PreparedScene loadAndPrepare(const RenderOptions& o) {
     PreparedScene p;
     const auto start = Clock::now();
     p.scene = loadGltf(o.scenePath);
+    for (const std::string& w : p.scene.warnings) std::cerr << "dacrt: warning: " << w << "\n";
     applyCullMode(p.scene, o.cull);
     p.loadMs = msSince(start);
     const auto prepareStart = Clock::now();

@@ -71,12 +71,21 @@ bool noFileRead(std::vector<unsigned char>*, std::string* err, const std::string
     return false;
 }
 
+// Textures are not applied yet, so images stay undecoded: a file that carries them (most
+// real-world .glb files) loads, and the flattener says they are ignored. tinygltf otherwise
+// refuses every embedded or data-URI image ("No LoadImageData callback specified").
+bool keepImageUndecoded(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+                        void*) {
+    return true;
+}
+
 tinygltf::Model parseGltf(std::span<const unsigned char> bytes, const std::string& name, const std::string& baseDir,
                           bool readFiles) {
     if (bytes.size() > std::numeric_limits<unsigned int>::max())
         throw InputError(name + ": " + str(bytes.size()) + " bytes is more than the glTF parser takes (4 GiB)");
     tinygltf::TinyGLTF reader;
     reader.SetStoreOriginalJSONForExtrasAndExtensions(false);
+    reader.SetImageLoader(keepImageUndecoded, nullptr);
     if (!readFiles) reader.SetFsCallbacks(tinygltf::FsCallbacks{noFileExists, keepPath, noFileRead, nullptr, nullptr});
     tinygltf::Model model;
     std::string err, warn;
@@ -330,6 +339,10 @@ public:
         }
         defaultMaterial_ = std::uint32_t(scene_.materials.size());
         scene_.materials.push_back(Material{});
+        if (!model.images.empty())
+            scene_.warnings.push_back(name + ": " + std::to_string(model.images.size()) +
+                                      (model.images.size() == 1 ? " image (texture) is" : " images (textures) are") +
+                                      " not applied yet; the model is shaded with its base colour factors");
     }
 
     Scene run() {

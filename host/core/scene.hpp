@@ -54,6 +54,7 @@ struct Scene {
     std::vector<Material> materials;
     std::optional<SceneCamera> camera;              // the first perspective camera found
     std::uint64_t degenerateTrianglesDropped = 0;   // no area (triangleHasNoArea), dropped at load
+    std::vector<std::string> warnings;              // what the loader ignored, one line each (render prints them)
     // Changes whenever `triangles` does (load, applyCullMode): a frame's FrameGeometry
     // trianglesVersion, unique in the process. Code that edits `triangles` itself calls
     // touchTriangles(*this).

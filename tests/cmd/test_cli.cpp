@@ -417,6 +417,15 @@ TEST(Cli, EveryBackendCullsTheSameBackFacesAndTheSkipsChangeNoPixel) {
     }
 }
 
+TEST(Cli, ATexturedFileRendersWithAWarning) {
+    const std::string png = temp("textured.png");
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_texture_image.glb") + " --size 16x12 -o " + png);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("dacrt: warning: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("not applied yet"), std::string::npos) << r.output;
+    EXPECT_TRUE(std::filesystem::exists(png));
+}
+
 TEST(Cli, PlanAndStatsListEverySkipWithItsCounts) {
     const std::string scene = insideOutScene(), stats = temp("skips.json");
     const CommandResult plan = run("render " + scene + " --size 48x32 --regions 2 --plan");

@@ -4,7 +4,7 @@
 Each file is small enough to check by hand: positions, indices and transforms are listed
 below with the answers the tests expect.
 """
-import base64, json, math, struct
+import base64, json, math, struct, zlib
 
 def gltf(positions, indices=None, index_format=None, mode=4, nodes=None, extra=None, uri=None):
     pos = b"".join(struct.pack("<3f", *p) for p in positions)
@@ -78,6 +78,31 @@ write("triangle_trs_hierarchy.gltf", gltf([(0, 0, 0), (1, 0, 0), (0, 1, 0)],
 
 # A triangle fan of the quad (0 1 2 3) with u32 indices, as a binary .glb.
 glb("quad_fan_u32.glb", gltf(quad, [0, 1, 2, 3], "I", mode=6))
+
+# The quad with a 2x2 RGB texture image (red, green / blue, white), as a PNG in the GLB's
+# binary chunk and, in the .gltf, as a data URI: the loader keeps images undecoded (textures
+# are not applied yet) and must load the geometry with a warning.
+def png(width, height, rgb):
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
+    rows = b"".join(b"\0" + bytes(rgb[y * width * 3:(y + 1) * width * 3]) for y in range(height))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+texture = png(2, 2, [255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
+def add_texture(doc, embedded):
+    if embedded:
+        data = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+        offset = len(data)
+        data += texture + b"\0" * ((4 - len(texture) % 4) % 4)
+        doc["buffers"][0] = {"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": offset, "byteLength": len(texture)})
+        doc["images"] = [{"bufferView": len(doc["bufferViews"]) - 1, "mimeType": "image/png"}]
+    else:
+        doc["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(texture).decode()}]
+    doc["textures"] = [{"source": 0}]
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+glb("quad_texture_image.glb", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=lambda d: add_texture(d, True)))
+write("quad_texture_data_uri.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=lambda d: add_texture(d, False)))
 
 # Bad inputs.
 write("bad_index_out_of_range.gltf", gltf(quad, [0, 1, 2, 0, 2, 7], "B"))
