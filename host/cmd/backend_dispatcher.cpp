@@ -110,20 +110,20 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
         r.phaseMs.insert(r.phaseMs.begin(), {"skips", skipMs});
         return r;
     };
+    const PlanHook planWithSkips = withWorkLines(onPlan, skipPlan.work, true);
     if (skips.applied && skips.traced.empty()) {
         // No triangle can be hit: every ray misses, with nothing to divide or upload.
         TraceResult r;
         r.threads = threadPool.size();
-        skipPlan.add("hits", std::uint64_t(geometry.rays->size()) * sizeof(Hit));
-        r.memory = skipPlan;
-        if (onPlan && !onPlan(r.memory)) return r;
-        r.hits.assign(geometry.rays->size(), missHit());
-        r.counters.raysCulled = geometry.rays->size();
-        r.memory.work.clear();
+        r.memory.add("hits", std::uint64_t(geometry.rays->size()) * sizeof(Hit));
+        if (!planWithSkips || planWithSkips(r.memory)) {
+            r.hits.assign(geometry.rays->size(), missHit());
+            r.counters.raysCulled = geometry.rays->size();
+        }
         return withSkipLines(std::move(r));
     }
     const FrameGeometry traced = withSkips(geometry, skips);
-    return withSkipLines(traceOnBackend(traced, request, withWorkLines(onPlan, skipPlan.work, true), onProgress));
+    return withSkipLines(traceOnBackend(traced, request, planWithSkips, onProgress));
 }
 
 TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request,

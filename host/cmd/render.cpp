@@ -67,6 +67,15 @@ PreparedScene loadAndPrepare(const RenderOptions& o) {
     return p;
 }
 
+// The frame of one camera's rays: the scene's arrays, its view frustum, its triangles' version.
+FrameGeometry cameraFrame(const RenderOptions& o, const PreparedScene& p, const Camera& camera,
+                          const std::vector<Ray>& rays) {
+    FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
+    g.frustum = viewFrustum(camera, o.width, o.height);
+    g.trianglesVersion = p.scene.trianglesVersion;
+    return g;
+}
+
 // Prints the plan and stops the frame under --plan; otherwise refuses a plan that exceeds
 // this machine's memory.
 PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t rays, int cameraIndex) {
@@ -103,10 +112,7 @@ std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScen
     for (int j = 0; j < k; ++j)
         for (int i = 0; i < k; ++i) {
             const std::vector<Ray> rays = primaryRays(camera, o.width, o.height, {(i + 0.5) / k, (j + 0.5) / k});
-            FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
-            g.frustum = viewFrustum(camera, o.width, o.height);
-            g.trianglesVersion = p.scene.trianglesVersion;
-            const TraceResult r = backends.trace(g, o.request);
+            const TraceResult r = backends.trace(cameraFrame(o, p, camera, rays), o.request);
             accumulateShading(p.scene, HitImage{o.width, o.height, &rays, &r.hits}, 1.0f / float(k * k), sum);
         }
     samplesMs = msSince(start);
@@ -193,9 +199,7 @@ int runRender(const RenderOptions& o) {
         const Camera& camera = p.cameras[std::size_t(k)];
         const auto frameStart = Clock::now();
         const std::vector<Ray> rays = primaryRays(camera, o.width, o.height);
-        FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
-        g.frustum = viewFrustum(camera, o.width, o.height);
-        g.trianglesVersion = p.scene.trianglesVersion;
+        const FrameGeometry g = cameraFrame(o, p, camera, rays);
         const double prepareMs = p.prepareMs + msSince(frameStart);
 
         const auto traceStart = Clock::now();

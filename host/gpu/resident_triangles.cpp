@@ -6,8 +6,8 @@ bool ResidentTriangles::holds(const FrameGeometry& g) const {
     return triangles_ && g.trianglesVersion != 0 && g.trianglesVersion == version_ && g.triangles->size() == count_;
 }
 
-std::uint64_t ResidentTriangles::prepare(const Context& context, const FrameGeometry& g) {
-    if (holds(g)) return 0;
+void ResidentTriangles::prepare(const Context& context, const FrameGeometry& g) {
+    if (holds(g)) return;
     const std::uint64_t n = g.triangles->size();
     if (!triangles_ || count_ != n) {
         triangles_.reset();
@@ -19,7 +19,6 @@ std::uint64_t ResidentTriangles::prepare(const Context& context, const FrameGeom
     bounds_->upload(g.triangleBounds->data(), n * sizeof(Bounds));
     version_ = g.trianglesVersion;
     count_ = n;
-    return n * (sizeof(Triangle) + sizeof(Bounds));
 }
 
 }  // namespace dacrt::gpu

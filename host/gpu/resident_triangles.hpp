@@ -15,8 +15,8 @@ class ResidentTriangles {
 public:
     // Whether the buffers already hold g's triangles and bounds.
     bool holds(const FrameGeometry& g) const;
-    // Makes them hold g's (allocating and uploading unless holds(g)); returns the bytes uploaded.
-    std::uint64_t prepare(const Context& context, const FrameGeometry& g);
+    // Makes them hold g's (allocating and uploading unless holds(g)).
+    void prepare(const Context& context, const FrameGeometry& g);
     Buffer& triangles() { return *triangles_; }
     Buffer& bounds() { return *bounds_; }
 
