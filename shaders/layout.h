@@ -108,7 +108,7 @@ struct StackEntry {   // a far child waiting, with its parent's ranges
 
 // Push constants of the DACRT kernel.
 struct DacrtPush {
-    vec3 rayOrigin;        // every ray starts here: the near child is the one on its side
+    vec3 rayOrigin;        // the rays' near side (FrameGeometry::nearSide), their origin when they share it: the near child is the one on its side
     float margin;          // filter widening (filterMargin)
     uint firstWorkItem;    // this dispatch's work items are [firstWorkItem, + group count)
     uint axis;             // division axis

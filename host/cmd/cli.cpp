@@ -14,6 +14,7 @@
 #include "cmd/bench/bench.hpp"
 #include "cmd/exit_codes.hpp"
 #include "cmd/output_paths.hpp"
+#include "cmd/info.hpp"
 #include "cmd/render.hpp"
 #include "cmd/stress/stress.hpp"
 #include "core/atomic_file.hpp"
@@ -180,6 +181,8 @@ Subcommand addRenderCommand(CLI::App& app) {
     RenderOptions& render = s->render;
     CLI::App* cmd = app.add_subcommand("render", "trace primary rays through a glTF scene");
     cmd->add_option("scene", render.scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
+    cmd->add_option("--scene", render.sceneChoice, "which of the file's scenes, by index or name (default: the file's default scene; 'dacrt info' lists them)");
+    cmd->add_option("--camera", render.cameraChoice, "which camera the scene places, by glTF camera index or name (default: the first; 'dacrt info' lists them)");
     cmd->add_option("-o,--output", render.outputPath, "shaded image (PNG or any OpenImageIO format)");
     cmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id and hit mask");
     cmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
@@ -224,6 +227,14 @@ Subcommand addRenderCommand(CLI::App& app) {
                 r.request.embree.imageWidth = std::uint32_t(r.width);
                 return runRender(r);
             }};
+}
+
+Subcommand addInfoCommand(CLI::App& app) {
+    auto options = std::make_shared<InfoOptions>();
+    CLI::App* cmd = app.add_subcommand("info", "what a glTF file holds: scenes, cameras, lights, meshes, materials, textures, extensions, bounds");
+    cmd->add_option("scene", options->scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
+    cmd->add_option("--scene", options->sceneChoice, "which of the file's scenes to load and measure, by index or name (default: the file's default scene)");
+    return {cmd, [options] { return runInfo(*options); }};
 }
 
 Subcommand addDevicesCommand(CLI::App& app) {
@@ -389,7 +400,7 @@ int runCli(int argc, char** argv) {
     CLI::App app{"dacrt: divide-and-conquer ray tracing without an acceleration structure"};
     app.require_subcommand(1);
     app.footer(exitCodeHelp());
-    const std::vector<Subcommand> commands = {addRenderCommand(app), addDevicesCommand(app), addCompareCommand(app),
+    const std::vector<Subcommand> commands = {addRenderCommand(app), addInfoCommand(app), addDevicesCommand(app), addCompareCommand(app),
                                               addStressCommand(app), addBenchCommand(app)};
     try {
         app.parse(argc, argv);

@@ -55,7 +55,8 @@ struct PreparedScene {
 PreparedScene loadAndPrepare(const RenderOptions& o) {
     PreparedScene p;
     const auto start = Clock::now();
-    p.scene = loadGltf(o.scenePath);
+    p.scene = loadGltf(o.scenePath, {}, GltfSelection{o.sceneChoice});
+    selectCamera(p.scene, o.cameraChoice);
     for (const std::string& w : p.scene.warnings) std::cerr << "dacrt: warning: " << w << "\n";
     applyCullMode(p.scene, o.cull);
     p.loadMs = msSince(start);

@@ -9,6 +9,8 @@ namespace dacrt {
 
 struct RenderOptions {
     std::string scenePath;
+    std::string sceneChoice;   // --scene: an index or name among the file's scenes; empty: its default
+    std::string cameraChoice;  // --camera: an index or name among the cameras the scene places; empty: the first
     std::string outputPath;   // shaded image; empty: none
     std::string aovPath;      // EXR AOVs; empty: none
     std::string statsPath;    // JSON; empty: none

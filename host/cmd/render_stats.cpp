@@ -25,8 +25,11 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     j["regions"] = r.regions;
     j["threads"] = r.threads;
     j["division_axis"] = r.axis < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(std::string(1, "xyz"[r.axis]));
-    j["camera"] = {{"index", frame.cameraIndex}, {"eye", vec(camera.eye)}, {"forward", vec(camera.forward)},
-                   {"up", vec(camera.up)}, {"yfov_degrees", glm::degrees(camera.yfovRadians)}};
+    j["camera"] = {{"index", frame.cameraIndex}, {"projection", toString(camera.projection)}, {"eye", vec(camera.eye)},
+                   {"forward", vec(camera.forward)}, {"up", vec(camera.up)}};
+    if (camera.projection == Projection::Perspective) j["camera"]["yfov_degrees"] = glm::degrees(camera.yfovRadians);
+    else j["camera"]["ymag"] = camera.ymag;
+    if (scene.camera && !scene.camera->name.empty()) j["camera"]["name"] = scene.camera->name;
     const DacrtOptions dacrt = trace.dacrt.resolvedFor(trace.backend);
     j["options"] = {{"ray_limit", dacrt.rayLimit}, {"tri_limit", dacrt.triLimit},
                     {"max_depth", trace.dacrt.maxDepth}, {"split", toString(trace.dacrt.split)},

@@ -44,7 +44,8 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
     const glm::dvec3 centre = glm::dvec3(bounds.center());
     double yfov = glm::radians(kDefaultFovDegrees);
     glm::dvec3 eye, target = centre, up{0.0, 1.0, 0.0};
-    if (scene.camera && !options.eye && !options.target) {
+    const bool fromScene = scene.camera && !options.eye && !options.target;
+    if (fromScene) {
         yfov = scene.camera->yfovRadians;
         eye = scene.camera->eye;
         target = eye + scene.camera->forward;
@@ -66,7 +67,14 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
             throw InputError("camera: the vertical field of view must lie strictly between 0 and 180 degrees, got " + std::to_string(deg));
         yfov = glm::radians(deg);
     }
-    const Camera base = lookAt(eye, target, up, yfov);
+    Camera base = lookAt(eye, target, up, yfov);
+    if (fromScene && scene.camera->projection == Projection::Orthographic) {
+        if (options.fovDegrees)
+            throw InputError("camera: the scene's camera is orthographic, which has no field of view (--fov); give --eye or --target for a perspective view");
+        base.projection = Projection::Orthographic;
+        base.ymag = scene.camera->ymag;
+        base.yfovRadians = 0.0;
+    }
     if (options.orbit < 0) throw InputError("camera: an orbit needs a positive number of cameras");
     if (options.orbit <= 1) return {base};
 
@@ -84,7 +92,8 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
     return cameras;
 }
 
-ViewFrustum viewFrustum(const Camera& camera, int width, int height) {
+std::optional<ViewFrustum> viewFrustum(const Camera& camera, int width, int height) {
+    if (camera.projection == Projection::Orthographic) return std::nullopt;
     // primaryRayRow's directions are forward + sx right + sy up with |sx| <= x and |sy| <= y;
     // n . d is affine in (sx, sy), so the rectangle's edges bound it.
     const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
@@ -123,13 +132,16 @@ namespace {
 
 void primaryRayRow(const Camera& camera, int width, int height, glm::dvec2 offset, int y, Ray* row) {
     const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
-    const double tanHalf = std::tan(0.5 * camera.yfovRadians);
     const double aspect = double(width) / double(height);
+    const bool orthographic = camera.projection == Projection::Orthographic;
+    const double halfHeight = orthographic ? camera.ymag : std::tan(0.5 * camera.yfovRadians);
     const glm::vec3 origin = glm::vec3(camera.eye);
     for (int x = 0; x < width; ++x) {
-        const double sx = (2.0 * (x + offset.x) / width - 1.0) * tanHalf * aspect;
-        const double sy = (1.0 - 2.0 * (y + offset.y) / height) * tanHalf;
-        row[x] = makeRay(origin, camera.forward + sx * right + sy * camera.up);
+        const double sx = (2.0 * (x + offset.x) / width - 1.0) * halfHeight * aspect;
+        const double sy = (1.0 - 2.0 * (y + offset.y) / height) * halfHeight;
+        const glm::dvec3 offPlane = sx * right + sy * camera.up;
+        row[x] = orthographic ? makeRay(glm::vec3(camera.eye + offPlane), camera.forward)
+                              : makeRay(origin, camera.forward + offPlane);
     }
 }
 

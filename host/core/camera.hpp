@@ -15,7 +15,9 @@ struct Camera {
     glm::dvec3 eye{0.0};
     glm::dvec3 forward{0.0, 0.0, -1.0};  // unit
     glm::dvec3 up{0.0, 1.0, 0.0};        // unit, orthogonal to forward
-    double yfovRadians = 0.0;
+    double yfovRadians = 0.0;            // perspective
+    Projection projection = Projection::Perspective;
+    double ymag = 0.0;                   // orthographic: half the view's height
 };
 
 struct CameraOptions {
@@ -28,8 +30,8 @@ struct CameraOptions {
 
 constexpr double kDefaultFovDegrees = 45.0;
 
-// The scene's camera if it has one, else a front view (looking down -z) framing the box;
-// options override it. With orbit K, the K cameras are the base camera rotated about the
+// The scene's camera if it has one (perspective or orthographic), else a perspective front view
+// (looking down -z) framing the box; options override it (eye or target: a perspective view). With orbit K, the K cameras are the base camera rotated about the
 // vertical (y) axis through the box centre by 2 pi k / K. Throws InputError on bad values.
 std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const CameraOptions& options, double aspect);
 
@@ -41,7 +43,8 @@ struct ViewFrustum {
     glm::dvec3 apex{0.0};
     std::array<glm::dvec3, 4> inward{};
 };
-ViewFrustum viewFrustum(const Camera& camera, int width, int height);
+// Empty for an orthographic camera, whose rays share no apex.
+std::optional<ViewFrustum> viewFrustum(const Camera& camera, int width, int height);
 
 // Canonical float32 ray from an origin and a direction of any length: normalized in double,
 // rounded to float, components below 2^-64 flushed to zero (so 1/dir <= 2^64), and the
@@ -50,7 +53,9 @@ ViewFrustum viewFrustum(const Camera& camera, int width, int height);
 Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin = 0.0f);
 
 // One ray per pixel through the point `offset` of the pixel (in pixel units from its top-left
-// corner; the centre by default), row-major from the top-left pixel.
+// corner; the centre by default), row-major from the top-left pixel. Perspective rays start at
+// the eye; orthographic rays all travel along forward, from the pixel's point of the plane
+// through the eye (2 ymag high, the image's aspect wide), with tmin 0.
 std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::dvec2 offset = {0.5, 0.5});
 // The same rays, rows on every thread of pool, into rays (resized; reusing its memory).
 void primaryRays(const Camera& camera, int width, int height, ThreadPool& pool, std::vector<Ray>& rays,

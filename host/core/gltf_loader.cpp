@@ -1,6 +1,8 @@
 #include "core/gltf_loader.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstdio>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -8,7 +10,6 @@
 #include <limits>
 #include <string_view>
 
-#define TINYGLTF_IMPLEMENTATION
 #include <tiny_gltf.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -16,6 +17,10 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "core/errors.hpp"
+#include "core/gltf_accessors.hpp"
+#include "core/gltf_compression.hpp"
+#include "core/gltf_container.hpp"
+#include "core/gltf_materials.hpp"
 #include "core/json_nesting.hpp"
 #include "core/system_memory.hpp"
 #include "core/triangle_rules.hpp"
@@ -24,8 +29,10 @@ namespace dacrt {
 namespace {
 
 // What one flattened triangle costs while the scene is built and traced: the triangle, its
-// provenance and material (Scene), and its bounds (allTriangleBounds).
-constexpr std::uint64_t kBytesPerTriangle = sizeof(Triangle) + sizeof(TriangleSource) + 4 + sizeof(Bounds);
+// provenance and material (Scene), its bounds (allTriangleBounds), and at most its corners'
+// normals, texture coordinates and colours (CornerAttributes).
+constexpr std::uint64_t kBytesPerTriangle =
+    sizeof(Triangle) + sizeof(TriangleSource) + 4 + sizeof(Bounds) + 3 * (sizeof(glm::vec3) + sizeof(glm::vec2) + sizeof(glm::vec4));
 // Primitive ids are 32-bit and kMissPrim is reserved.
 constexpr std::uint64_t kMaxTriangles = std::numeric_limits<std::uint32_t>::max() - 1;
 
@@ -71,21 +78,13 @@ bool noFileRead(std::vector<unsigned char>*, std::string* err, const std::string
     return false;
 }
 
-// Textures are not applied yet, so images stay undecoded: a file that carries them (most
-// real-world .glb files) loads, and the flattener says they are ignored. tinygltf otherwise
-// refuses every embedded or data-URI image ("No LoadImageData callback specified").
-bool keepImageUndecoded(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                        void*) {
-    return true;
-}
-
 tinygltf::Model parseGltf(std::span<const unsigned char> bytes, const std::string& name, const std::string& baseDir,
                           bool readFiles) {
     if (bytes.size() > std::numeric_limits<unsigned int>::max())
         throw InputError(name + ": " + str(bytes.size()) + " bytes is more than the glTF parser takes (4 GiB)");
     tinygltf::TinyGLTF reader;
     reader.SetStoreOriginalJSONForExtrasAndExtensions(false);
-    reader.SetImageLoader(keepImageUndecoded, nullptr);
+    reader.SetImageLoader(gltf::keepEncodedImage, nullptr);
     if (!readFiles) reader.SetFsCallbacks(tinygltf::FsCallbacks{noFileExists, keepPath, noFileRead, nullptr, nullptr});
     tinygltf::Model model;
     std::string err, warn;
@@ -107,41 +106,47 @@ tinygltf::Model parseGltf(std::span<const unsigned char> bytes, const std::strin
 
 // ---- the rules of the glTF 2.0 specification the flattening relies on -------------------
 
-// A view of one accessor's elements, every offset checked in 64-bit arithmetic that cannot
-// wrap before any byte is read.
-struct ElementView {
-    const unsigned char* data = nullptr;
-    std::uint64_t stride = 0;
-    std::uint64_t count = 0;
-    int componentType = 0;
-};
+// Extensions dacrt reads; a file may require them. Any other required extension is refused.
+constexpr std::array<std::string_view, 6> kReadExtensions{"KHR_mesh_quantization", "EXT_meshopt_compression",
+                                                          "KHR_meshopt_compression", "KHR_draco_mesh_compression",
+                                                          "KHR_texture_transform", "KHR_lights_punctual"};
+bool readsExtension(const std::string& e) {
+    return std::find(kReadExtensions.begin(), kReadExtensions.end(), e) != kReadExtensions.end();
+}
+
+std::string joined(const std::vector<std::string>& items) {
+    std::string out;
+    for (const std::string& e : items) out += (out.empty() ? "" : ", ") + e;
+    return out;
+}
 
 class GltfChecker {
 public:
-    GltfChecker(const std::string& name, const tinygltf::Model& model) : name_(name), model_(model) {}
+    GltfChecker(const gltf::AccessorReader& reader) : reader_(reader), model_(reader.model()) {}
 
-    [[noreturn]] void fail(const std::string& what) const { throw InputError(name_ + ": " + what); }
+    [[noreturn]] void fail(const std::string& what) const { reader_.fail(what); }
+    std::uint64_t add(std::uint64_t a, std::uint64_t b, const std::string& what) const { return reader_.add(a, b, what); }
+    std::uint64_t mul(std::uint64_t a, std::uint64_t b, const std::string& what) const { return reader_.mul(a, b, what); }
 
-    // Sum and product that name the quantity instead of wrapping.
-    std::uint64_t add(std::uint64_t a, std::uint64_t b, const std::string& what) const {
-        std::uint64_t r;
-        if (__builtin_add_overflow(a, b, &r)) fail(what + " overflows 64 bits (" + str(a) + " + " + str(b) + ")");
-        return r;
+    // Required extensions dacrt does not read are refused by name; used ones it ignores are
+    // named in one warning.
+    void checkExtensions(std::vector<std::string>& warnings) const {
+        std::vector<std::string> refused, ignored;
+        for (const std::string& e : model_.extensionsRequired)
+            if (!readsExtension(e)) refused.push_back(e);
+        if (!refused.empty())
+            fail("the file requires the extension" + std::string(refused.size() > 1 ? "s " : " ") + joined(refused) +
+                 ", which dacrt does not support (it reads " + joined({kReadExtensions.begin(), kReadExtensions.end()}) + ")");
+        for (const std::string& e : model_.extensionsUsed)
+            if (!readsExtension(e)) ignored.push_back(e);
+        if (!ignored.empty())
+            warnings.push_back(reader_.name() + ": ignored the extension" + std::string(ignored.size() > 1 ? "s " : " ") +
+                               joined(ignored) + " (used, not required)");
     }
-    std::uint64_t mul(std::uint64_t a, std::uint64_t b, const std::string& what) const {
-        std::uint64_t r;
-        if (__builtin_mul_overflow(a, b, &r)) fail(what + " overflows 64 bits (" + str(a) + " x " + str(b) + ")");
-        return r;
-    }
 
-    void checkExtensions() const {
-        // No extension changes how dacrt reads geometry yet: a file that requires one cannot be
-        // read correctly without it.
-        if (!model_.extensionsRequired.empty()) {
-            std::string names;
-            for (const std::string& e : model_.extensionsRequired) names += (names.empty() ? "" : ", ") + e;
-            fail("the file requires the extension(s) " + names + ", which dacrt does not support");
-        }
+    bool uses(const char* extension) const {
+        return std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), extension) != model_.extensionsUsed.end() ||
+               std::find(model_.extensionsRequired.begin(), model_.extensionsRequired.end(), extension) != model_.extensionsRequired.end();
     }
 
     void checkCameras() const {
@@ -173,7 +178,7 @@ public:
     // transforms of the right sizes, unit rotations. Returns each node's parent (-1 for none).
     // (A node with both a matrix and TRS cannot be told apart here: tinygltf reads the matrix
     // and skips TRS, which is the transform dacrt then uses.)
-    std::vector<int> checkNodes() const {
+    std::vector<int> checkNodes(std::vector<std::string>& warnings) const {
         const std::size_t n = model_.nodes.size();
         std::vector<int> parent(n, -1);
         for (std::size_t i = 0; i < n; ++i) {
@@ -204,8 +209,13 @@ public:
             if (node.rotation.size() == 4) {
                 const double len = std::sqrt(node.rotation[0] * node.rotation[0] + node.rotation[1] * node.rotation[1] +
                                              node.rotation[2] * node.rotation[2] + node.rotation[3] * node.rotation[3]);
-                if (!(std::abs(len - 1.0) <= 1e-5))
+                // Exported files round their quaternions (Khronos' own Cameras sample: 1.000232);
+                // within 1% of unit length the rotation is meant, and is normalized.
+                if (!(std::abs(len - 1.0) <= 1e-2))
                     fail(where + ": the rotation quaternion has length " + std::to_string(len) + ", not 1");
+                if (std::abs(len - 1.0) > 1e-5)
+                    warnings.push_back(reader_.name() + ": " + where + ": the rotation quaternion has length " +
+                                       std::to_string(len) + "; normalized");
             }
         }
         // With one parent each, a node on a loop is never reached from a parentless node.
@@ -224,16 +234,37 @@ public:
         return parent;
     }
 
-    // The roots of the default scene (or, with no scene, every parentless node).
-    std::vector<int> sceneRoots(const std::vector<int>& parent) const {
-        std::vector<int> roots;
+    // Which scene to load: `choice` is an index or a scene name; empty: the file's default
+    // scene (or the first). -1 when the file has no scenes.
+    int chooseScene(const std::string& choice) const {
         if (model_.scenes.empty()) {
+            if (!choice.empty()) fail("the file has no scenes, so --scene " + choice + " names none");
+            return -1;
+        }
+        if (choice.empty()) {
+            const int index = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+            if (index >= int(model_.scenes.size())) fail("default scene " + std::to_string(index) + " does not exist");
+            return index;
+        }
+        for (std::size_t i = 0; i < model_.scenes.size(); ++i)
+            if (model_.scenes[i].name == choice) return int(i);
+        if (choice.find_first_not_of("0123456789") == std::string::npos && choice.size() < 10) {
+            const int index = std::stoi(choice);
+            if (index < int(model_.scenes.size())) return index;
+        }
+        std::vector<std::string> names;
+        for (std::size_t i = 0; i < model_.scenes.size(); ++i) names.push_back(str(i) + (model_.scenes[i].name.empty() ? "" : " '" + model_.scenes[i].name + "'"));
+        fail("no scene is called or numbered '" + choice + "' (the file has " + joined(names) + ")");
+    }
+
+    // The roots of the scene (or, with no scene, every parentless node).
+    std::vector<int> sceneRoots(const std::vector<int>& parent, int index) const {
+        std::vector<int> roots;
+        if (index < 0) {
             for (std::size_t i = 0; i < parent.size(); ++i)
                 if (parent[i] < 0) roots.push_back(int(i));
             return roots;
         }
-        const int index = model_.defaultScene >= 0 ? model_.defaultScene : 0;
-        if (index >= int(model_.scenes.size())) fail("default scene " + std::to_string(index) + " does not exist");
         for (int root : model_.scenes[std::size_t(index)].nodes) {
             if (root < 0 || std::size_t(root) >= parent.size()) fail("scene " + std::to_string(index) + " names node " + std::to_string(root) + ", which does not exist");
             if (parent[std::size_t(root)] >= 0)
@@ -246,53 +277,8 @@ public:
         return roots;
     }
 
-    ElementView view(int accessorIndex, int expectedType, const std::string& where) const {
-        if (accessorIndex < 0 || std::size_t(accessorIndex) >= model_.accessors.size())
-            fail(where + ": accessor " + std::to_string(accessorIndex) + " does not exist");
-        const tinygltf::Accessor& acc = model_.accessors[std::size_t(accessorIndex)];
-        const std::string a = where + ": accessor " + std::to_string(accessorIndex);
-        if (acc.type != expectedType) fail(a + " has the wrong type");
-        if (acc.sparse.isSparse) fail(a + " is sparse, which is not supported");
-        if (acc.bufferView < 0 || std::size_t(acc.bufferView) >= model_.bufferViews.size())
-            fail(a + " has no buffer view");
-        const int componentSize = tinygltf::GetComponentSizeInBytes(std::uint32_t(acc.componentType));
-        const int components = tinygltf::GetNumComponentsInType(std::uint32_t(acc.type));
-        if (componentSize <= 0 || components <= 0) fail(a + " has an unknown component type");
-        if (acc.count == 0) fail(a + " has count 0 (the minimum is 1)");
-        const tinygltf::BufferView& bv = model_.bufferViews[std::size_t(acc.bufferView)];
-        const std::string b = "buffer view " + std::to_string(acc.bufferView);
-        if (bv.buffer < 0 || std::size_t(bv.buffer) >= model_.buffers.size()) fail(b + " names a missing buffer");
-        const std::uint64_t bufferBytes = model_.buffers[std::size_t(bv.buffer)].data.size();
-        const std::uint64_t viewEnd = add(bv.byteOffset, bv.byteLength, b + ": byteOffset + byteLength");
-        if (viewEnd > bufferBytes)
-            fail(b + " (byteOffset " + str(bv.byteOffset) + ", byteLength " + str(bv.byteLength) + ") runs past the end of buffer " +
-                 std::to_string(bv.buffer) + " (" + str(bufferBytes) + " bytes)");
-        const std::uint64_t elementSize = std::uint64_t(componentSize) * std::uint64_t(components);
-        if (bv.byteStride != 0 && (bv.byteStride < 4 || bv.byteStride > 252 || bv.byteStride % 4 != 0))
-            fail(b + ": byteStride " + str(bv.byteStride) + " is not a multiple of 4 in 4..252");
-        if (bv.byteStride != 0 && bv.byteStride < elementSize)
-            fail(b + ": byteStride " + str(bv.byteStride) + " is smaller than the " + str(elementSize) + "-byte elements of " +
-                 "accessor " + std::to_string(accessorIndex));
-        if (acc.byteOffset % std::uint64_t(componentSize) != 0 ||
-            add(bv.byteOffset, acc.byteOffset, a + ": offset") % std::uint64_t(componentSize) != 0)
-            fail(a + ": byteOffset " + str(acc.byteOffset) + " is not aligned to its " + std::to_string(componentSize) + "-byte components");
-        const std::uint64_t stride = bv.byteStride ? bv.byteStride : elementSize;
-        const std::uint64_t span = add(mul(acc.count - 1, stride, a + ": count x stride"), elementSize, a + ": size");
-        const std::uint64_t end = add(acc.byteOffset, span, a + ": byteOffset + size");
-        if (end > bv.byteLength)
-            fail(a + " (" + str(acc.count) + " elements of " + str(elementSize) + " bytes, stride " + str(stride) +
-                 ", byteOffset " + str(acc.byteOffset) + ", " + str(end) + " bytes) runs past the end of " + b + " (" +
-                 str(bv.byteLength) + " bytes)");
-        ElementView v;
-        v.data = model_.buffers[std::size_t(bv.buffer)].data.data() + bv.byteOffset + acc.byteOffset;
-        v.stride = stride;
-        v.count = acc.count;
-        v.componentType = acc.componentType;
-        return v;
-    }
-
 private:
-    std::string name_;
+    const gltf::AccessorReader& reader_;
     const tinygltf::Model& model_;
 };
 
@@ -304,7 +290,9 @@ glm::dmat4 localTransform(const tinygltf::Node& node) {
     if (node.translation.size() == 3) m = glm::translate(m, glm::make_vec3(node.translation.data()));
     if (node.rotation.size() == 4) {
         const std::vector<double>& q = node.rotation;  // glTF order: x, y, z, w
-        m = m * glm::mat4_cast(glm::dquat(q[3], q[0], q[1], q[2]));
+        glm::dquat r(q[3], q[0], q[1], q[2]);
+        if (std::abs(glm::length(r) - 1.0) > 1e-12) r = glm::normalize(r);  // within 1% (checkNodes)
+        m = m * glm::mat4_cast(r);
     }
     if (node.scale.size() == 3) m = glm::scale(m, glm::make_vec3(node.scale.data()));
     return m;
@@ -325,37 +313,40 @@ const char* modeName(int mode) {
     }
 }
 
+bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+const std::string kPosition = "POSITION", kNormal = "NORMAL", kColor = "COLOR_0";
+std::string texCoordName(std::uint32_t set) { return "TEXCOORD_" + std::to_string(set); }
+
 class GltfFlattener {
 public:
-    GltfFlattener(const std::string& name, const tinygltf::Model& model, const GltfLimits& limits)
-        : name_(name), model_(model), limits_(limits), check_(name, model) {
-        scene_.name = name;
-        for (const tinygltf::Material& m : model.materials) {
-            Material mat;
-            const std::vector<double>& f = m.pbrMetallicRoughness.baseColorFactor;
-            if (f.size() == 4) mat.baseColor = glm::vec4(float(f[0]), float(f[1]), float(f[2]), float(f[3]));
-            mat.doubleSided = m.doubleSided;
-            scene_.materials.push_back(mat);
-        }
-        defaultMaterial_ = std::uint32_t(scene_.materials.size());
-        scene_.materials.push_back(Material{});
-        if (!model.images.empty())
-            scene_.warnings.push_back(name + ": " + std::to_string(model.images.size()) +
-                                      (model.images.size() == 1 ? " image (texture) is" : " images (textures) are") +
-                                      " not applied yet; the model is shaded with its base colour factors");
+    GltfFlattener(gltf::AccessorReader& reader, const GltfLimits& limits, const GltfSelection& selection,
+                  const gltf::ImageSource& images)
+        : reader_(reader), model_(reader.model()), limits_(limits), selection_(selection), images_(images), check_(reader) {
+        scene_.name = reader.name();
     }
 
     Scene run() {
-        check_.checkExtensions();
+        check_.checkExtensions(scene_.warnings);
         check_.checkCameras();
-        const std::vector<int> parent = check_.checkNodes();
-        const std::vector<NodeInstance> instances = walkHierarchy(check_.sceneRoots(parent));
+        const std::vector<int> parent = check_.checkNodes(scene_.warnings);
+        const int sceneIndex = check_.chooseScene(selection_.scene);
+        const std::vector<NodeInstance> instances = walkHierarchy(check_.sceneRoots(parent, sceneIndex));
+        gltf::decodeMeshoptViews(reader_, memoryLimit());
         planTriangles(instances);
+        gltf::readMaterials(reader_, images_, scene_);
+        defaultMaterial_ = std::uint32_t(scene_.materials.size());
+        Material fallback;
+        fallback.name = "(default)";
+        scene_.materials.push_back(fallback);
         for (const NodeInstance& i : instances) flattenNode(i);
+        takeInventory(sceneIndex);
         return std::move(scene_);
     }
 
 private:
+    std::uint64_t memoryLimit() const { return limits_.maxBytes ? limits_.maxBytes : physicalMemoryBytes(); }
+
     // Every node of the scene with its world transform, depth first without recursion.
     std::vector<NodeInstance> walkHierarchy(const std::vector<int>& roots) const {
         std::vector<NodeInstance> out;
@@ -375,17 +366,22 @@ private:
         return out;
     }
 
+    static int modeOf(const tinygltf::Primitive& prim) { return prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode; }
+
+    // The triangles a primitive declares, from its accessors' counts (a Draco primitive's
+    // accessors declare the decoded counts).
     std::uint64_t primitiveTriangles(const tinygltf::Primitive& prim, const std::string& where) const {
-        const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+        const int mode = modeOf(prim);
         if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
             check_.fail(where + ": primitive mode " + std::string(modeName(mode)) +
                         (mode > 6 ? " " + std::to_string(mode) : std::string()) +
                         " is not supported (only TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN)");
-        auto pos = prim.attributes.find("POSITION");
+        auto pos = prim.attributes.find(kPosition);
         if (pos == prim.attributes.end()) check_.fail(where + ": no POSITION attribute");
-        const ElementView positions = check_.view(pos->second, TINYGLTF_TYPE_VEC3, where + " POSITION");
+        // Counts are trusted only once their accessors' ranges are checked.
+        const std::uint64_t vertices = reader_.checkedCount(pos->second, {TINYGLTF_TYPE_VEC3}, where + " POSITION");
         const std::uint64_t corners =
-            prim.indices >= 0 ? check_.view(prim.indices, TINYGLTF_TYPE_SCALAR, where + " indices").count : positions.count;
+            prim.indices >= 0 ? reader_.checkedCount(prim.indices, {TINYGLTF_TYPE_SCALAR}, where + " indices") : vertices;
         if (mode == TINYGLTF_MODE_TRIANGLES) {
             if (corners % 3 != 0) check_.fail(where + ": " + str(corners) + " indices is not a multiple of 3");
             return corners / 3;
@@ -402,14 +398,7 @@ private:
             const int m = model_.nodes[std::size_t(i.node)].mesh;
             if (m < 0) continue;
             std::int64_t& count = meshTriangles[std::size_t(m)];
-            if (count < 0) {
-                std::uint64_t sum = 0;
-                const tinygltf::Mesh& mesh = model_.meshes[std::size_t(m)];
-                for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
-                    sum = check_.add(sum, primitiveTriangles(mesh.primitives[p], "mesh " + str(std::uint64_t(m)) + " primitive " + str(p)),
-                                     "the triangle count");
-                count = std::int64_t(std::min<std::uint64_t>(sum, std::uint64_t(std::numeric_limits<std::int64_t>::max())));
-            }
+            if (count < 0) count = std::int64_t(std::min<std::uint64_t>(meshTriangleCount(std::size_t(m)), std::uint64_t(std::numeric_limits<std::int64_t>::max())));
             total = check_.add(total, std::uint64_t(count), "the triangle count");
             ++meshInstances;
         }
@@ -417,16 +406,25 @@ private:
         if (total > kMaxTriangles)
             check_.fail("the scene has " + counted + ", more than the " + str(kMaxTriangles) + " that 32-bit primitive ids allow");
         const std::uint64_t bytes = check_.mul(total, kBytesPerTriangle, "the scene's size");
-        const std::uint64_t limit = limits_.maxBytes ? limits_.maxBytes : physicalMemoryBytes();
+        const std::uint64_t limit = memoryLimit();
         if (limit && bytes > limit)
             check_.fail("the scene has " + counted + ", which need " + str(bytes) + " bytes, more than the " + str(limit) +
                         " bytes of " + (limits_.maxBytes ? "the limit" : "this machine's memory") + " (over by " +
                         str(bytes - limit) + ")");
     }
 
+    std::uint64_t meshTriangleCount(std::size_t m) const {
+        std::uint64_t sum = 0;
+        const tinygltf::Mesh& mesh = model_.meshes[m];
+        for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
+            sum = check_.add(sum, primitiveTriangles(mesh.primitives[p], "mesh " + str(m) + " primitive " + str(p)), "the triangle count");
+        return sum;
+    }
+
     void flattenNode(const NodeInstance& instance) {
         const tinygltf::Node& node = model_.nodes[std::size_t(instance.node)];
-        if (node.camera >= 0) takeCamera(node.camera, instance.world);
+        if (node.camera >= 0) placeCamera(instance, node.camera);
+        placeLight(instance, node);
         if (node.mesh < 0) return;
         const tinygltf::Mesh& mesh = model_.meshes[std::size_t(node.mesh)];
         for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
@@ -434,54 +432,136 @@ private:
                          instance.world);
     }
 
-    void takeCamera(int cameraIndex, const glm::dmat4& world) {
-        if (scene_.camera) return;
+    void placeCamera(const NodeInstance& instance, int cameraIndex) {
         const tinygltf::Camera& cam = model_.cameras[std::size_t(cameraIndex)];
-        if (cam.type != "perspective") return;  // orthographic cameras fall back to the default view
         SceneCamera c;
+        const glm::dmat4& world = instance.world;
         c.eye = glm::dvec3(world * glm::dvec4(0, 0, 0, 1));
         c.forward = glm::normalize(glm::dvec3(world * glm::dvec4(0, 0, -1, 0)));
         c.up = glm::normalize(glm::dvec3(world * glm::dvec4(0, 1, 0, 0)));
-        c.yfovRadians = cam.perspective.yfov;
-        if (!std::isfinite(c.eye.x) || !std::isfinite(c.eye.y) || !std::isfinite(c.eye.z) ||
-            !std::isfinite(c.forward.x + c.forward.y + c.forward.z) || !std::isfinite(c.up.x + c.up.y + c.up.z))
-            check_.fail("camera " + std::to_string(cameraIndex) + " has a non-finite or degenerate placement");
-        scene_.camera = c;
+        c.name = cam.name;
+        c.cameraIndex = cameraIndex;
+        c.node = instance.node;
+        if (cam.type == "perspective") {
+            c.yfovRadians = cam.perspective.yfov;
+        } else {
+            c.projection = Projection::Orthographic;
+            // The node's scale along y scales the view like the geometry it frames.
+            c.ymag = std::abs(cam.orthographic.ymag) * glm::length(glm::dvec3(world * glm::dvec4(0, 1, 0, 0)));
+        }
+        if (!finite3(c.eye) || !finite3(c.forward) || !finite3(c.up) || !std::isfinite(c.ymag) ||
+            (c.projection == Projection::Orthographic && !(c.ymag > 0.0)))
+            check_.fail("camera " + std::to_string(cameraIndex) + " (node " + std::to_string(instance.node) +
+                        ") has a non-finite or degenerate placement");
+        scene_.cameras.push_back(c);
+        if (!scene_.camera) scene_.camera = c;
     }
 
-    std::vector<std::uint32_t> readIndices(const tinygltf::Primitive& prim, std::uint64_t vertexCount, const std::string& where) const {
-        std::vector<std::uint32_t> indices;
-        if (prim.indices < 0) {
-            indices.resize(vertexCount);
-            for (std::size_t i = 0; i < indices.size(); ++i) indices[i] = std::uint32_t(i);
-            return indices;
+    void placeLight(const NodeInstance& instance, const tinygltf::Node& node) {
+        auto ext = node.extensions.find("KHR_lights_punctual");
+        if (ext == node.extensions.end() || !ext->second.IsObject() || !ext->second.Has("light")) return;
+        const tinygltf::Value& index = ext->second.Get("light");
+        const std::string where = "node " + std::to_string(instance.node) + ": KHR_lights_punctual";
+        if (!index.IsNumber() || index.GetNumberAsDouble() < 0 || index.GetNumberAsDouble() >= double(model_.lights.size()))
+            check_.fail(where + " names a light that does not exist");
+        const std::size_t li = std::size_t(index.GetNumberAsDouble());
+        const tinygltf::Light& l = model_.lights[li];
+        Light light;
+        light.name = l.name;
+        light.node = std::uint32_t(instance.node);
+        if (l.type == "point") light.type = LightType::Point;
+        else if (l.type == "spot") light.type = LightType::Spot;
+        else if (l.type == "directional") light.type = LightType::Directional;
+        else check_.fail("light " + str(li) + ": type '" + l.type + "' is none of point, spot, directional");
+        if (l.color.size() == 3) light.color = glm::vec3(float(l.color[0]), float(l.color[1]), float(l.color[2]));
+        light.intensity = float(l.intensity);
+        light.range = float(l.range);
+        light.innerConeAngle = float(l.spot.innerConeAngle);
+        light.outerConeAngle = float(l.spot.outerConeAngle);
+        if (!std::isfinite(light.color.x + light.color.y + light.color.z + light.intensity + light.range) || light.intensity < 0 ||
+            light.range < 0)
+            check_.fail("light " + str(li) + ": colour, intensity and range must be finite and not negative");
+        if (light.type == LightType::Spot &&
+            !(light.innerConeAngle >= 0 && light.innerConeAngle < light.outerConeAngle && light.outerConeAngle <= M_PI / 2 + 1e-6))
+            check_.fail("light " + str(li) + ": a spot light needs 0 <= innerConeAngle < outerConeAngle <= pi/2");
+        light.position = glm::dvec3(instance.world * glm::dvec4(0, 0, 0, 1));
+        light.direction = glm::dvec3(instance.world * glm::dvec4(0, 0, -1, 0));
+        const double length = glm::length(light.direction);
+        if (!finite3(light.position) || !(length > 0.0) || !std::isfinite(length))
+            check_.fail(where + ": the light's placement is non-finite or degenerate");
+        light.direction /= length;
+        scene_.lights.push_back(light);
+    }
+
+    // The attributes the shading reads, for a primitive whose material is `material`.
+    std::vector<std::string> wantedAttributes(std::uint32_t material) const {
+        std::vector<std::string> names{kPosition, kNormal, kColor};
+        if (scene_.materials[material].baseColorTexture.texture >= 0)
+            names.push_back(texCoordName(scene_.materials[material].baseColorTexture.texCoord));
+        return names;
+    }
+
+    gltf::PrimitiveData readPrimitive(const tinygltf::Primitive& prim, const std::vector<std::string>& wanted,
+                                      const std::string& where) const {
+        if (gltf::usesDraco(prim)) return gltf::decodeDracoPrimitive(reader_, prim, wanted, where);
+        gltf::PrimitiveData data;
+        if (prim.indices >= 0) {
+            data.indexed = true;
+            data.indices = reader_.readIndices(prim.indices, where + " indices");
         }
-        const ElementView iv = check_.view(prim.indices, TINYGLTF_TYPE_SCALAR, where + " indices");
-        indices.resize(iv.count);
-        for (std::size_t i = 0; i < iv.count; ++i) {
-            const unsigned char* p = iv.data + i * iv.stride;
-            switch (iv.componentType) {
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: indices[i] = *p; break;
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t x; std::memcpy(&x, p, 2); indices[i] = x; break; }
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&indices[i], p, 4); break;
-                default: check_.fail(where + ": indices must be unsigned 8, 16 or 32-bit integers");
-            }
+        for (const std::string& name : wanted) {
+            auto a = prim.attributes.find(name);
+            if (a == prim.attributes.end()) continue;
+            const std::string w = where + " " + name;
+            if (name == kColor) data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, w);
+            else if (name.rfind("TEXCOORD_", 0) == 0) data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC2}, w);
+            else data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3}, w);
         }
-        return indices;
+        return data;
+    }
+
+    // POSITION must be float unless the file uses KHR_mesh_quantization, which allows
+    // (normalized) 8 and 16-bit integers.
+    void checkPositionType(const tinygltf::Primitive& prim, const std::string& where) const {
+        const tinygltf::Accessor& acc = reader_.accessor(prim.attributes.at(kPosition), {TINYGLTF_TYPE_VEC3}, where + " POSITION");
+        const int t = acc.componentType;
+        if (t == TINYGLTF_COMPONENT_TYPE_FLOAT) return;
+        const bool quantizable = t == TINYGLTF_COMPONENT_TYPE_BYTE || t == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                 t == TINYGLTF_COMPONENT_TYPE_SHORT || t == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+        if (!quantizable) check_.fail(where + ": POSITION must be float32, or 8 or 16-bit integers under KHR_mesh_quantization");
+        if (!check_.uses("KHR_mesh_quantization"))
+            check_.fail(where + ": POSITION is quantized (integer components), which needs the extension KHR_mesh_quantization the file does not declare");
+    }
+
+    // Grows an attribute array to one entry per triangle so far, with its default.
+    template <typename T>
+    static void fillTo(std::vector<std::array<T, 3>>& v, std::size_t n, const T& value) {
+        if (v.size() < n) v.resize(n, {value, value, value});
     }
 
     void addPrimitive(std::uint32_t node, std::uint32_t meshIndex, std::uint32_t primIndex,
                       const tinygltf::Primitive& prim, const glm::dmat4& world) {
         const std::string where = "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(primIndex);
-        const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-        const ElementView positions = check_.view(prim.attributes.at("POSITION"), TINYGLTF_TYPE_VEC3, where + " POSITION");
-        if (positions.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
-            check_.fail(where + ": POSITION must be float32 (quantized positions are not supported)");
-        const std::vector<std::uint32_t> indices = readIndices(prim, positions.count, where);
+        const int mode = modeOf(prim);
+        std::uint32_t material = defaultMaterial_;
+        if (prim.material >= 0) {
+            if (std::size_t(prim.material) >= model_.materials.size())
+                check_.fail(where + ": material " + std::to_string(prim.material) + " does not exist");
+            material = std::uint32_t(prim.material);
+        }
+        checkPositionType(prim, where);
+        const gltf::PrimitiveData data = readPrimitive(prim, wantedAttributes(material), where);
+        if (!data.attributes.count(kPosition)) check_.fail(where + ": no POSITION data");
+        const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
+        std::vector<std::uint32_t> indices = data.indices;
+        if (!data.indexed) {
+            indices.resize(positions.size());
+            for (std::size_t i = 0; i < indices.size(); ++i) indices[i] = std::uint32_t(i);
+        }
 
         std::vector<std::uint32_t> corners;  // three per triangle, as TRIANGLES
         if (mode == TINYGLTF_MODE_TRIANGLES) {
-            corners = indices;
+            corners = std::move(indices);
         } else {
             for (std::size_t i = 2; i < indices.size(); ++i) {
                 if (mode == TINYGLTF_MODE_TRIANGLE_FAN) corners.insert(corners.end(), {indices[0], indices[i - 1], indices[i]});
@@ -489,38 +569,48 @@ private:
                 else corners.insert(corners.end(), {indices[i - 1], indices[i - 2], indices[i]});
             }
         }
+        if (corners.size() % 3 != 0) check_.fail(where + ": " + str(corners.size()) + " indices is not a multiple of 3");
 
-        std::vector<glm::vec3> worldPositions(positions.count);
-        for (std::size_t i = 0; i < positions.count; ++i) {
-            float xyz[3];
-            std::memcpy(xyz, positions.data + i * positions.stride, sizeof(xyz));
-            if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
-                check_.fail(where + ": vertex " + std::to_string(i) + " has a non-finite position (" + std::to_string(xyz[0]) +
-                            ", " + std::to_string(xyz[1]) + ", " + std::to_string(xyz[2]) + ")");
-            worldPositions[i] = glm::vec3(world * glm::dvec4(xyz[0], xyz[1], xyz[2], 1.0));
+        std::vector<glm::vec3> worldPositions(positions.size());
+        for (std::size_t i = 0; i < positions.size(); ++i) {
+            const glm::dvec3 p(positions[i]);
+            if (!finite3(p))
+                check_.fail(where + ": vertex " + std::to_string(i) + " has a non-finite position (" + std::to_string(p.x) +
+                            ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
+            worldPositions[i] = glm::vec3(world * glm::dvec4(p, 1.0));
         }
-
-        std::uint32_t material = defaultMaterial_;
-        if (prim.material >= 0) {
-            if (std::size_t(prim.material) >= model_.materials.size())
-                check_.fail(where + ": material " + std::to_string(prim.material) + " does not exist");
-            material = std::uint32_t(prim.material);
-        }
+        auto attribute = [&](const std::string& name) -> const std::vector<glm::dvec4>* {
+            auto it = data.attributes.find(name);
+            if (it == data.attributes.end()) return nullptr;
+            if (it->second.size() != positions.size())
+                check_.fail(where + ": " + name + " has " + str(it->second.size()) + " elements, POSITION has " + str(positions.size()));
+            return &it->second;
+        };
+        const std::vector<glm::dvec4>* normals = attribute(kNormal);
+        const std::vector<glm::dvec4>* colors = attribute(kColor);
+        const TextureBinding& texture = scene_.materials[material].baseColorTexture;
+        const std::vector<glm::dvec4>* texCoords = texture.texture >= 0 ? attribute(texCoordName(texture.texCoord)) : nullptr;
+        const bool colorHasAlpha = colors && prim.attributes.count(kColor) &&
+                                   model_.accessors[std::size_t(prim.attributes.at(kColor))].type == TINYGLTF_TYPE_VEC4;
+        const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
 
         // glTF: a node whose global transform mirrors (negative determinant) turns its
         // triangles' winding clockwise; swapping two corners keeps counter-clockwise the front.
         const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+        const int order[3] = {0, mirrored ? 2 : 1, mirrored ? 1 : 2};
         const std::uint32_t cullBackFace = scene_.materials[material].doubleSided ? 0u : 1u;
+        CornerAttributes& out = scene_.corners;
         for (std::size_t t = 0; t * 3 < corners.size(); ++t) {
             Triangle tri{};
             tri.cullBackFace = cullBackFace;
-            glm::vec3* v[3] = {&tri.v0, mirrored ? &tri.v2 : &tri.v1, mirrored ? &tri.v1 : &tri.v2};
+            glm::vec3* v[3] = {&tri.v0, &tri.v1, &tri.v2};
+            std::uint32_t index[3];
             for (int k = 0; k < 3; ++k) {
-                const std::uint32_t index = corners[t * 3 + std::size_t(k)];
-                if (index >= positions.count)
-                    check_.fail(where + ": index " + std::to_string(index) + " (triangle " + std::to_string(t) +
-                                ") is out of range for " + str(positions.count) + " vertices");
-                *v[k] = worldPositions[index];
+                index[k] = corners[t * 3 + std::size_t(order[k])];
+                if (index[k] >= positions.size())
+                    check_.fail(where + ": index " + std::to_string(index[k]) + " (triangle " + std::to_string(t) +
+                                ") is out of range for " + str(positions.size()) + " vertices");
+                *v[k] = worldPositions[index[k]];
             }
             // Never hit, so never traced. (A non-finite vertex gives a non-zero cross product:
             // such a triangle stays, for validateScene to refuse.)
@@ -528,34 +618,100 @@ private:
                 ++scene_.degenerateTrianglesDropped;
                 continue;
             }
+            const std::size_t at = scene_.triangles.size();
             scene_.triangles.push_back(tri);
             scene_.sources.push_back(TriangleSource{node, meshIndex, primIndex, std::uint32_t(t)});
             scene_.materialOfTriangle.push_back(material);
+            if (normals || !out.normals.empty()) {
+                fillTo(out.normals, at + 1, glm::vec3(0.0f));
+                for (int k = 0; normals && k < 3; ++k) {
+                    const glm::dvec3 n = normalMatrix * glm::dvec3((*normals)[index[k]]);
+                    const double length = glm::length(n);
+                    out.normals[at][std::size_t(k)] = length > 0.0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f);
+                }
+            }
+            if (colors || !out.colors.empty()) {
+                fillTo(out.colors, at + 1, glm::vec4(1.0f));
+                for (int k = 0; colors && k < 3; ++k) {
+                    glm::vec4 c((*colors)[index[k]]);
+                    if (!colorHasAlpha) c.a = 1.0f;
+                    out.colors[at][std::size_t(k)] = glm::clamp(c, 0.0f, 1.0f);
+                }
+            }
+            if (texCoords || !out.texCoords.empty()) {
+                fillTo(out.texCoords, at + 1, glm::vec2(0.0f));
+                for (int k = 0; texCoords && k < 3; ++k) {
+                    const glm::vec2 uv((*texCoords)[index[k]]);
+                    out.texCoords[at][std::size_t(k)] = std::isfinite(uv.x) && std::isfinite(uv.y) ? uv : glm::vec2(0.0f);
+                }
+            }
         }
         touchTriangles(scene_);
     }
 
-    std::string name_;
+    void takeInventory(int sceneIndex) {
+        GltfInventory& inv = scene_.inventory;
+        inv.loadedScene = sceneIndex < 0 ? 0 : std::uint32_t(sceneIndex);
+        auto named = [](const std::string& n) { return n.empty() ? std::string() : " '" + n + "'"; };
+        for (std::size_t i = 0; i < model_.scenes.size(); ++i)
+            inv.scenes.push_back(str(i) + named(model_.scenes[i].name) + ": " + str(model_.scenes[i].nodes.size()) + " root node(s)" +
+                                 (int(i) == sceneIndex ? " (loaded)" : ""));
+        for (std::size_t m = 0; m < model_.meshes.size(); ++m) {
+            std::string compressed, triangles;
+            for (const tinygltf::Primitive& p : model_.meshes[m].primitives)
+                if (gltf::usesDraco(p)) compressed = ", Draco";
+            try {  // meshes no node of the loaded scene places were never checked
+                triangles = str(meshTriangleCount(m)) + " triangles";
+            } catch (const InputError& e) {
+                triangles = "unreadable (" + std::string(e.what()) + ")";
+            }
+            inv.meshes.push_back(str(m) + named(model_.meshes[m].name) + ": " + str(model_.meshes[m].primitives.size()) +
+                                 " primitive(s), " + triangles + compressed);
+        }
+        for (std::size_t m = 0; m + 1 < scene_.materials.size(); ++m) {
+            const Material& mat = scene_.materials[m];
+            char colour[96];
+            std::snprintf(colour, sizeof colour, "base colour (%.3g, %.3g, %.3g, %.3g)", mat.baseColor.r, mat.baseColor.g,
+                          mat.baseColor.b, mat.baseColor.a);
+            std::string texture;
+            if (mat.baseColorTexture.texture >= 0)
+                texture = ", texture '" + scene_.textures[std::size_t(mat.baseColorTexture.texture)].name + "' (TEXCOORD_" +
+                          str(mat.baseColorTexture.texCoord) + ")";
+            inv.materials.push_back(str(m) + named(mat.name) + ": " + colour + texture +
+                                    (mat.doubleSided ? ", double-sided" : ", single-sided"));
+        }
+        for (const Texture& t : scene_.textures)
+            inv.textures.push_back("'" + t.name + "': " + std::to_string(t.width) + " x " + std::to_string(t.height));
+        inv.extensionsUsed = model_.extensionsUsed;
+        inv.extensionsRequired = model_.extensionsRequired;
+    }
+
+    gltf::AccessorReader& reader_;
     const tinygltf::Model& model_;
     GltfLimits limits_;
+    GltfSelection selection_;
+    gltf::ImageSource images_;
     GltfChecker check_;
     Scene scene_;
     std::uint32_t defaultMaterial_ = 0;
 };
 
 Scene loadFromBytes(std::span<const unsigned char> bytes, const std::string& name, const std::string& baseDir,
-                    bool readFiles, const GltfLimits& limits) {
+                    bool readFiles, const GltfLimits& limits, const GltfSelection& selection) {
     if (bytes.empty()) throw InputError(name + ": the file is empty");
     checkJsonNesting(bytes, name, limits);
-    const tinygltf::Model model = parseGltf(bytes, name, baseDir, readFiles);
-    Scene scene = GltfFlattener(name, model, limits).run();
+    const gltf::PreparedContainer prepared = gltf::prepareForParser(bytes);
+    const tinygltf::Model model = parseGltf(prepared.bytes.empty() ? bytes : std::span<const unsigned char>(prepared.bytes),
+                                            name, baseDir, readFiles);
+    gltf::AccessorReader reader(name, model, prepared.rewrites);
+    Scene scene = GltfFlattener(reader, limits, selection, gltf::ImageSource{baseDir, readFiles}).run();
     validateScene(scene);
     return scene;
 }
 
 }  // namespace
 
-Scene loadGltf(const std::string& path, const GltfLimits& limits) {
+Scene loadGltf(const std::string& path, const GltfLimits& limits, const GltfSelection& selection) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": no such file");
     const std::uint64_t size = std::filesystem::file_size(path, ec);
@@ -568,11 +724,36 @@ Scene loadGltf(const std::string& path, const GltfLimits& limits) {
     if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
         throw InputError(path + ": cannot read the file");
     const std::string baseDir = std::filesystem::path(path).parent_path().string();
-    return loadFromBytes(bytes, path, baseDir.empty() ? "." : baseDir, true, limits);
+    return loadFromBytes(bytes, path, baseDir.empty() ? "." : baseDir, true, limits, selection);
 }
 
-Scene loadGltfFromMemory(std::span<const unsigned char> bytes, const std::string& name, const GltfLimits& limits) {
-    return loadFromBytes(bytes, name, "", false, limits);
+Scene loadGltfFromMemory(std::span<const unsigned char> bytes, const std::string& name, const GltfLimits& limits,
+                         const GltfSelection& selection) {
+    return loadFromBytes(bytes, name, "", false, limits, selection);
+}
+
+void selectCamera(Scene& scene, const std::string& choice) {
+    if (choice.empty()) return;
+    auto describe = [&]() {
+        std::string list;
+        for (const SceneCamera& c : scene.cameras)
+            list += (list.empty() ? "" : ", ") + std::to_string(c.cameraIndex) + (c.name.empty() ? "" : " '" + c.name + "'");
+        return list.empty() ? std::string("the scene places no camera") : "the scene places " + list;
+    };
+    for (const SceneCamera& c : scene.cameras)
+        if (!c.name.empty() && c.name == choice) {
+            scene.camera = c;
+            return;
+        }
+    if (choice.find_first_not_of("0123456789") == std::string::npos && choice.size() < 10) {
+        const int index = std::stoi(choice);
+        for (const SceneCamera& c : scene.cameras)
+            if (c.cameraIndex == index) {
+                scene.camera = c;
+                return;
+            }
+    }
+    throw InputError(scene.name + ": no camera is called or numbered '" + choice + "' (" + describe() + ")");
 }
 
 }  // namespace dacrt

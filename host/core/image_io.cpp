@@ -1,4 +1,5 @@
 #include "core/image_io.hpp"
+#include "core/shading.hpp"
 
 #include <limits>
 
@@ -34,21 +35,23 @@ void writeAov(const std::string& path, const Scene& scene, const HitImage& image
         float z, nx, ny, nz;
         std::uint32_t primId;
         float hit, u, v;
+        float albedoR, albedoG, albedoB;
     };
     std::vector<Pixel> pixels(image.hits->size());
     for (std::size_t i = 0; i < pixels.size(); ++i) {
         const Hit& h = (*image.hits)[i];
         Pixel& p = pixels[i];
         if (h.prim == kMissPrim) {
-            p = Pixel{std::numeric_limits<float>::infinity(), 0, 0, 0, kMissPrim, 0, 0, 0};
+            p = Pixel{std::numeric_limits<float>::infinity(), 0, 0, 0, kMissPrim, 0, 0, 0, 0, 0, 0};
         } else {
             const glm::vec3 n = geometricNormal(scene.triangles[h.prim]);
-            p = Pixel{h.t, n.x, n.y, n.z, h.prim, 1.0f, h.u, h.v};
+            const glm::vec3 albedo = surfaceAt(scene, h).albedo;
+            p = Pixel{h.t, n.x, n.y, n.z, h.prim, 1.0f, h.u, h.v, albedo.r, albedo.g, albedo.b};
         }
     }
-    OIIO::ImageSpec spec(image.width, image.height, 8, OIIO::TypeDesc::FLOAT);
-    spec.channelnames = {"Z", "N.X", "N.Y", "N.Z", "primId", "hit", "u", "v"};
-    spec.channelformats.assign(8, OIIO::TypeDesc::FLOAT);
+    OIIO::ImageSpec spec(image.width, image.height, 11, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"Z", "N.X", "N.Y", "N.Z", "primId", "hit", "u", "v", "albedo.R", "albedo.G", "albedo.B"};
+    spec.channelformats.assign(11, OIIO::TypeDesc::FLOAT);
     spec.channelformats[4] = OIIO::TypeDesc::UINT32;
     spec.z_channel = 0;
     spec.attribute("compression", "zip");
@@ -82,6 +85,13 @@ Aov readAov(const std::string& path) {
         !in->read_image(0, 0, prim, prim + 1, OIIO::TypeDesc::UINT32, aov.primId.data()) ||
         !in->read_image(0, 0, hit, hit + 1, OIIO::TypeDesc::FLOAT, aov.hit.data()))
         throw InputError(path + ": reading failed: " + in->geterror());
+    if (const int albedo = spec.channelindex("albedo.R"); albedo >= 0) {
+        if (spec.channelindex("albedo.G") != albedo + 1 || spec.channelindex("albedo.B") != albedo + 2)
+            throw InputError(path + ": the albedo.R, albedo.G and albedo.B channels are not consecutive");
+        aov.albedo.resize(n);
+        if (!in->read_image(0, 0, albedo, albedo + 3, OIIO::TypeDesc::FLOAT, aov.albedo.data()))
+            throw InputError(path + ": reading failed: " + in->geterror());
+    }
     return aov;
 }
 

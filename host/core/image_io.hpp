@@ -17,7 +17,8 @@ void writeRgb8(const std::string& path, int width, int height, const std::vector
 
 // Multi-channel EXR: Z (ray parameter t, +inf on a miss; directions are unit length),
 // N.X N.Y N.Z (unit geometric normal), primId (exact uint32, 0xFFFFFFFF on a miss),
-// hit (1 or 0), u v (barycentric weights of the second and third vertex).
+// hit (1 or 0), u v (barycentric weights of the second and third vertex), albedo.R albedo.G
+// albedo.B (linear base colour: factor x texture x vertex colour; 0 on a miss).
 void writeAov(const std::string& path, const Scene& scene, const HitImage& image);
 
 struct Aov {
@@ -27,6 +28,7 @@ struct Aov {
     std::vector<glm::vec3> normal;
     std::vector<std::uint32_t> primId;
     std::vector<float> hit;
+    std::vector<glm::vec3> albedo;  // empty when the file has no albedo channels
 };
 
 // Reads an AOV written by writeAov; throws InputError on a missing file, a non-image, or

@@ -114,7 +114,7 @@ Scene sceneFromMeshes(const std::vector<Mesh>& meshes, const std::string& name) 
     s.name = name;
     for (std::size_t mi = 0; mi < meshes.size(); ++mi) {
         const Mesh& m = meshes[mi];
-        s.materials.push_back(Material{m.color, m.doubleSided});
+        s.materials.push_back(Material{"", m.color, m.doubleSided, {}});
         for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
             Triangle tri{};
             tri.v0 = m.positions.at(m.indices[t]);

@@ -1,5 +1,7 @@
 #pragma once
 // The flattened scene every backend consumes: one triangle array with provenance.
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -17,9 +19,63 @@ namespace dacrt {
 // intermediate of the watertight test stays below 2^110, far from float overflow.
 constexpr float kMaxCoordinate = 1e9f;
 
+// How a texture's coordinates outside [0, 1] wrap (glTF sampler wrapS, wrapT).
+enum class TextureWrap { Repeat, ClampToEdge, MirroredRepeat };
+
+// A decoded image: 8-bit RGBA texels as the file stores them (base colour: sRGB), row 0 at the
+// top (glTF's texture coordinate (0, 0) is the top-left corner).
+struct Texture {
+    std::string name;
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> rgba;
+};
+
+// A material's use of a texture: which one, through which coordinates and sampler.
+struct TextureBinding {
+    int texture = -1;              // index into Scene::textures; -1: none
+    std::uint32_t texCoord = 0;    // TEXCOORD_n (after KHR_texture_transform's override)
+    TextureWrap wrapS = TextureWrap::Repeat;
+    TextureWrap wrapT = TextureWrap::Repeat;
+    bool nearest = false;          // magnification NEAREST (no mipmaps are built: minification samples like it)
+    glm::mat3 transform{1.0f};     // KHR_texture_transform: uv' = transform * (u, v, 1)
+};
+
 struct Material {
+    std::string name;
     glm::vec4 baseColor{1.0f};
     bool doubleSided = false;  // glTF's default: single-sided, back faces culled
+    TextureBinding baseColorTexture;
+};
+
+// Per-corner shading inputs of each triangle, in the triangle's corner order (after a
+// mirroring node's corner swap). Each array is empty when no primitive of the scene has the
+// attribute; otherwise it has one entry per triangle, with the defaults below where the
+// triangle's primitive lacks it.
+struct CornerAttributes {
+    std::vector<std::array<glm::vec3, 3>> normals;    // world space, unit; (0, 0, 0): use the geometric normal
+    std::vector<std::array<glm::vec2, 3>> texCoords;  // the set the triangle's base colour texture reads; (0, 0)
+    std::vector<std::array<glm::vec4, 3>> colors;     // COLOR_0, linear RGBA; (1, 1, 1, 1)
+};
+
+// KHR_lights_punctual, placed in world space. Loaded for the secondary-ray passes.
+enum class LightType { Point, Spot, Directional };
+template <>
+struct EnumNames<LightType> {
+    static constexpr std::array<std::pair<LightType, std::string_view>, 3> table{
+        {{LightType::Point, "point"}, {LightType::Spot, "spot"}, {LightType::Directional, "directional"}}};
+};
+struct Light {
+    std::string name;
+    LightType type = LightType::Point;
+    glm::vec3 color{1.0f};
+    float intensity = 1.0f;        // candela (point, spot) or lux (directional)
+    float range = 0.0f;            // 0: infinite
+    float innerConeAngle = 0.0f;   // spot only, radians
+    float outerConeAngle = float(M_PI / 4.0);
+    glm::dvec3 position{0.0};      // point, spot
+    glm::dvec3 direction{0.0, 0.0, -1.0};  // spot, directional: where the light travels, unit
+    std::uint32_t node = 0;
 };
 
 // Which back faces no ray hits (Triangle::cullBackFace): the materials' (glTF's rule, the
@@ -31,6 +87,17 @@ struct EnumNames<CullMode> {
         {{CullMode::Material, "material"}, {CullMode::None, "none"}, {CullMode::BackFaces, "backfaces"}}};
 };
 
+// What a glTF file holds beyond the flattened scene, one line per item, for `dacrt info`.
+struct GltfInventory {
+    std::vector<std::string> scenes;      // "0 'name': K root nodes" (the loaded one marked)
+    std::vector<std::string> meshes;      // with primitives and triangles
+    std::vector<std::string> materials;
+    std::vector<std::string> textures;
+    std::vector<std::string> extensionsUsed;
+    std::vector<std::string> extensionsRequired;
+    std::uint32_t loadedScene = 0;
+};
+
 // Where a flattened triangle came from in the glTF file.
 struct TriangleSource {
     std::uint32_t node = 0;
@@ -39,11 +106,23 @@ struct TriangleSource {
     std::uint32_t triangle = 0;   // index within the primitive
 };
 
+enum class Projection { Perspective, Orthographic };
+template <>
+struct EnumNames<Projection> {
+    static constexpr std::array<std::pair<Projection, std::string_view>, 2> table{
+        {{Projection::Perspective, "perspective"}, {Projection::Orthographic, "orthographic"}}};
+};
+
 struct SceneCamera {
     glm::dvec3 eye{0.0};
     glm::dvec3 forward{0.0, 0.0, -1.0};
     glm::dvec3 up{0.0, 1.0, 0.0};
-    double yfovRadians = 0.0;
+    double yfovRadians = 0.0;                      // perspective
+    Projection projection = Projection::Perspective;
+    double ymag = 0.0;                             // orthographic: half the view's height
+    std::string name;                              // the glTF camera's
+    std::int32_t cameraIndex = -1;                 // in the file's cameras; -1: not from a file
+    std::int32_t node = -1;                        // the node that places it
 };
 
 struct Scene {
@@ -52,7 +131,12 @@ struct Scene {
     std::vector<TriangleSource> sources;          // one per triangle
     std::vector<std::uint32_t> materialOfTriangle;  // index into materials
     std::vector<Material> materials;
-    std::optional<SceneCamera> camera;              // the first perspective camera found
+    CornerAttributes corners;                       // normals, texture coordinates, vertex colours
+    std::vector<Texture> textures;                  // the decoded images materials use
+    std::vector<Light> lights;                      // KHR_lights_punctual, as placed by the scene's nodes
+    std::vector<SceneCamera> cameras;               // every camera the scene's nodes place, in node order
+    std::optional<SceneCamera> camera;              // the one frames are rendered from: the first placed, or the one chosen
+    GltfInventory inventory;                        // what the file holds (dacrt info)
     std::uint64_t degenerateTrianglesDropped = 0;   // no area (triangleHasNoArea), dropped at load
     std::vector<std::string> warnings;              // what the loader ignored, one line each (render prints them)
     // Changes whenever `triangles` does (load, applyCullMode): a frame's FrameGeometry

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/texture_sampling.hpp"
+
 namespace dacrt {
 namespace {
 
@@ -20,15 +22,39 @@ glm::vec3 shadePixel(const Scene& scene, const HitImage& image, std::size_t i) {
     const glm::vec3 background(0.18f, 0.20f, 0.24f);
     const Hit& h = (*image.hits)[i];
     if (h.prim == kMissPrim) return background;
-    const glm::vec3 n = geometricNormal(scene.triangles[h.prim]);
-    const float cosine = std::abs(glm::dot(n, (*image.rays)[i].dir));
-    const glm::vec4 base = scene.materials[scene.materialOfTriangle[h.prim]].baseColor;
-    return glm::vec3(base) * (0.12f + 0.88f * cosine);
+    const SurfacePoint s = surfaceAt(scene, h);
+    const float cosine = std::abs(glm::dot(s.normal, (*image.rays)[i].dir));
+    return s.albedo * (0.12f + 0.88f * cosine);
 }
 
 std::uint8_t unorm8(float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
 
 }  // namespace
+
+SurfacePoint surfaceAt(const Scene& scene, const Hit& h) {
+    SurfacePoint s;
+    const float w[3] = {1.0f - h.u - h.v, h.u, h.v};
+    const Material& material = scene.materials[scene.materialOfTriangle[h.prim]];
+    glm::vec4 albedo = material.baseColor;
+    const CornerAttributes& c = scene.corners;
+    if (!c.colors.empty()) albedo *= w[0] * c.colors[h.prim][0] + w[1] * c.colors[h.prim][1] + w[2] * c.colors[h.prim][2];
+    const TextureBinding& binding = material.baseColorTexture;
+    if (binding.texture >= 0) {
+        const glm::vec2 uv = c.texCoords.empty() ? glm::vec2(0.0f)
+                                                 : w[0] * c.texCoords[h.prim][0] + w[1] * c.texCoords[h.prim][1] +
+                                                       w[2] * c.texCoords[h.prim][2];
+        albedo *= sampleTexture(scene.textures[std::size_t(binding.texture)], binding, uv);
+    }
+    s.albedo = glm::vec3(albedo);
+    s.normal = geometricNormal(scene.triangles[h.prim]);
+    if (!c.normals.empty()) {
+        const std::array<glm::vec3, 3>& n = c.normals[h.prim];
+        const glm::vec3 smooth = w[0] * n[0] + w[1] * n[1] + w[2] * n[2];
+        const float length = glm::length(smooth);
+        if (length > 1e-12f && std::isfinite(length)) s.normal = smooth / length;
+    }
+    return s;
+}
 
 std::vector<std::uint8_t> shadeImage(const Scene& scene, const HitImage& image) {
     std::vector<std::uint8_t> rgb(std::size_t(image.width) * std::size_t(image.height) * 3);

@@ -8,8 +8,17 @@
 
 namespace dacrt {
 
-// Headlight Lambert (|cos| between ray and geometric normal) times the base colour, sRGB
-// encoded to 8-bit RGB, row-major; misses get a fixed background.
+// The surface at a hit as the preview shades it: the material's base colour factor times its
+// base colour texture times the vertex colour (linear RGB), and the normal interpolated from
+// the corners' NORMAL (the geometric normal where the primitive has none).
+struct SurfacePoint {
+    glm::vec3 albedo{1.0f};
+    glm::vec3 normal{0.0f, 0.0f, 1.0f};
+};
+SurfacePoint surfaceAt(const Scene& scene, const Hit& hit);
+
+// Headlight Lambert (|cos| between ray and shading normal) times the albedo, sRGB encoded to
+// 8-bit RGB, row-major; misses get a fixed background.
 std::vector<std::uint8_t> shadeImage(const Scene& scene, const HitImage& image);
 
 // The same in linear RGB, for averaging samples: adds each pixel's colour times `weight` to

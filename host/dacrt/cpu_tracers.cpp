@@ -56,6 +56,7 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
 }
 
 TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options, const PlanHook& onPlan) {
+    requireNearSide(g, "cpu-seq");
     TraceResult result;
     const std::uint32_t rayCount = std::uint32_t(g.rays->size());
     const std::uint32_t triCount = std::uint32_t(g.tracedTriangleCount());
@@ -87,6 +88,7 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
 
 TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool,
                           const PlanHook& onPlan) {
+    requireNearSide(g, "cpu");
     TraceResult result;
     result.threads = pool.size();
     const unsigned regions = options.regions ? options.regions : pool.size();

@@ -3,14 +3,26 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <string>
+
+#include "core/errors.hpp"
 
 namespace dacrt {
 
-float filterMargin(const Box& sceneBox, const glm::vec3& rayOrigin) {
+float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin) {
     float m = 0.0f;
     for (int a = 0; a < 3; ++a)
-        m = std::max({m, std::abs(sceneBox.lo[a]), std::abs(sceneBox.hi[a]), std::abs(rayOrigin[a])});
+        m = std::max({m, std::abs(sceneBox.lo[a]), std::abs(sceneBox.hi[a]), std::abs(farthestOrigin[a])});
     return std::max(m * 0x1p-18f, 0x1p-100f);
+}
+
+void requireNearSide(const FrameGeometry& g, const char* tracer) {
+    if (!g.nearSideKnown)
+        throw InputError(std::string(tracer) +
+                         ": these rays start at different points and travel both ways along an axis; the DACRT tracers "
+                         "take rays that share an origin (pinhole cameras) or whose directions agree in sign per axis "
+                         "(orthographic cameras); use brute or embree for others");
 }
 
 bool raysShareStart(const std::vector<Ray>& rays) {
@@ -28,8 +40,26 @@ FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::v
     g.rays = &rays;
     g.sceneBox = sceneBox;
     g.rayOrigin = rays.front().origin;
-    g.margin = filterMargin(sceneBox, g.rayOrigin);
     g.raysShareStart = raysShareStart(rays);
+    if (g.raysShareStart) {
+        g.farthestOrigin = glm::abs(g.rayOrigin);
+        g.nearSide = g.rayOrigin;
+        g.nearSideKnown = true;
+    } else {
+        bool towardLow[3] = {false, false, false}, towardHigh[3] = {false, false, false};
+        for (const Ray& r : rays)
+            for (int a = 0; a < 3; ++a) {
+                g.farthestOrigin[a] = std::max(g.farthestOrigin[a], std::abs(r.origin[a]));
+                towardLow[a] |= r.dir[a] < 0.0f;
+                towardHigh[a] |= r.dir[a] > 0.0f;
+            }
+        g.nearSideKnown = true;
+        for (int a = 0; a < 3; ++a) {
+            g.nearSide[a] = towardLow[a] ? std::numeric_limits<float>::max() : -std::numeric_limits<float>::max();
+            g.nearSideKnown &= !(towardLow[a] && towardHigh[a]);
+        }
+    }
+    g.margin = filterMargin(sceneBox, g.farthestOrigin);
     g.imageWidth = imageWidth && rays.size() % imageWidth == 0 ? imageWidth : 0;
     return g;
 }

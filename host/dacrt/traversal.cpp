@@ -91,7 +91,7 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
     : rays_(g.rays->data()),
       triangles_(g.triangles->data()),
       triangleBounds_(g.triangleBounds->data()),
-      origin_(g.rayOrigin),
+      nearSide_(g.nearSide),
       margin_(g.margin),
       options_(options.resolvedFor(Backend::Cpu)),
       hits_(buffers.hits),
@@ -187,8 +187,8 @@ float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triB
 }
 
 // The split both recursions share (node over rays, nodePackets over packets): the longest
-// axis at the split position, then the two children front to back (every ray shares the
-// origin, so the child on its side is crossed first), each with its items and triangles
+// axis at the split position, then the two children front to back (the child on the rays'
+// near side is crossed first by every ray that crosses both), each with its items and triangles
 // filtered from the node's. itemBegin is read again for the second child: a ray recursion
 // moves the rays the first child finished before it. False (nothing done) where the node
 // must end here instead: fewItems, too few triangles, too deep, stalled, or no split inside.
@@ -204,7 +204,7 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     Box low = box, high = box;
     low.hi[axis] = split;
     high.lo[axis] = split;
-    const bool lowFirst = origin_[axis] <= split;
+    const bool lowFirst = nearSide_[axis] <= split;
     for (const Box* child : {lowFirst ? &low : &high, lowFirst ? &high : &low}) {
         const Box cell = widen(*child, margin_);
         const std::uint32_t childItems = filterItems(cell, itemBegin, itemEnd);

@@ -134,7 +134,7 @@ private:
     const Ray* rays_;
     const Triangle* triangles_;
     const Bounds* triangleBounds_;
-    glm::vec3 origin_;
+    glm::vec3 nearSide_;  // FrameGeometry::nearSide
     float margin_;
     DacrtOptions options_;
     Hit* hits_;

@@ -139,7 +139,7 @@ FrameGeometry withSkips(const FrameGeometry& g, const TriangleSkips& skips) {
     FrameGeometry r = g;
     r.tracedTriangles = &skips.traced;
     r.sceneBox = skips.tracedBox;
-    r.margin = filterMargin(r.sceneBox, r.rayOrigin);
+    r.margin = filterMargin(r.sceneBox, r.farthestOrigin);
     return r;
 }
 

@@ -152,7 +152,7 @@ gpu::ComputePipeline& preparePipeline(const GpuFrame& frame, const DacrtOptions&
 
 DacrtPush framePush(const GpuFrame& frame) {
     DacrtPush push{};
-    push.rayOrigin = frame.geometry.rayOrigin;
+    push.rayOrigin = frame.geometry.nearSide;  // the shared origin when raysShareStart
     push.margin = frame.geometry.margin;
     push.axis = std::uint32_t(frame.division.axis);
     push.rayScratchHalf = std::uint32_t(frame.division.rayIds.size());
@@ -274,6 +274,7 @@ TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options,
                      gpu::ResidentTriangles* resident) {
     const gpu::DeviceInfo& device = context.info();
     checkGpuOptions(options);
+    requireNearSide(geometry, "gpu");
     if (!device.subgroupOperations)
         throw InputError("device '" + device.name +
                          "' lacks subgroup arithmetic or shuffles in compute shaders, which the gpu backend needs");

@@ -262,7 +262,10 @@ TEST(StressRejects, NonFiniteCameraParameters) {
     EXPECT_TRUE(refused(with([&](CameraOptions& o) { o.eye = glm::dvec3(1e12, 0, 5); }), "coordinate limit"));
     // A scene camera read from a file goes through the same checks.
     Scene withCamera = s;
-    withCamera.camera = SceneCamera{{0, 0, 5}, {nan, 0, -1}, {0, 1, 0}, 0.8};
+    withCamera.camera = SceneCamera{};
+    withCamera.camera->eye = {0, 0, 5};
+    withCamera.camera->forward = {nan, 0, -1};
+    withCamera.camera->yfovRadians = 0.8;
     EXPECT_TRUE(refused([&] { makeCameras(withCamera, b, {}, 1.0); }, "finite"));
 }
 

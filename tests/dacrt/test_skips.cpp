@@ -145,7 +145,7 @@ TEST(Skips, AFrustumDropIsNeverATriangleAPrimaryRayHits) {
     camera.up = glm::normalize(glm::cross(glm::cross(camera.forward, glm::dvec3(0, 1, 0)), camera.forward));
     camera.yfovRadians = glm::radians(50.0);
     const int w = 48, h = 32;
-    const ViewFrustum f = viewFrustum(camera, w, h);
+    const ViewFrustum f = *viewFrustum(camera, w, h);
     const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
     std::vector<Triangle> tris;
     for (int i = 0; i < 3000; ++i) {

@@ -1,6 +1,7 @@
 // Known answers on tiny scenes, and brute / cpu-seq / cpu agreeing bit for bit.
 #include <gtest/gtest.h>
 
+#include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
 #include "core/procedural.hpp"
 #include "dacrt/traversal.hpp"
@@ -231,5 +232,59 @@ TEST(BackendsAgree, StanfordModelsAt640x480) {
         for (unsigned regions : {1u, 2u, 4u, 8u, 16u})
             EXPECT_TRUE(identicalHits(reference.hits, frame.trace(Backend::Cpu, regions, 2).hits))
                 << name << ", " << regions << " regions";
+    }
+}
+
+namespace {
+
+// An orthographic view of the shapes scene from `eye` towards the origin, 2 ymag high.
+Camera orthographicView(glm::dvec3 eye, double ymag) {
+    Camera c;
+    c.eye = eye;
+    c.forward = glm::normalize(-eye);
+    const glm::dvec3 right = glm::normalize(glm::cross(c.forward, glm::dvec3(0, 1, 0)));
+    c.up = glm::cross(right, c.forward);
+    c.projection = Projection::Orthographic;
+    c.ymag = ymag;
+    return c;
+}
+
+}  // namespace
+
+TEST(BackendsAgree, OrthographicCameras) {
+    // Rays of many origins sharing one direction: each split's near child is the one the
+    // direction's sign points away from, for every ray (FrameGeometry::nearSide).
+    // The last two start inside the scene box, obliquely: their origins lie on both sides of
+    // splits that the rays cross, so no one origin gives every ray its near child.
+    for (const glm::dvec3 eye : {glm::dvec3(0.0, 0.0, 6.0), glm::dvec3(4.0, 3.0, 5.0), glm::dvec3(0.6, 0.35, 0.45),
+                                 glm::dvec3(-0.5, 0.3, -0.4)}) {
+        SCOPED_TRACE("eye " + std::to_string(eye.x) + " " + std::to_string(eye.y) + " " + std::to_string(eye.z));
+        const Frame frame(test::shapesScene(), orthographicView(eye, 1.8), 64, 48);
+        ASSERT_FALSE(frame.geometry.raysShareStart);
+        ASSERT_TRUE(frame.geometry.nearSideKnown);
+        expectAllBackendsAgree(frame, {1, 2, 4, 8});
+    }
+}
+
+TEST(BackendsAgree, RaysWithoutANearSideAreRefusedByTheDacrtTracers) {
+    // Two rays from different points travelling opposite ways along x: brute traces them, the
+    // DACRT tracers say why they cannot (yet).
+    const Scene s = test::shapesScene();
+    const std::vector<Bounds> bounds = allTriangleBounds(s.triangles);
+    const std::vector<Ray> rays = {makeRay({-5, 0, 0}, {1, 0, 0}), makeRay({5, 0.1f, 0}, {-1, 0, 0})};
+    const FrameGeometry g = frameGeometry(s.triangles, bounds, rays, sceneBounds(s.triangles));
+    EXPECT_FALSE(g.nearSideKnown);
+    ThreadPool pool(1);
+    TraceOptions o;
+    o.backend = Backend::Brute;
+    EXPECT_EQ(hitCount(traceCpu(g, o, pool).hits), 2u);
+    for (Backend b : {Backend::CpuSeq, Backend::Cpu}) {
+        o.backend = b;
+        try {
+            traceCpu(g, o, pool);
+            ADD_FAILURE() << toString(b) << " traced";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("travel both ways"), std::string::npos) << e.what();
+        }
     }
 }

@@ -80,8 +80,8 @@ write("triangle_trs_hierarchy.gltf", gltf([(0, 0, 0), (1, 0, 0), (0, 1, 0)],
 glb("quad_fan_u32.glb", gltf(quad, [0, 1, 2, 3], "I", mode=6))
 
 # The quad with a 2x2 RGB texture image (red, green / blue, white), as a PNG in the GLB's
-# binary chunk and, in the .gltf, as a data URI: the loader keeps images undecoded (textures
-# are not applied yet) and must load the geometry with a warning.
+# binary chunk and, in the .gltf, as a data URI, read through TEXCOORD_0 (image top-left at the
+# quad's corner (-1, 1)) with a NEAREST sampler: each quarter of the quad is one texel's colour.
 def png(width, height, rgb):
     def chunk(kind, body):
         return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
@@ -89,20 +89,95 @@ def png(width, height, rgb):
     return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)) +
             chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
 texture = png(2, 2, [255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255])
+
+def append_data(doc, blob):
+    """Appends blob to buffer 0 (a data URI) as a new buffer view; returns the view's index."""
+    data = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+    offset = len(data)
+    data += blob + b"\0" * ((4 - len(blob) % 4) % 4)
+    doc["buffers"][0] = {"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}
+    doc["bufferViews"].append({"buffer": 0, "byteOffset": offset, "byteLength": len(blob)})
+    return len(doc["bufferViews"]) - 1
+
+def add_accessor(doc, blob, component_type, count, kind, **more):
+    doc["accessors"].append(dict({"bufferView": append_data(doc, blob), "componentType": component_type,
+                                  "count": count, "type": kind}, **more))
+    return len(doc["accessors"]) - 1
+
+quad_uv = [(0, 1), (1, 1), (1, 0), (0, 0)]
 def add_texture(doc, embedded):
+    uv = add_accessor(doc, b"".join(struct.pack("<2f", *t) for t in quad_uv), 5126, 4, "VEC2")
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv
     if embedded:
-        data = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
-        offset = len(data)
-        data += texture + b"\0" * ((4 - len(texture) % 4) % 4)
-        doc["buffers"][0] = {"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}
-        doc["bufferViews"].append({"buffer": 0, "byteOffset": offset, "byteLength": len(texture)})
-        doc["images"] = [{"bufferView": len(doc["bufferViews"]) - 1, "mimeType": "image/png"}]
+        doc["images"] = [{"bufferView": append_data(doc, texture), "mimeType": "image/png"}]
     else:
         doc["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(texture).decode()}]
-    doc["textures"] = [{"source": 0}]
+    doc["samplers"] = [{"magFilter": 9728, "minFilter": 9728}]
+    doc["textures"] = [{"source": 0, "sampler": 0}]
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = [1, 1, 1, 1]
     doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
 glb("quad_texture_image.glb", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=lambda d: add_texture(d, True)))
 write("quad_texture_data_uri.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=lambda d: add_texture(d, False)))
+
+# The quad with COLOR_0 as normalized unsigned bytes (RGBA): corners red, green, blue, white.
+def add_colors(doc):
+    rgba = [(255, 0, 0, 255), (0, 255, 0, 255), (0, 0, 255, 255), (255, 255, 255, 255)]
+    doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = add_accessor(
+        doc, b"".join(bytes(c) for c in rgba), 5121, 4, "VEC4", normalized=True)
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = [1, 1, 1, 1]
+write("quad_vertex_colors.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=add_colors))
+
+# Sparse accessors: the quad's POSITION with a sparse part moving vertex 2 from (1, 1, 0) to
+# (2, 2, 0), and a second triangle whose POSITION has no buffer view at all (zeros) with every
+# vertex given by its sparse part: (0, 0, 1), (1, 0, 1), (0, 1, 1).
+def add_sparse(doc):
+    doc["accessors"][0]["sparse"] = {"count": 1,
+                                     "indices": {"bufferView": append_data(doc, struct.pack("<H", 2)), "componentType": 5123},
+                                     "values": {"bufferView": append_data(doc, struct.pack("<3f", 2, 2, 0))}}
+    values = append_data(doc, b"".join(struct.pack("<3f", *p) for p in [(0, 0, 1), (1, 0, 1), (0, 1, 1)]))
+    doc["accessors"].append({"componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 1], "max": [1, 1, 1],
+                             "sparse": {"count": 3,
+                                        "indices": {"bufferView": append_data(doc, bytes([0, 1, 2])), "componentType": 5121},
+                                        "values": {"bufferView": values}}})
+    doc["meshes"][0]["primitives"].append({"attributes": {"POSITION": len(doc["accessors"]) - 1}, "material": 0})
+write("quad_sparse.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=add_sparse))
+
+# KHR_mesh_quantization: POSITION as normalized shorts (+-32767 is +-1) under a node scaling by
+# 2, which dequantizes to the quad [-2, 2]^2 near z = 0.5 (+-32767 is exactly +-1, and
+# the short 8192 is 0.25000763..., doubled 0.50001525...). Its plain twin lists the same
+# positions as floats.
+quantized = [(-32767, -32767, 8192), (32767, -32767, 8192), (32767, 32767, 8192), (-32767, 32767, 8192)]
+def dequantized(q):
+    return tuple(float(struct.unpack("<f", struct.pack("<f", 2.0 * (c / 32767.0)))[0]) for c in q)
+def quantize(doc):
+    doc["extensionsUsed"] = ["KHR_mesh_quantization"]
+    doc["extensionsRequired"] = ["KHR_mesh_quantization"]
+    shorts = b"".join(struct.pack("<3h2x", *q) for q in quantized)  # 8-byte elements: 4-byte aligned stride
+    doc["accessors"][0] = {"bufferView": append_data(doc, shorts), "componentType": 5122, "normalized": True,
+                           "count": 4, "type": "VEC3", "min": [-32767, -32767, 8192], "max": [32767, 32767, 8192]}
+    doc["bufferViews"][-1]["byteStride"] = 8
+    doc["nodes"][0]["scale"] = [2, 2, 2]
+write("quad_quantized.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=quantize))
+write("quad_quantized_twin.gltf", gltf([dequantized(q) for q in quantized], [0, 1, 2, 0, 2, 3], "B"))
+
+# Cameras, scenes and lights: two scenes (scene 1 'far' has the quad moved to z = -5), an
+# orthographic camera 'top' (ymag 1.5) at (0, 0, 3) and a perspective camera 'side', a point
+# light and a spot light (KHR_lights_punctual).
+def add_views(doc):
+    doc["cameras"] = [{"name": "top", "type": "orthographic", "orthographic": {"xmag": 1.5, "ymag": 1.5, "znear": 0, "zfar": 10}},
+                      {"name": "side", "type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]
+    doc["extensionsUsed"] = ["KHR_lights_punctual", "EXT_unheard_of_but_optional"]
+    doc["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "bulb", "type": "point", "color": [1, 0.5, 0.25], "intensity": 20},
+        {"name": "torch", "type": "spot", "intensity": 5, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}}]}}
+    doc["nodes"] = [{"mesh": 0},
+                    {"camera": 0, "name": "top camera", "translation": [0, 0, 3]},
+                    {"camera": 1, "translation": [4, 0, 0], "rotation": [0, 0.7071067811865476, 0, 0.7071067811865476]},
+                    {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0, 2, 2]},
+                    {"extensions": {"KHR_lights_punctual": {"light": 1}}, "translation": [0, 0, 2]},
+                    {"mesh": 0, "translation": [0, 0, -5]}]
+    doc["scenes"] = [{"name": "near", "nodes": [0, 1, 2, 3, 4]}, {"name": "far", "nodes": [5, 2]}]
+write("quad_cameras_lights.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=add_views))
 
 # Bad inputs.
 write("bad_index_out_of_range.gltf", gltf(quad, [0, 1, 2, 0, 2, 7], "B"))

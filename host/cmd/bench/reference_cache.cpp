@@ -15,7 +15,7 @@ std::string cameraKey(const Camera& c, int width, int height) {
     std::ostringstream s;
     s << std::setprecision(17) << c.eye.x << "," << c.eye.y << "," << c.eye.z << "|" << c.forward.x << ","
       << c.forward.y << "," << c.forward.z << "|" << c.up.x << "," << c.up.y << "," << c.up.z << "|"
-      << c.yfovRadians << "|" << width << "x" << height;
+      << c.yfovRadians << "|" << int(c.projection) << "|" << c.ymag << "|" << width << "x" << height;
     return s.str();
 }
 

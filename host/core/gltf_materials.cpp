@@ -1,0 +1,229 @@
+#include "core/gltf_materials.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+namespace dacrt::gltf {
+namespace {
+
+// Decoded images larger than this are refused with a warning (a 16k x 16k RGBA8 texture).
+constexpr std::uint64_t kMaxTextureBytes = std::uint64_t(1) << 30;
+
+// OpenImageIO picks its reader from the name's extension; the bytes say which format they are.
+const char* formatExtension(std::span<const unsigned char> b, const std::string& mimeType) {
+    auto starts = [&](const char* magic, std::size_t at = 0) {
+        const std::size_t n = std::strlen(magic);
+        return b.size() >= at + n && std::memcmp(b.data() + at, magic, n) == 0;
+    };
+    if (starts("\x89PNG")) return ".png";
+    if (b.size() >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) return ".jpg";
+    if (starts("RIFF") && starts("WEBP", 8)) return ".webp";
+    if (mimeType == "image/png") return ".png";
+    if (mimeType == "image/jpeg") return ".jpg";
+    return "";
+}
+
+std::string percentDecoded(const std::string& uri) {
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit((unsigned char)uri[i + 1]) && std::isxdigit((unsigned char)uri[i + 2])) {
+            out.push_back(char(std::stoi(uri.substr(i + 1, 2), nullptr, 16)));
+            i += 2;
+        } else {
+            out.push_back(uri[i]);
+        }
+    }
+    return out;
+}
+
+// Decodes to 8-bit RGBA (grey expands to RGB, alpha 255 where absent); empty with `why` set
+// when it cannot.
+Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mimeType, std::string& why) {
+    Texture t;
+    const char* ext = formatExtension(bytes, mimeType);
+    if (!*ext) {
+        why = "its format" + (mimeType.empty() ? std::string() : " (" + mimeType + ")") + " is neither PNG, JPEG nor WebP";
+        return t;
+    }
+    OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
+    auto in = OIIO::ImageInput::open(std::string("image") + ext, nullptr, &memory);
+    if (!in) {
+        why = "it does not decode (" + OIIO::geterror() + ")";
+        return t;
+    }
+    const OIIO::ImageSpec& spec = in->spec();
+    const std::uint64_t texels = std::uint64_t(std::max(spec.width, 0)) * std::uint64_t(std::max(spec.height, 0));
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || texels * 4 > kMaxTextureBytes) {
+        why = "its size " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " is empty or over the " +
+              std::to_string(kMaxTextureBytes >> 20) + " MiB texture limit";
+        return t;
+    }
+    const int channels = spec.nchannels;
+    std::vector<std::uint8_t> raw(std::size_t(texels) * std::size_t(channels));
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, raw.data())) {
+        why = "it does not decode (" + in->geterror() + ")";
+        return t;
+    }
+    t.width = spec.width;
+    t.height = spec.height;
+    t.rgba.resize(std::size_t(texels) * 4);
+    for (std::size_t i = 0; i < texels; ++i) {
+        const std::uint8_t* p = raw.data() + i * std::size_t(channels);
+        std::uint8_t* q = t.rgba.data() + i * 4;
+        const bool grey = channels <= 2;
+        q[0] = p[0];
+        q[1] = grey ? p[0] : p[1];
+        q[2] = grey ? p[0] : p[2];
+        q[3] = channels == 2 ? p[1] : channels >= 4 ? p[3] : 255;
+    }
+    return t;
+}
+
+TextureWrap wrapOf(int mode) {
+    if (mode == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE) return TextureWrap::ClampToEdge;
+    if (mode == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT) return TextureWrap::MirroredRepeat;
+    return TextureWrap::Repeat;
+}
+
+double number(const tinygltf::Value& object, const char* key, std::size_t index, double fallback) {
+    if (!object.Has(key)) return fallback;
+    const tinygltf::Value& v = object.Get(key);
+    if (v.IsArray()) {
+        if (index >= v.ArrayLen() || !v.Get(int(index)).IsNumber()) return fallback;
+        return v.Get(int(index)).GetNumberAsDouble();
+    }
+    return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
+}
+
+class MaterialReader {
+public:
+    MaterialReader(const AccessorReader& reader, const ImageSource& source, Scene& scene)
+        : reader_(reader), model_(reader.model()), source_(source), scene_(scene) {}
+
+    void run() {
+        for (std::size_t m = 0; m < model_.materials.size(); ++m) scene_.materials.push_back(material(m));
+    }
+
+private:
+    Material material(std::size_t index) {
+        const tinygltf::Material& m = model_.materials[index];
+        Material mat;
+        mat.name = m.name;
+        const std::vector<double>& f = m.pbrMetallicRoughness.baseColorFactor;
+        if (f.size() == 4) mat.baseColor = glm::vec4(float(f[0]), float(f[1]), float(f[2]), float(f[3]));
+        for (int k = 0; k < 4; ++k)
+            if (!std::isfinite(mat.baseColor[k])) reader_.fail("material " + std::to_string(index) + ": baseColorFactor is not finite");
+        mat.doubleSided = m.doubleSided;
+        const tinygltf::TextureInfo& info = m.pbrMetallicRoughness.baseColorTexture;
+        if (info.index >= 0) mat.baseColorTexture = binding(info, "material " + std::to_string(index) + " '" + m.name + "'");
+        return mat;
+    }
+
+    TextureBinding binding(const tinygltf::TextureInfo& info, const std::string& where) {
+        TextureBinding b;
+        if (std::size_t(info.index) >= model_.textures.size())
+            reader_.fail(where + ": baseColorTexture names texture " + std::to_string(info.index) + ", which does not exist");
+        const tinygltf::Texture& tex = model_.textures[std::size_t(info.index)];
+        b.texCoord = std::uint32_t(std::max(info.texCoord, 0));
+        if (auto t = info.extensions.find("KHR_texture_transform"); t != info.extensions.end() && t->second.IsObject()) {
+            const tinygltf::Value& x = t->second;
+            const double ox = number(x, "offset", 0, 0.0), oy = number(x, "offset", 1, 0.0);
+            const double sx = number(x, "scale", 0, 1.0), sy = number(x, "scale", 1, 1.0), r = number(x, "rotation", 0, 0.0);
+            if (!std::isfinite(ox + oy + sx + sy + r)) reader_.fail(where + ": KHR_texture_transform has a non-finite number");
+            const double c = std::cos(r), s = std::sin(r);
+            // uv' = T R S uv (the extension's order), as columns.
+            b.transform = glm::mat3(glm::dmat3(sx * c, -sx * s, 0.0, sy * s, sy * c, 0.0, ox, oy, 1.0));
+            const double texCoord = number(x, "texCoord", 0, -1.0);
+            if (texCoord >= 0.0 && texCoord < 256.0) b.texCoord = std::uint32_t(texCoord);
+        }
+        if (tex.sampler >= 0) {
+            if (std::size_t(tex.sampler) >= model_.samplers.size())
+                reader_.fail(where + ": texture " + std::to_string(info.index) + " names sampler " + std::to_string(tex.sampler) + ", which does not exist");
+            const tinygltf::Sampler& s = model_.samplers[std::size_t(tex.sampler)];
+            b.wrapS = wrapOf(s.wrapS);
+            b.wrapT = wrapOf(s.wrapT);
+            b.nearest = s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST;
+        }
+        int image = tex.source;
+        for (const char* alternative : {"EXT_texture_webp", "KHR_texture_basisu", "MSFT_texture_dds"})
+            if (auto e = tex.extensions.find(alternative); image < 0 && e != tex.extensions.end() && e->second.IsObject())
+                image = int(number(e->second, "source", 0, -1.0));
+        if (image < 0) {
+            warn(reader_.name() + ": " + where + ": its base colour texture has no image dacrt can read; shaded with the base colour factor");
+            return b;
+        }
+        if (std::size_t(image) >= model_.images.size())
+            reader_.fail(where + ": texture " + std::to_string(info.index) + " names image " + std::to_string(image) + ", which does not exist");
+        b.texture = decoded(image, where);
+        return b;
+    }
+
+    int decoded(int image, const std::string& where) {
+        if (auto it = decodedImage_.find(image); it != decodedImage_.end()) return it->second;
+        const tinygltf::Image& img = model_.images[std::size_t(image)];
+        const std::string label = "image " + std::to_string(image) + (img.name.empty() ? "" : " '" + img.name + "'") +
+                                  (img.uri.empty() || img.uri.rfind("data:", 0) == 0 ? "" : " (" + img.uri + ")");
+        std::string why;
+        std::vector<unsigned char> fileBytes;
+        std::span<const unsigned char> bytes;
+        if (img.bufferView >= 0) {
+            bytes = reader_.viewBytes(img.bufferView, label);
+        } else if (!img.image.empty()) {
+            bytes = img.image;
+        } else if (!img.uri.empty() && source_.readFiles) {
+            const std::filesystem::path path = std::filesystem::path(source_.baseDir) / percentDecoded(img.uri);
+            std::ifstream in(path, std::ios::binary);
+            std::error_code ec;
+            const auto size = std::filesystem::file_size(path, ec);
+            if (!in || ec) why = "the file " + path.string() + " cannot be read";
+            else if (size > kMaxTextureBytes) why = "the file is larger than the texture limit";
+            else {
+                fileBytes.resize(std::size_t(size));
+                if (!in.read(reinterpret_cast<char*>(fileBytes.data()), std::streamsize(size))) why = "the file " + path.string() + " cannot be read";
+                bytes = fileBytes;
+            }
+        } else {
+            why = img.uri.empty() ? "it has no data" : "files named by uri are not read from memory input";
+        }
+        int result = -1;
+        if (why.empty()) {
+            Texture t = decodeImage(bytes, img.mimeType, why);
+            if (why.empty()) {
+                t.name = img.name.empty() ? "image " + std::to_string(image) : img.name;
+                result = int(scene_.textures.size());
+                scene_.textures.push_back(std::move(t));
+            }
+        }
+        if (result < 0) warn(reader_.name() + ": " + label + " (" + where + "): " + why + "; shaded with the base colour factor");
+        decodedImage_[image] = result;
+        return result;
+    }
+
+    void warn(const std::string& line) { scene_.warnings.push_back(line); }
+
+    const AccessorReader& reader_;
+    const tinygltf::Model& model_;
+    const ImageSource& source_;
+    Scene& scene_;
+    std::map<int, int> decodedImage_;
+};
+
+}  // namespace
+
+bool keepEncodedImage(tinygltf::Image* image, int, std::string*, std::string*, int, int, const unsigned char* bytes,
+                      int size, void*) {
+    if (image->bufferView < 0 && bytes && size > 0) image->image.assign(bytes, bytes + size);
+    return true;
+}
+
+void readMaterials(const AccessorReader& reader, const ImageSource& source, Scene& scene) {
+    MaterialReader(reader, source, scene).run();
+}
+
+}  // namespace dacrt::gltf

@@ -1,0 +1,364 @@
+// glTF features beyond plain geometry, one test each, on the fixtures of make_fixtures.py and on
+// meshopt- and Draco-compressed twins encoded here by the reference encoders.
+#include <algorithm>
+#include <array>
+#include <fstream>
+#include <tuple>
+
+#include <draco/compression/encode.h>
+#include <draco/mesh/mesh.h>
+#include <gtest/gtest.h>
+#include <meshoptimizer.h>
+#include <nlohmann/json.hpp>
+
+#include "core/camera.hpp"
+#include "core/errors.hpp"
+#include "core/gltf_loader.hpp"
+#include "core/procedural.hpp"
+#include "core/shading.hpp"
+#include "support/fixtures.hpp"
+
+using namespace dacrt;
+using dacrt::test::fixture;
+
+namespace {
+
+// The hit of the point p on triangle `prim` (barycentrics solved in double).
+Hit hitAt(const Scene& s, std::uint32_t prim, glm::dvec3 p) {
+    const Triangle& t = s.triangles[prim];
+    const glm::dvec3 a(t.v0), e1 = glm::dvec3(t.v1) - a, e2 = glm::dvec3(t.v2) - a, q = p - a;
+    const double d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+    const double q1 = glm::dot(q, e1), q2 = glm::dot(q, e2), det = d11 * d22 - d12 * d12;
+    Hit h{};
+    h.prim = prim;
+    h.t = 1.0f;
+    h.u = float((d22 * q1 - d12 * q2) / det);
+    h.v = float((d11 * q2 - d12 * q1) / det);
+    return h;
+}
+
+// The triangle of the quad (z = 0, [-1, 1]^2) that holds (x, y).
+Hit quadHit(const Scene& s, double x, double y) {
+    for (std::uint32_t k = 0; k < s.triangleCount(); ++k) {
+        const Hit h = hitAt(s, k, {x, y, 0.0});
+        if (h.u >= 0 && h.v >= 0 && h.u + h.v <= 1) return h;
+    }
+    ADD_FAILURE() << "no triangle holds (" << x << ", " << y << ")";
+    return Hit{};
+}
+
+void expectColor(const glm::vec3& c, float r, float g, float b) {
+    EXPECT_NEAR(c.r, r, 1e-5f);
+    EXPECT_NEAR(c.g, g, 1e-5f);
+    EXPECT_NEAR(c.b, b, 1e-5f);
+}
+
+// Each triangle's corners rotated to start at the smallest (keeping the winding), then sorted:
+// the same list for the same triangles in any order.
+std::vector<std::array<float, 9>> canonical(const std::vector<Triangle>& triangles) {
+    std::vector<std::array<float, 9>> out;
+    for (const Triangle& t : triangles) {
+        std::array<glm::vec3, 3> v{t.v0, t.v1, t.v2};
+        auto less = [](const glm::vec3& a, const glm::vec3& b) {
+            return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+        };
+        std::rotate(v.begin(), std::min_element(v.begin(), v.end(), less), v.end());
+        out.push_back({v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z, v[2].x, v[2].y, v[2].z});
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+    static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (std::size_t i = 0; i < bytes.size(); i += 3) {
+        const std::uint32_t n = std::uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? std::uint32_t(bytes[i + 1]) << 8 : 0) |
+                                (i + 2 < bytes.size() ? bytes[i + 2] : 0);
+        out += digits[n >> 18 & 63];
+        out += digits[n >> 12 & 63];
+        out += i + 1 < bytes.size() ? digits[n >> 6 & 63] : '=';
+        out += i + 2 < bytes.size() ? digits[n & 63] : '=';
+    }
+    return out;
+}
+
+std::string dataUri(const std::vector<unsigned char>& bytes) { return "data:application/octet-stream;base64," + base64(bytes); }
+
+template <typename T>
+std::vector<unsigned char> bytesOf(const std::vector<T>& v) {
+    const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+    return {p, p + v.size() * sizeof(T)};
+}
+
+Scene loadJson(const nlohmann::json& doc, const std::string& name) {
+    const std::string text = doc.dump();
+    return loadGltfFromMemory({reinterpret_cast<const unsigned char*>(text.data()), text.size()}, name);
+}
+
+// A torus as a plain glTF (positions and u32 indices in one data-URI buffer).
+nlohmann::json plainDocument(const Mesh& m) {
+    std::vector<unsigned char> data = bytesOf(m.positions);
+    const std::vector<unsigned char> idx = bytesOf(m.indices);
+    data.insert(data.end(), idx.begin(), idx.end());
+    return {{"asset", {{"version", "2.0"}}},
+            {"buffers", {{{"byteLength", data.size()}, {"uri", dataUri(data)}}}},
+            {"bufferViews", {{{"buffer", 0}, {"byteLength", m.positions.size() * 12}},
+                             {{"buffer", 0}, {"byteOffset", m.positions.size() * 12}, {"byteLength", idx.size()}}}},
+            {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", m.positions.size()}, {"type", "VEC3"}},
+                           {{"bufferView", 1}, {"componentType", 5125}, {"count", m.indices.size()}, {"type", "SCALAR"}}}},
+            {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
+            {"nodes", {{{"mesh", 0}}}},
+            {"scenes", {{{"nodes", {0}}}}}};
+}
+
+Mesh testMesh() { return torus({0.2f, -0.1f, 0.3f}, 1.0f, 0.3f, 24, 12); }
+
+}  // namespace
+
+TEST(GltfFeatures, ATexturedQuadShowsItsTexelsThroughTexcoordAndSampler) {
+    // 2x2 texture red, green / blue, white; image top-left at the quad's corner (-1, 1); NEAREST.
+    for (const char* name : {"quad_texture_image.glb", "quad_texture_data_uri.gltf"}) {
+        SCOPED_TRACE(name);
+        const Scene s = loadGltf(fixture(name));
+        EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+        ASSERT_EQ(s.textures.size(), 1u);
+        EXPECT_EQ(s.textures[0].width, 2);
+        expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 1, 0, 0);
+        expectColor(surfaceAt(s, quadHit(s, 0.5, 0.5)).albedo, 0, 1, 0);
+        expectColor(surfaceAt(s, quadHit(s, -0.5, -0.5)).albedo, 0, 0, 1);
+        expectColor(surfaceAt(s, quadHit(s, 0.5, -0.5)).albedo, 1, 1, 1);
+    }
+}
+
+TEST(GltfFeatures, AnImageThatDoesNotDecodeIsAWarningAndTheFactorShades) {
+    std::ifstream in(fixture("quad_texture_data_uri.gltf"));
+    nlohmann::json doc = nlohmann::json::parse(in);
+    doc["images"][0]["uri"] = "data:image/png;base64," + base64({'n', 'o', 't', ' ', 'a', ' ', 'p', 'n', 'g'});
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {0.5, 0.25, 1, 1};
+    const Scene s = loadJson(doc, "broken_image.gltf");
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_NE(s.warnings[0].find("image 0"), std::string::npos) << s.warnings[0];
+    EXPECT_NE(s.warnings[0].find("base colour factor"), std::string::npos) << s.warnings[0];
+    EXPECT_TRUE(s.textures.empty());
+    expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 0.5f, 0.25f, 1);
+}
+
+TEST(GltfFeatures, TextureTransformAndWrapModes) {
+    std::ifstream in(fixture("quad_texture_data_uri.gltf"));
+    nlohmann::json doc = nlohmann::json::parse(in);
+    // Offset by half the image in u with REPEAT: the left half now shows the right column.
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+        {"KHR_texture_transform", {{"offset", {0.5, 0.0}}}}};
+    doc["extensionsUsed"] = {"KHR_texture_transform"};
+    Scene s = loadJson(doc, "transformed.gltf");
+    expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 0, 1, 0);
+    expectColor(surfaceAt(s, quadHit(s, 0.5, 0.5)).albedo, 1, 0, 0);
+    // CLAMP_TO_EDGE: past the right edge the right column repeats.
+    doc["samplers"][0]["wrapS"] = 33071;
+    s = loadJson(doc, "clamped.gltf");
+    expectColor(surfaceAt(s, quadHit(s, 0.5, 0.5)).albedo, 0, 1, 0);
+}
+
+TEST(GltfFeatures, VertexColoursAreNormalizedBytesInterpolated) {
+    const Scene s = loadGltf(fixture("quad_vertex_colors.gltf"));
+    ASSERT_EQ(s.corners.colors.size(), s.triangleCount());
+    // Corner (-1, -1) is red, (1, -1) green, (1, 1) blue, (-1, 1) white.
+    Hit h = quadHit(s, -1.0, -1.0);
+    expectColor(surfaceAt(s, h).albedo, 1, 0, 0);
+    h = quadHit(s, 0.0, -1.0);  // halfway along the bottom edge
+    expectColor(surfaceAt(s, h).albedo, 0.5f, 0.5f, 0);
+}
+
+TEST(GltfFeatures, SparseAccessorsAndAccessorsWithoutABufferView) {
+    const Scene s = loadGltf(fixture("quad_sparse.gltf"));
+    ASSERT_EQ(s.triangleCount(), 3u);
+    EXPECT_EQ(s.triangles[0].v2, glm::vec3(2, 2, 0));  // vertex 2 replaced by the sparse part
+    EXPECT_EQ(s.triangles[1].v1, glm::vec3(2, 2, 0));
+    EXPECT_EQ(s.triangles[0].v0, glm::vec3(-1, -1, 0));
+    EXPECT_EQ(s.triangles[2].v0, glm::vec3(0, 0, 1));  // zeros, then every vertex from its sparse part
+    EXPECT_EQ(s.triangles[2].v1, glm::vec3(1, 0, 1));
+    EXPECT_EQ(s.triangles[2].v2, glm::vec3(0, 1, 1));
+}
+
+TEST(GltfFeatures, QuantizedPositionsUnderADequantizingNodeEqualTheirFloatTwin) {
+    const Scene q = loadGltf(fixture("quad_quantized.gltf"));
+    const Scene plain = loadGltf(fixture("quad_quantized_twin.gltf"));
+    ASSERT_EQ(q.triangleCount(), plain.triangleCount());
+    for (std::size_t i = 0; i < q.triangleCount(); ++i) {
+        EXPECT_EQ(q.triangles[i].v0, plain.triangles[i].v0);
+        EXPECT_EQ(q.triangles[i].v1, plain.triangles[i].v1);
+        EXPECT_EQ(q.triangles[i].v2, plain.triangles[i].v2);
+    }
+    EXPECT_EQ(q.triangles[0].v1, glm::vec3(2, -2, plain.triangles[0].v1.z));
+    // Without the extension declared, quantized positions are refused by name.
+    std::ifstream in(fixture("quad_quantized.gltf"));
+    nlohmann::json doc = nlohmann::json::parse(in);
+    doc.erase("extensionsUsed");
+    doc.erase("extensionsRequired");
+    try {
+        loadJson(doc, "undeclared.gltf");
+        FAIL() << "loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("KHR_mesh_quantization"), std::string::npos) << e.what();
+    }
+}
+
+TEST(GltfFeatures, MeshoptCompressedMeshDecodesToItsPlainTwin) {
+    const Mesh m = testMesh();
+    const Scene plain = loadJson(plainDocument(m), "plain.gltf");
+    std::vector<unsigned char> vertices(meshopt_encodeVertexBufferBound(m.positions.size(), 12));
+    vertices.resize(meshopt_encodeVertexBuffer(vertices.data(), vertices.size(), m.positions.data(), m.positions.size(), 12));
+    std::vector<unsigned char> indices(meshopt_encodeIndexBufferBound(m.indices.size(), m.positions.size()));
+    indices.resize(meshopt_encodeIndexBuffer(indices.data(), indices.size(), m.indices.data(), m.indices.size()));
+    std::vector<unsigned char> data = vertices;
+    while (data.size() % 4) data.push_back(0);
+    const std::size_t indexOffset = data.size();
+    data.insert(data.end(), indices.begin(), indices.end());
+
+    nlohmann::json doc = plainDocument(m);
+    const std::size_t vertexBytes = m.positions.size() * 12, indexBytes = m.indices.size() * 4;
+    doc["extensionsUsed"] = {"EXT_meshopt_compression"};
+    doc["extensionsRequired"] = {"EXT_meshopt_compression"};
+    doc["buffers"] = {{{"byteLength", data.size()}, {"uri", dataUri(data)}},
+                      {{"byteLength", vertexBytes + indexBytes}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}}};
+    doc["bufferViews"] = {
+        {{"buffer", 1}, {"byteLength", vertexBytes}, {"byteStride", 12},
+         {"extensions", {{"EXT_meshopt_compression", {{"buffer", 0}, {"byteLength", vertices.size()}, {"byteStride", 12},
+                                                      {"count", m.positions.size()}, {"mode", "ATTRIBUTES"}}}}}},
+        {{"buffer", 1}, {"byteOffset", vertexBytes}, {"byteLength", indexBytes},
+         {"extensions", {{"EXT_meshopt_compression", {{"buffer", 0}, {"byteOffset", indexOffset}, {"byteLength", indices.size()},
+                                                      {"byteStride", 4}, {"count", m.indices.size()}, {"mode", "TRIANGLES"}}}}}}};
+    const Scene packed = loadJson(doc, "meshopt.gltf");
+    ASSERT_EQ(packed.triangleCount(), plain.triangleCount());
+    // Lossless; the index codec may rotate a triangle's corners (keeping its winding).
+    EXPECT_EQ(canonical(packed.triangles), canonical(plain.triangles));
+
+    // Corrupted compressed bytes are refused naming the extension.
+    nlohmann::json bad = doc;
+    std::vector<unsigned char> broken = data;
+    std::fill(broken.begin(), broken.begin() + 8, 0xFF);
+    bad["buffers"][0]["uri"] = dataUri(broken);
+    try {
+        loadJson(bad, "broken_meshopt.gltf");
+        FAIL() << "loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("EXT_meshopt_compression"), std::string::npos) << e.what();
+    }
+}
+
+TEST(GltfFeatures, DracoCompressedMeshDecodesToItsPlainTwin) {
+    const Mesh m = testMesh();
+    const Scene plain = loadJson(plainDocument(m), "plain.gltf");
+    draco::Mesh mesh;
+    mesh.set_num_points(std::uint32_t(m.positions.size()));
+    draco::GeometryAttribute position;
+    position.Init(draco::GeometryAttribute::POSITION, nullptr, 3, draco::DT_FLOAT32, false, 12, 0);
+    const int id = mesh.AddAttribute(position, true, std::uint32_t(m.positions.size()));
+    for (std::uint32_t i = 0; i < m.positions.size(); ++i)
+        mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(i), &m.positions[i]);
+    for (std::size_t t = 0; t < m.indices.size(); t += 3)
+        mesh.AddFace({draco::PointIndex(m.indices[t]), draco::PointIndex(m.indices[t + 1]), draco::PointIndex(m.indices[t + 2])});
+    draco::Encoder encoder;  // no quantization: positions are stored losslessly
+    encoder.SetEncodingMethod(draco::MESH_SEQUENTIAL_ENCODING);
+    draco::EncoderBuffer encoded;
+    ASSERT_TRUE(encoder.EncodeMeshToBuffer(mesh, &encoded).ok());
+    const std::vector<unsigned char> data(encoded.data(), encoded.data() + encoded.size());
+
+    nlohmann::json doc = plainDocument(m);
+    doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    doc["buffers"] = {{{"byteLength", data.size()}, {"uri", dataUri(data)}}};
+    doc["bufferViews"] = {{{"buffer", 0}, {"byteLength", data.size()}}};
+    doc["accessors"][0].erase("bufferView");
+    doc["accessors"][1].erase("bufferView");
+    doc["meshes"][0]["primitives"][0]["extensions"] = {
+        {"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", mesh.attribute(id)->unique_id()}}}}}};
+    const Scene packed = loadJson(doc, "draco.gltf");
+    ASSERT_EQ(packed.triangleCount(), plain.triangleCount());
+    EXPECT_EQ(canonical(packed.triangles), canonical(plain.triangles));
+
+    nlohmann::json bad = doc;
+    bad["buffers"][0]["uri"] = dataUri(std::vector<unsigned char>(data.size(), 0x5A));
+    try {
+        loadJson(bad, "broken_draco.gltf");
+        FAIL() << "loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("KHR_draco_mesh_compression"), std::string::npos) << e.what();
+    }
+}
+
+TEST(GltfFeatures, UnknownRequiredExtensionsAreRefusedByNameAndUsedOnesWarned) {
+    nlohmann::json doc = plainDocument(testMesh());
+    doc["extensionsUsed"] = {"EXT_made_up_a", "EXT_made_up_b"};
+    const Scene s = loadJson(doc, "used.gltf");
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_NE(s.warnings[0].find("EXT_made_up_a, EXT_made_up_b"), std::string::npos) << s.warnings[0];
+    doc["extensionsRequired"] = {"EXT_made_up_b"};
+    try {
+        loadJson(doc, "required.gltf");
+        FAIL() << "loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("requires the extension EXT_made_up_b"), std::string::npos) << e.what();
+    }
+}
+
+TEST(GltfFeatures, ScenesCamerasAndLights) {
+    Scene s = loadGltf(fixture("quad_cameras_lights.gltf"));
+    ASSERT_EQ(s.cameras.size(), 2u);
+    ASSERT_TRUE(s.camera.has_value());
+    EXPECT_EQ(s.camera->name, "top");
+    EXPECT_EQ(s.camera->projection, Projection::Orthographic);
+    EXPECT_DOUBLE_EQ(s.camera->ymag, 1.5);
+    selectCamera(s, "side");
+    EXPECT_EQ(s.camera->projection, Projection::Perspective);
+    EXPECT_NEAR(s.camera->eye.x, 4.0, 1e-12);
+    EXPECT_NEAR(s.camera->forward.x, -1.0, 1e-12);
+    selectCamera(s, "0");
+    EXPECT_EQ(s.camera->name, "top");
+    try {
+        selectCamera(s, "front");
+        FAIL() << "selected";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("0 'top', 1 'side'"), std::string::npos) << e.what();
+    }
+    ASSERT_EQ(s.lights.size(), 2u);
+    EXPECT_EQ(s.lights[0].type, LightType::Point);
+    EXPECT_EQ(s.lights[0].name, "bulb");
+    EXPECT_EQ(s.lights[0].color, glm::vec3(1, 0.5f, 0.25f));
+    EXPECT_FLOAT_EQ(s.lights[0].intensity, 20.0f);
+    EXPECT_EQ(s.lights[0].position, glm::dvec3(0, 2, 2));
+    EXPECT_EQ(s.lights[1].type, LightType::Spot);
+    EXPECT_FLOAT_EQ(s.lights[1].outerConeAngle, 0.5f);
+    EXPECT_EQ(s.lights[1].direction, glm::dvec3(0, 0, -1));
+    EXPECT_EQ(s.warnings.size(), 1u);  // EXT_unheard_of_but_optional, used only
+
+    const Scene far = loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{"far"});
+    EXPECT_EQ(far.triangles[0].v0.z, -5.0f);
+    EXPECT_EQ(far.lights.size(), 0u);
+    EXPECT_EQ(far.cameras.size(), 1u);
+    EXPECT_EQ(loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{"1"}).triangles[0].v0.z, -5.0f);
+    try {
+        loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{"middle"});
+        FAIL() << "loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("0 'near', 1 'far'"), std::string::npos) << e.what();
+    }
+}
+
+TEST(GltfFeatures, OrthographicRaysShareADirectionAndStartOnTheViewPlane) {
+    Scene s = loadGltf(fixture("quad_cameras_lights.gltf"));
+    const std::vector<Camera> cams = makeCameras(s, sceneBounds(s.triangles), {}, 1.0);
+    ASSERT_EQ(cams[0].projection, Projection::Orthographic);
+    const std::vector<Ray> rays = primaryRays(cams[0], 4, 4);
+    for (const Ray& r : rays) {
+        EXPECT_EQ(r.dir, rays[0].dir);
+        EXPECT_EQ(r.origin.z, 3.0f);
+        EXPECT_LE(std::abs(r.origin.x), 1.5f);
+    }
+    EXPECT_EQ(rays[0].origin, glm::vec3(-1.125f, 1.125f, 3.0f));  // pixel centre (0.5, 0.5) of 4 over [-1.5, 1.5]
+    EXPECT_FALSE(viewFrustum(cams[0], 4, 4).has_value());
+    CameraOptions fov;
+    fov.fovDegrees = 30.0;
+    EXPECT_THROW(makeCameras(s, sceneBounds(s.triangles), fov, 1.0), InputError);
+}
