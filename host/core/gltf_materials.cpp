@@ -67,7 +67,7 @@ Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mim
     const int channels = spec.nchannels;
     std::vector<std::uint8_t> raw(std::size_t(texels) * std::size_t(channels));
     if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, raw.data())) {
-        why = "it does not decode (" + in->geterror() + ")";
+        why = "its pixels do not decode (" + in->geterror() + ")";
         return t;
     }
     t.width = spec.width;

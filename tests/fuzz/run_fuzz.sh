@@ -48,6 +48,8 @@ fuzzer="$build/dacrt_gltf_fuzzer"
 # report carry a stack. Leaks count as findings (libFuzzer's -detect_leaks=1 default).
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:allocator_may_return_null=0}"
+# Leaks inside libraries, not dacrt, are suppressed as in the sanitizer job (.ci/lsan.supp).
+export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$here/../../.ci/lsan.supp:print_suppressions=0}"
 
 findings="$build/findings"
 mkdir -p "$findings" "$build/corpus"
