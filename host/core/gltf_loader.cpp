@@ -107,9 +107,10 @@ tinygltf::Model parseGltf(std::span<const unsigned char> bytes, const std::strin
 // ---- the rules of the glTF 2.0 specification the flattening relies on -------------------
 
 // Extensions dacrt reads; a file may require them. Any other required extension is refused.
-constexpr std::array<std::string_view, 6> kReadExtensions{"KHR_mesh_quantization", "EXT_meshopt_compression",
+constexpr std::array<std::string_view, 7> kReadExtensions{"KHR_mesh_quantization", "EXT_meshopt_compression",
                                                           "KHR_meshopt_compression", "KHR_draco_mesh_compression",
-                                                          "KHR_texture_transform", "KHR_lights_punctual"};
+                                                          "KHR_texture_transform", "KHR_lights_punctual",
+                                                          "KHR_materials_pbrSpecularGlossiness"};
 bool readsExtension(const std::string& e) {
     return std::find(kReadExtensions.begin(), kReadExtensions.end(), e) != kReadExtensions.end();
 }

@@ -101,6 +101,16 @@ double number(const tinygltf::Value& object, const char* key, std::size_t index,
     return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
 }
 
+// A textureInfo object held in an extension's JSON (tinygltf parses only the core ones).
+tinygltf::TextureInfo textureInfoOf(const tinygltf::Value& v) {
+    tinygltf::TextureInfo info;
+    info.index = int(number(v, "index", 0, -1.0));
+    info.texCoord = int(number(v, "texCoord", 0, 0.0));
+    if (v.Has("extensions") && v.Get("extensions").IsObject() && v.Get("extensions").Has("KHR_texture_transform"))
+        info.extensions["KHR_texture_transform"] = v.Get("extensions").Get("KHR_texture_transform");
+    return info;
+}
+
 class MaterialReader {
 public:
     MaterialReader(const AccessorReader& reader, const ImageSource& source, Scene& scene)
@@ -117,10 +127,19 @@ private:
         mat.name = m.name;
         const std::vector<double>& f = m.pbrMetallicRoughness.baseColorFactor;
         if (f.size() == 4) mat.baseColor = glm::vec4(float(f[0]), float(f[1]), float(f[2]), float(f[3]));
-        for (int k = 0; k < 4; ++k)
-            if (!std::isfinite(mat.baseColor[k])) reader_.fail("material " + std::to_string(index) + ": baseColorFactor is not finite");
         mat.doubleSided = m.doubleSided;
-        const tinygltf::TextureInfo& info = m.pbrMetallicRoughness.baseColorTexture;
+        tinygltf::TextureInfo info = m.pbrMetallicRoughness.baseColorTexture;
+        // The archived specular-glossiness workflow (required by older files, Khronos' samples
+        // among them): its diffuse colour is what the preview shows as the base colour.
+        if (auto sg = m.extensions.find("KHR_materials_pbrSpecularGlossiness"); sg != m.extensions.end() && sg->second.IsObject()) {
+            const tinygltf::Value& x = sg->second;
+            mat.baseColor = glm::vec4(float(number(x, "diffuseFactor", 0, 1.0)), float(number(x, "diffuseFactor", 1, 1.0)),
+                                      float(number(x, "diffuseFactor", 2, 1.0)), float(number(x, "diffuseFactor", 3, 1.0)));
+            info = tinygltf::TextureInfo{};
+            if (x.Has("diffuseTexture") && x.Get("diffuseTexture").IsObject()) info = textureInfoOf(x.Get("diffuseTexture"));
+        }
+        for (int k = 0; k < 4; ++k)
+            if (!std::isfinite(mat.baseColor[k])) reader_.fail("material " + std::to_string(index) + ": the base colour is not finite");
         if (info.index >= 0) mat.baseColorTexture = binding(info, "material " + std::to_string(index) + " '" + m.name + "'");
         return mat;
     }

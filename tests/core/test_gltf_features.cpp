@@ -362,3 +362,19 @@ TEST(GltfFeatures, OrthographicRaysShareADirectionAndStartOnTheViewPlane) {
     fov.fovDegrees = 30.0;
     EXPECT_THROW(makeCameras(s, sceneBounds(s.triangles), fov, 1.0), InputError);
 }
+
+TEST(GltfFeatures, SpecularGlossinessMaterialsShowTheirDiffuseColour) {
+    // Older files (Khronos' glTF-pbrSpecularGlossiness samples) require the archived
+    // extension; its diffuse texture and factor are the preview's base colour.
+    std::ifstream in(fixture("quad_texture_data_uri.gltf"));
+    nlohmann::json doc = nlohmann::json::parse(in);
+    doc["materials"][0]["pbrMetallicRoughness"].erase("baseColorTexture");
+    doc["materials"][0]["extensions"] = {{"KHR_materials_pbrSpecularGlossiness",
+                                          {{"diffuseFactor", {0.5, 1, 1, 1}}, {"diffuseTexture", {{"index", 0}}}}}};
+    doc["extensionsUsed"] = {"KHR_materials_pbrSpecularGlossiness"};
+    doc["extensionsRequired"] = {"KHR_materials_pbrSpecularGlossiness"};
+    const Scene s = loadJson(doc, "specgloss.gltf");
+    EXPECT_TRUE(s.warnings.empty());
+    expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 0.5f, 0, 0);
+    expectColor(surfaceAt(s, quadHit(s, 0.5, -0.5)).albedo, 0.5f, 1, 1);
+}
