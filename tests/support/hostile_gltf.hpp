@@ -66,6 +66,62 @@ inline std::vector<HostileGltf> hostileGltfFiles() {
              j["extensionsUsed"] = {"EXT_unheard_of_geometry"};
              j["extensionsRequired"] = {"EXT_unheard_of_geometry"};
          })},
+        // The forms and extensions the loader decodes, each broken once.
+        {"SparseIndexOutOfRange", "index 128 is out of range for 4 elements", changed([](nlohmann::json& j) {
+             // Byte 2 of the positions (-1.0f: 00 00 80 bf) read as an index: 128.
+             j["accessors"][0]["sparse"] = {{"count", 1}, {"indices", {{"bufferView", 0}, {"componentType", 5121}, {"byteOffset", 2}}},
+                                            {"values", {{"bufferView", 0}}}};
+         })},
+        {"SparseIndicesPastTheirView", "run past the end of buffer view 1", changed([](nlohmann::json& j) {
+             j["accessors"][0]["sparse"] = {{"count", 4}, {"indices", {{"bufferView", 1}, {"componentType", 5125}}},
+                                            {"values", {{"bufferView", 0}}}};
+         })},
+        {"SparseCountAboveTheAccessor", "not in 1..4", changed([](nlohmann::json& j) {
+             j["accessors"][0]["sparse"] = {{"count", 5}, {"indices", {{"bufferView", 1}, {"componentType", 5121}}},
+                                            {"values", {{"bufferView", 0}}}};
+         })},
+        {"QuantizedWithoutTheExtension", "needs the extension KHR_mesh_quantization", changed([](nlohmann::json& j) {
+             j["accessors"][0]["componentType"] = 5122;
+         })},
+        {"MeshoptCountDisagreesWithTheView", "count x byteStride is 12 bytes", changed([](nlohmann::json& j) {
+             j["extensionsUsed"] = {"EXT_meshopt_compression"};
+             j["bufferViews"][0]["extensions"] = {{"EXT_meshopt_compression",
+                                                   {{"buffer", 0}, {"byteLength", 48}, {"byteStride", 12}, {"count", 1}, {"mode", "ATTRIBUTES"}}}};
+         })},
+        {"MeshoptSourcePastTheBuffer", "run past the end of buffer 0", changed([](nlohmann::json& j) {
+             j["extensionsUsed"] = {"EXT_meshopt_compression"};
+             j["bufferViews"][0]["extensions"] = {{"EXT_meshopt_compression",
+                                                   {{"buffer", 0}, {"byteOffset", 40}, {"byteLength", 4096}, {"byteStride", 12}, {"count", 4},
+                                                    {"mode", "ATTRIBUTES"}}}};
+         })},
+        {"MeshoptMalformedStream", "malformed (meshoptimizer error", changed([](nlohmann::json& j) {
+             j["extensionsUsed"] = {"EXT_meshopt_compression"};
+             j["bufferViews"][0]["extensions"] = {{"EXT_meshopt_compression",
+                                                   {{"buffer", 0}, {"byteLength", 48}, {"byteStride", 12}, {"count", 4}, {"mode", "ATTRIBUTES"}}}};
+         })},
+        {"DracoViewMissing", "buffer view 9 does not exist", changed([](nlohmann::json& j) {
+             j["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+             j["meshes"][0]["primitives"][0]["extensions"] = {
+                 {"KHR_draco_mesh_compression", {{"bufferView", 9}, {"attributes", {{"POSITION", 0}}}}}};
+         })},
+        {"DracoStreamIsNotDraco", "does not decode", changed([](nlohmann::json& j) {
+             j["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+             j["meshes"][0]["primitives"][0]["extensions"] = {
+                 {"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", 0}}}}}};
+         })},
+        {"TextureNamesAMissingImage", "names image 4, which does not exist", changed([](nlohmann::json& j) {
+             j["textures"] = {{{"source", 4}}};
+             j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+         })},
+        {"ImageViewPastTheBuffer", "runs past the end of buffer 0", changed([](nlohmann::json& j) {
+             j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 40}, {"byteLength", 1000000}});
+             j["images"] = {{{"bufferView", 2}, {"mimeType", "image/png"}}};
+             j["textures"] = {{{"source", 0}}};
+             j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+         })},
+        {"LightThatDoesNotExist", "names a light that does not exist", changed([](nlohmann::json& j) {
+             j["nodes"][1]["extensions"] = {{"KHR_lights_punctual", {{"light", 3}}}};
+         })},
         {"SceneListsANodeTwice", "twice", changed([](nlohmann::json& j) { j["scenes"][0]["nodes"] = {0, 0, 1}; })},
         {"RootIsAChild", "is a root of scene 0 but a child",
          changed([](nlohmann::json& j) { j["nodes"][1]["children"] = {0}; })},
