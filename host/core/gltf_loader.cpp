@@ -342,6 +342,7 @@ public:
         scene_.materials.push_back(fallback);
         for (const NodeInstance& i : instances) flattenNode(i);
         takeInventory(sceneIndex);
+        warnAboutMotion();
         return std::move(scene_);
     }
 
@@ -648,6 +649,20 @@ private:
             }
         }
         touchTriangles(scene_);
+    }
+
+    // Animations, skins and morph targets are not applied: the meshes are traced at rest (their
+    // bind pose, morph weights 0). Said once, so that a still image is not mistaken for a frame.
+    void warnAboutMotion() {
+        std::size_t morphed = 0;
+        for (const tinygltf::Mesh& m : model_.meshes)
+            for (const tinygltf::Primitive& p : m.primitives) morphed += !p.targets.empty();
+        std::vector<std::string> parts;
+        if (!model_.animations.empty()) parts.push_back(str(model_.animations.size()) + " animation(s)");
+        if (!model_.skins.empty()) parts.push_back(str(model_.skins.size()) + " skin(s)");
+        if (morphed) parts.push_back(str(morphed) + " primitive(s) with morph targets");
+        if (!parts.empty())
+            scene_.warnings.push_back(reader_.name() + ": " + joined(parts) + " not applied; the meshes are traced at rest");
     }
 
     void takeInventory(int sceneIndex) {

@@ -378,3 +378,11 @@ TEST(GltfFeatures, SpecularGlossinessMaterialsShowTheirDiffuseColour) {
     expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 0.5f, 0, 0);
     expectColor(surfaceAt(s, quadHit(s, 0.5, -0.5)).albedo, 0.5f, 1, 1);
 }
+
+TEST(GltfFeatures, AnimationsAndSkinsAreNamedInOneWarning) {
+    nlohmann::json doc = plainDocument(testMesh());
+    doc["skins"] = {{{"joints", {0}}}};
+    const Scene s = loadJson(doc, "skinned.gltf");
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_NE(s.warnings[0].find("1 skin(s) not applied; the meshes are traced at rest"), std::string::npos) << s.warnings[0];
+}
