@@ -156,7 +156,7 @@ void planSkips(const FrameGeometry& g, const SkipSwitches& switches, const Trian
     plan.addWork("skipped: outside the view frustum", skips.outsideFrustum,
                  skips.frustumTested ? "no primary ray of the camera can reach them"
                  : switches.frustum && g.frustum ? "none tested: the scene box lies inside the view"
-                                                 : reason(switches.frustum, bool(g.frustum), "needs a camera's primary rays"));
+                                                 : reason(switches.frustum, bool(g.frustum), "needs a pinhole camera's primary rays (an orthographic view has no apex)"));
     plan.addWork("triangles traced", skips.applied ? skips.traced.size() : g.triangles->size());
     plan.addWork("rays", g.rays->size());
 }
