@@ -145,6 +145,10 @@ void AccessorReader::applySparse(const tinygltf::Accessor& acc, const Elements& 
 
 std::vector<glm::dvec4> AccessorReader::readVectors(int index, std::initializer_list<int> types, const std::string& where) const {
     const Elements e = elements(index, types, where);
+    const std::uint64_t bytes = mul(e.count, sizeof(glm::dvec4), where + ": accessor " + std::to_string(index) + " size");
+    if (byteLimit_ && bytes > byteLimit_)
+        fail(where + ": accessor " + std::to_string(index) + " has " + str(e.count) + " elements, which need " + str(bytes) +
+             " bytes to read, more than the " + str(byteLimit_) + "-byte limit");
     std::vector<glm::dvec4> out(e.count, glm::dvec4(0.0));
     if (e.data) {
         const std::uint64_t componentSize = std::uint64_t(tinygltf::GetComponentSizeInBytes(std::uint32_t(e.componentType)));

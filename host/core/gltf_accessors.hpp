@@ -46,6 +46,10 @@ public:
     // The bytes of a buffer view: the buffer's, or what EXT_meshopt_compression decoded.
     std::span<const unsigned char> viewBytes(int view, const std::string& where) const;
 
+    // The most bytes one accessor's decoded elements may take (each element is a dvec4, 32
+    // bytes); 0: no limit. A view-less accessor's count is bounded by nothing else.
+    void setByteLimit(std::uint64_t bytes) { byteLimit_ = bytes; }
+
     // Decoded contents for a buffer view (EXT_meshopt_compression), used instead of its buffer.
     void setDecodedView(int view, std::vector<unsigned char> bytes) { decodedViews_[view] = std::move(bytes); }
     bool isDecodedView(int view) const { return decodedViews_.count(view) != 0; }
@@ -70,6 +74,7 @@ private:
     const tinygltf::Model& model_;
     const ContainerRewrites& rewrites_;
     std::map<int, std::vector<unsigned char>> decodedViews_;
+    std::uint64_t byteLimit_ = 0;
 };
 
 // One component of type `componentType` at p, as glTF reads it (normalized or not).

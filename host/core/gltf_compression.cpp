@@ -127,17 +127,23 @@ PrimitiveData decodeDracoPrimitive(const AccessorReader& reader, const tinygltf:
     const std::unique_ptr<draco::Mesh>& mesh = decoded.value();
     const std::uint64_t points = mesh->num_points();
 
+    // The decoded faces are a triangle list over the decoded points (Draco reorders points),
+    // whatever the primitive's mode and whether or not it names an indices accessor; their
+    // number must be the one the accessors declared, which planned the scene's memory.
     PrimitiveData data;
-    if (primitive.indices >= 0) {
-        const tinygltf::Accessor& acc = reader.accessor(primitive.indices, {TINYGLTF_TYPE_SCALAR}, w + " indices");
-        if (std::uint64_t(acc.count) != std::uint64_t(mesh->num_faces()) * 3)
-            reader.fail(w + ": the indices accessor declares " + str(acc.count) + " indices, the compressed mesh has " +
-                        str(std::uint64_t(mesh->num_faces()) * 3));
-        data.indexed = true;
-        data.indices.reserve(std::size_t(mesh->num_faces()) * 3);
-        for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f)
-            for (int k = 0; k < 3; ++k) data.indices.push_back(mesh->face(f)[k].value());
-    }
+    const std::uint64_t corners = std::uint64_t(mesh->num_faces()) * 3;
+    const std::uint64_t declared =
+        primitive.indices >= 0
+            ? std::uint64_t(reader.accessor(primitive.indices, {TINYGLTF_TYPE_SCALAR}, w + " indices").count)
+            : std::uint64_t(reader.accessor(primitive.attributes.at("POSITION"), {TINYGLTF_TYPE_VEC3}, w + " POSITION").count);
+    if (declared != corners)
+        reader.fail(w + ": the accessors declare " + str(declared) + (primitive.indices >= 0 ? " indices" : " vertices") +
+                    ", the compressed mesh has " + str(corners) + " triangle corners");
+    data.indexed = true;
+    data.trianglesListed = true;
+    data.indices.reserve(std::size_t(corners));
+    for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f)
+        for (int k = 0; k < 3; ++k) data.indices.push_back(mesh->face(f)[k].value());
 
     const tinygltf::Value& ids = ext.Get("attributes");
     for (const std::string& name : wanted) {

@@ -16,6 +16,7 @@ namespace dacrt::gltf {
 // One primitive's corners and the attributes the flattener reads, whatever form they came in.
 struct PrimitiveData {
     bool indexed = false;
+    bool trianglesListed = false;  // the indices are a triangle list whatever the primitive's mode (Draco)
     std::vector<std::uint32_t> indices;
     std::map<std::string, std::vector<glm::dvec4>> attributes;
 };

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <string_view>
 
 #include <tiny_gltf.h>
@@ -511,10 +512,15 @@ private:
             data.indexed = true;
             data.indices = reader_.readIndices(prim.indices, where + " indices");
         }
+        const std::uint64_t vertices = reader_.checkedCount(prim.attributes.at(kPosition), {TINYGLTF_TYPE_VEC3}, where + " POSITION");
         for (const std::string& name : wanted) {
             auto a = prim.attributes.find(name);
             if (a == prim.attributes.end()) continue;
             const std::string w = where + " " + name;
+            const std::uint64_t count =
+                reader_.accessor(a->second, {TINYGLTF_TYPE_VEC2, TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, w).count;
+            if (count != vertices)
+                check_.fail(w + ": accessor " + std::to_string(a->second) + " has " + str(count) + " elements, POSITION has " + str(vertices));
             if (name == kColor) data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, w);
             else if (name.rfind("TEXCOORD_", 0) == 0) data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC2}, w);
             else data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3}, w);
@@ -544,7 +550,7 @@ private:
     void addPrimitive(std::uint32_t node, std::uint32_t meshIndex, std::uint32_t primIndex,
                       const tinygltf::Primitive& prim, const glm::dmat4& world) {
         const std::string where = "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(primIndex);
-        const int mode = modeOf(prim);
+        int mode = modeOf(prim);
         std::uint32_t material = defaultMaterial_;
         if (prim.material >= 0) {
             if (std::size_t(prim.material) >= model_.materials.size())
@@ -552,7 +558,20 @@ private:
             material = std::uint32_t(prim.material);
         }
         checkPositionType(prim, where);
-        const gltf::PrimitiveData data = readPrimitive(prim, wantedAttributes(material), where);
+        // A Draco mesh placed by many nodes is decoded once (the decoder is the costly reader).
+        gltf::PrimitiveData plain;
+        const gltf::PrimitiveData* read = &plain;
+        if (gltf::usesDraco(prim)) {
+            const auto key = std::make_pair(meshIndex, primIndex);
+            auto cached = dracoDecoded_.find(key);
+            if (cached == dracoDecoded_.end())
+                cached = dracoDecoded_.emplace(key, readPrimitive(prim, wantedAttributes(material), where)).first;
+            read = &cached->second;
+        } else {
+            plain = readPrimitive(prim, wantedAttributes(material), where);
+        }
+        const gltf::PrimitiveData& data = *read;
+        if (data.trianglesListed) mode = TINYGLTF_MODE_TRIANGLES;
         if (!data.attributes.count(kPosition)) check_.fail(where + ": no POSITION data");
         const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
         std::vector<std::uint32_t> indices = data.indices;
@@ -710,6 +729,7 @@ private:
     GltfChecker check_;
     Scene scene_;
     std::uint32_t defaultMaterial_ = 0;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, gltf::PrimitiveData> dracoDecoded_;  // by (mesh, primitive)
 };
 
 Scene loadFromBytes(std::span<const unsigned char> bytes, const std::string& name, const std::string& baseDir,
@@ -720,6 +740,7 @@ Scene loadFromBytes(std::span<const unsigned char> bytes, const std::string& nam
     const tinygltf::Model model = parseGltf(prepared.bytes.empty() ? bytes : std::span<const unsigned char>(prepared.bytes),
                                             name, baseDir, readFiles);
     gltf::AccessorReader reader(name, model, prepared.rewrites);
+    reader.setByteLimit(limits.maxBytes ? limits.maxBytes : physicalMemoryBytes());
     Scene scene = GltfFlattener(reader, limits, selection, gltf::ImageSource{baseDir, readFiles}).run();
     validateScene(scene);
     return scene;

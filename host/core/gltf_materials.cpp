@@ -52,7 +52,13 @@ Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mim
         return t;
     }
     OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
-    auto in = OIIO::ImageInput::open(std::string("image") + ext, nullptr, &memory);
+    // glTF colours are not premultiplied by alpha; OpenImageIO's PNG reader would otherwise
+    // associate them.
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    OIIO::Filesystem::IOProxy* proxy = &memory;  // with a config, the reader takes its proxy from it
+    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+    auto in = OIIO::ImageInput::open(std::string("image") + ext, &config, &memory);
     if (!in) {
         why = "it does not decode (" + OIIO::geterror() + ")";
         return t;
@@ -101,11 +107,17 @@ double number(const tinygltf::Value& object, const char* key, std::size_t index,
     return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
 }
 
+// An index held as a JSON number: -1 unless it is an integer in [0, 2^31).
+int indexOf(const tinygltf::Value& object, const char* key, int fallback) {
+    const double d = number(object, key, 0, double(fallback));
+    return d >= 0.0 && d < 2147483648.0 && d == std::floor(d) ? int(d) : -1;
+}
+
 // A textureInfo object held in an extension's JSON (tinygltf parses only the core ones).
 tinygltf::TextureInfo textureInfoOf(const tinygltf::Value& v) {
     tinygltf::TextureInfo info;
-    info.index = int(number(v, "index", 0, -1.0));
-    info.texCoord = int(number(v, "texCoord", 0, 0.0));
+    info.index = indexOf(v, "index", -1);
+    info.texCoord = std::max(indexOf(v, "texCoord", 0), 0);
     if (v.Has("extensions") && v.Get("extensions").IsObject() && v.Get("extensions").Has("KHR_texture_transform"))
         info.extensions["KHR_texture_transform"] = v.Get("extensions").Get("KHR_texture_transform");
     return info;
@@ -172,7 +184,7 @@ private:
         int image = tex.source;
         for (const char* alternative : {"EXT_texture_webp", "KHR_texture_basisu", "MSFT_texture_dds"})
             if (auto e = tex.extensions.find(alternative); image < 0 && e != tex.extensions.end() && e->second.IsObject())
-                image = int(number(e->second, "source", 0, -1.0));
+                image = indexOf(e->second, "source", -1);
         if (image < 0) {
             warn(reader_.name() + ": " + where + ": its base colour texture has no image dacrt can read; shaded with the base colour factor");
             return b;

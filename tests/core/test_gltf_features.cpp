@@ -158,6 +158,70 @@ TEST(GltfFeatures, TextureTransformAndWrapModes) {
     doc["samplers"][0]["wrapS"] = 33071;
     s = loadJson(doc, "clamped.gltf");
     expectColor(surfaceAt(s, quadHit(s, 0.5, 0.5)).albedo, 0, 1, 0);
+    // MIRRORED_REPEAT with offset 1: u in [1, 2) reads 2 - u, so the left half shows the right
+    // column (REPEAT would show the left one).
+    doc["samplers"][0]["wrapS"] = 33648;
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] = {{"offset", {1.0, 0.0}}};
+    s = loadJson(doc, "mirrored.gltf");
+    expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 0, 1, 0);
+    // The order T R S: scale (2, 1) then offset 0.5 sends u = 0.05 (x = -0.9) to 0.6, the right
+    // column; offsetting first would give 1.1, the left one (under REPEAT).
+    doc["samplers"][0]["wrapS"] = 10497;
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] = {
+        {"offset", {0.5, 0.0}}, {"scale", {2.0, 1.0}}};
+    s = loadJson(doc, "scaled.gltf");
+    expectColor(surfaceAt(s, quadHit(s, -0.9, 0.5)).albedo, 0, 1, 0);
+    // Rotation by pi/2: (u, v) -> (v, -u); u = v = 0.25 (top left) reads (0.25, -0.25), which
+    // repeats to (0.25, 0.75): the bottom-left texel, blue.
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]["KHR_texture_transform"] = {
+        {"rotation", M_PI / 2}};
+    s = loadJson(doc, "rotated.gltf");
+    expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 0, 0, 1);
+}
+
+TEST(GltfFeatures, TexelsAreSrgbDecodedAndLinearFilteredBetweenCentres) {
+    const Scene s = loadGltf(fixture("quad_texture_grey.gltf"));
+    const float grey = 0.21586050f;  // sRGB 128 / 255 in linear light
+    expectColor(surfaceAt(s, quadHit(s, -0.5, 0.0)).albedo, grey, grey, grey);  // the grey texel's centre
+    const float half = 0.5f * (grey + 1.0f);
+    expectColor(surfaceAt(s, quadHit(s, 0.0, 0.0)).albedo, half, half, half);  // halfway to the white one
+    expectColor(surfaceAt(s, quadHit(s, 0.99, 0.0)).albedo, 1, 1, 1);         // clamped past its centre
+}
+
+TEST(GltfFeatures, SmoothNormalsFollowTheirCornersUnderAMirroringNode) {
+    // Each vertex's NORMAL is normalize(x, y, 1) of its position; under a node that mirrors x
+    // (scale -1, 1, 1) positions and normals both flip x, and the loader swaps two corners of
+    // every triangle: each corner's normal must still be normalize(x, y, 1) of its corner.
+    const Mesh m = grid({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 3, 2);
+    nlohmann::json doc = plainDocument(m);
+    std::vector<glm::vec3> normals;
+    for (const glm::vec3& p : m.positions) normals.push_back(glm::normalize(glm::vec3(p.x, p.y, 1.0f)));
+    std::vector<unsigned char> data = bytesOf(m.positions);
+    const std::vector<unsigned char> idx = bytesOf(m.indices), nrm = bytesOf(normals);
+    data.insert(data.end(), idx.begin(), idx.end());
+    const std::size_t normalOffset = data.size();
+    data.insert(data.end(), nrm.begin(), nrm.end());
+    doc["buffers"][0] = {{"byteLength", data.size()}, {"uri", dataUri(data)}};
+    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", normalOffset}, {"byteLength", nrm.size()}});
+    doc["accessors"].push_back({{"bufferView", 2}, {"componentType", 5126}, {"count", normals.size()}, {"type", "VEC3"}});
+    doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 2;
+    doc["nodes"][0]["scale"] = {-1, 1, 1};
+    doc["materials"] = {{{"doubleSided", true}}};
+    doc["meshes"][0]["primitives"][0]["material"] = 0;
+    const Scene s = loadJson(doc, "mirrored_normals.gltf");
+    ASSERT_EQ(s.corners.normals.size(), s.triangleCount());
+    for (std::size_t t = 0; t < s.triangleCount(); ++t) {
+        const glm::vec3 v[3] = {s.triangles[t].v0, s.triangles[t].v1, s.triangles[t].v2};
+        for (int k = 0; k < 3; ++k) {
+            const glm::vec3 expected = glm::normalize(glm::vec3(v[k].x, v[k].y, 1.0f));
+            EXPECT_NEAR(glm::distance(s.corners.normals[t][std::size_t(k)], expected), 0.0f, 1e-6f) << t << " " << k;
+        }
+        // The corner swap keeps the front counter-clockwise: the geometric normal faces +z.
+        EXPECT_GT(geometricNormal(s.triangles[t]).z, 0.0f) << t;
+    }
+    // The shading normal at a hit is the corners' interpolated, not the geometric (0, 0, 1).
+    const Hit h = hitAt(s, 0, (glm::dvec3(s.triangles[0].v0) + glm::dvec3(s.triangles[0].v1)) * 0.5);
+    EXPECT_GT(glm::length(glm::vec2(surfaceAt(s, h).normal)), 0.1f);
 }
 
 TEST(GltfFeatures, VertexColoursAreNormalizedBytesInterpolated) {
@@ -176,7 +240,7 @@ TEST(GltfFeatures, SparseAccessorsAndAccessorsWithoutABufferView) {
     EXPECT_EQ(s.triangles[0].v2, glm::vec3(2, 2, 0));  // vertex 2 replaced by the sparse part
     EXPECT_EQ(s.triangles[1].v1, glm::vec3(2, 2, 0));
     EXPECT_EQ(s.triangles[0].v0, glm::vec3(-1, -1, 0));
-    EXPECT_EQ(s.triangles[2].v0, glm::vec3(0, 0, 1));  // zeros, then every vertex from its sparse part
+    EXPECT_EQ(s.triangles[2].v0, glm::vec3(0, 0, 0));  // no view and no sparse value: zero
     EXPECT_EQ(s.triangles[2].v1, glm::vec3(1, 0, 1));
     EXPECT_EQ(s.triangles[2].v2, glm::vec3(0, 1, 1));
 }

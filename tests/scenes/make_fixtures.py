@@ -119,6 +119,18 @@ def add_texture(doc, embedded):
 glb("quad_texture_image.glb", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=lambda d: add_texture(d, True)))
 write("quad_texture_data_uri.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=lambda d: add_texture(d, False)))
 
+# The quad with a 2x1 texture, sRGB 128 grey then white, LINEAR, clamped: at u = 0.25 (x = -0.5)
+# the grey texel's centre, linear 0.2158605; at u = 0.5 (x = 0) halfway to white.
+def add_grey_texture(doc):
+    uv = add_accessor(doc, b"".join(struct.pack("<2f", *t) for t in quad_uv), 5126, 4, "VEC2")
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv
+    doc["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(png(2, 1, [128, 128, 128, 255, 255, 255])).decode()}]
+    doc["samplers"] = [{"magFilter": 9729, "minFilter": 9729, "wrapS": 33071, "wrapT": 33071}]
+    doc["textures"] = [{"source": 0, "sampler": 0}]
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = [1, 1, 1, 1]
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+write("quad_texture_grey.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=add_grey_texture))
+
 # The quad with COLOR_0 as normalized unsigned bytes (RGBA): corners red, green, blue, white.
 def add_colors(doc):
     rgba = [(255, 0, 0, 255), (0, 255, 0, 255), (0, 0, 255, 255), (255, 255, 255, 255)]
@@ -128,16 +140,16 @@ def add_colors(doc):
 write("quad_vertex_colors.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=add_colors))
 
 # Sparse accessors: the quad's POSITION with a sparse part moving vertex 2 from (1, 1, 0) to
-# (2, 2, 0), and a second triangle whose POSITION has no buffer view at all (zeros) with every
-# vertex given by its sparse part: (0, 0, 1), (1, 0, 1), (0, 1, 1).
+# (2, 2, 0), and a second triangle whose POSITION has no buffer view at all (zeros) with its
+# vertices 1 and 2 given by its sparse part: (0, 0, 0), (1, 0, 1), (0, 1, 1).
 def add_sparse(doc):
     doc["accessors"][0]["sparse"] = {"count": 1,
                                      "indices": {"bufferView": append_data(doc, struct.pack("<H", 2)), "componentType": 5123},
                                      "values": {"bufferView": append_data(doc, struct.pack("<3f", 2, 2, 0))}}
-    values = append_data(doc, b"".join(struct.pack("<3f", *p) for p in [(0, 0, 1), (1, 0, 1), (0, 1, 1)]))
-    doc["accessors"].append({"componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 1], "max": [1, 1, 1],
-                             "sparse": {"count": 3,
-                                        "indices": {"bufferView": append_data(doc, bytes([0, 1, 2])), "componentType": 5121},
+    values = append_data(doc, b"".join(struct.pack("<3f", *p) for p in [(1, 0, 1), (0, 1, 1)]))
+    doc["accessors"].append({"componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1],
+                             "sparse": {"count": 2,
+                                        "indices": {"bufferView": append_data(doc, bytes([1, 2])), "componentType": 5121},
                                         "values": {"bufferView": values}}})
     doc["meshes"][0]["primitives"].append({"attributes": {"POSITION": len(doc["accessors"]) - 1}, "material": 0})
 write("quad_sparse.gltf", gltf(quad, [0, 1, 2, 0, 2, 3], "B", extra=add_sparse))
