@@ -2,6 +2,7 @@
 // meshopt- and Draco-compressed twins encoded here by the reference encoders.
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <fstream>
 #include <tuple>
 
@@ -449,4 +450,88 @@ TEST(GltfFeatures, AnimationsAndSkinsAreNamedInOneWarning) {
     const Scene s = loadJson(doc, "skinned.gltf");
     ASSERT_EQ(s.warnings.size(), 1u);
     EXPECT_NE(s.warnings[0].find("1 skin(s) not applied; the meshes are traced at rest"), std::string::npos) << s.warnings[0];
+}
+
+TEST(GltfFeatures, MeshoptExponentialFilterIsUndone) {
+    // Positions stored through the EXPONENTIAL filter (8-bit exponent, 16-bit mantissas: lossy)
+    // and the vertex codec decode to what the filter's own decoder gives: the twin is built
+    // from those values.
+    const Mesh m = testMesh();
+    std::vector<std::uint32_t> filtered(m.positions.size() * 3);
+    meshopt_encodeFilterExp(filtered.data(), m.positions.size() * 3, 4, 16, &m.positions[0].x);
+    std::vector<std::uint32_t> expected = filtered;
+    meshopt_decodeFilterExp(expected.data(), expected.size(), 4);
+    Mesh twin = m;
+    std::memcpy(twin.positions.data(), expected.data(), expected.size() * 4);
+    const Scene plain = loadJson(plainDocument(twin), "plain.gltf");
+
+    std::vector<unsigned char> vertices(meshopt_encodeVertexBufferBound(m.positions.size(), 12));
+    vertices.resize(meshopt_encodeVertexBuffer(vertices.data(), vertices.size(), filtered.data(), m.positions.size(), 12));
+    std::vector<unsigned char> data = vertices;
+    while (data.size() % 4) data.push_back(0);
+    const std::size_t indexOffset = data.size();
+    const std::vector<unsigned char> idx = bytesOf(m.indices);
+    data.insert(data.end(), idx.begin(), idx.end());
+    nlohmann::json doc = plainDocument(m);
+    const std::size_t vertexBytes = m.positions.size() * 12;
+    doc["extensionsUsed"] = {"EXT_meshopt_compression"};
+    doc["buffers"] = {{{"byteLength", data.size()}, {"uri", dataUri(data)}},
+                      {{"byteLength", vertexBytes}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}}};
+    doc["bufferViews"] = {
+        {{"buffer", 1}, {"byteLength", vertexBytes}, {"byteStride", 12},
+         {"extensions", {{"EXT_meshopt_compression", {{"buffer", 0}, {"byteLength", vertices.size()}, {"byteStride", 12},
+                                                      {"count", m.positions.size()}, {"mode", "ATTRIBUTES"},
+                                                      {"filter", "EXPONENTIAL"}}}}}},
+        {{"buffer", 0}, {"byteOffset", indexOffset}, {"byteLength", idx.size()}}};
+    const Scene packed = loadJson(doc, "meshopt_exp.gltf");
+    ASSERT_EQ(packed.triangleCount(), plain.triangleCount());
+    for (std::size_t i = 0; i < plain.triangleCount(); ++i) ASSERT_EQ(packed.triangles[i].v2, plain.triangles[i].v2) << i;
+    EXPECT_NE(plain.triangles[0].v1, loadJson(plainDocument(m), "raw.gltf").triangles[0].v1) << "the filter should be lossy here";
+}
+
+TEST(GltfFeatures, DracoAttributesFollowTheirIds) {
+    // Two Draco attributes whose unique ids are not the glTF order: NORMAL (added first) and
+    // POSITION; each corner's decoded normal must be the one its position had.
+    const Mesh m = testMesh();
+    std::vector<glm::vec3> normals;
+    for (const glm::vec3& p : m.positions) normals.push_back(glm::normalize(p - glm::vec3(0.2f, -0.1f, 0.3f)));
+    draco::Mesh mesh;
+    mesh.set_num_points(std::uint32_t(m.positions.size()));
+    draco::GeometryAttribute normal, position;
+    normal.Init(draco::GeometryAttribute::NORMAL, nullptr, 3, draco::DT_FLOAT32, false, 12, 0);
+    position.Init(draco::GeometryAttribute::POSITION, nullptr, 3, draco::DT_FLOAT32, false, 12, 0);
+    const int normalId = mesh.AddAttribute(normal, true, std::uint32_t(m.positions.size()));
+    const int positionId = mesh.AddAttribute(position, true, std::uint32_t(m.positions.size()));
+    for (std::uint32_t i = 0; i < m.positions.size(); ++i) {
+        mesh.attribute(normalId)->SetAttributeValue(draco::AttributeValueIndex(i), &normals[i]);
+        mesh.attribute(positionId)->SetAttributeValue(draco::AttributeValueIndex(i), &m.positions[i]);
+    }
+    for (std::size_t t = 0; t < m.indices.size(); t += 3)
+        mesh.AddFace({draco::PointIndex(m.indices[t]), draco::PointIndex(m.indices[t + 1]), draco::PointIndex(m.indices[t + 2])});
+    draco::Encoder encoder;
+    encoder.SetEncodingMethod(draco::MESH_EDGEBREAKER_ENCODING);  // reorders points
+    draco::EncoderBuffer encoded;
+    ASSERT_TRUE(encoder.EncodeMeshToBuffer(mesh, &encoded).ok());
+    const std::vector<unsigned char> data(encoded.data(), encoded.data() + encoded.size());
+    nlohmann::json doc = plainDocument(m);
+    doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    doc["buffers"] = {{{"byteLength", data.size()}, {"uri", dataUri(data)}}};
+    doc["bufferViews"] = {{{"buffer", 0}, {"byteLength", data.size()}}};
+    doc["accessors"][0].erase("bufferView");
+    doc["accessors"][1].erase("bufferView");
+    doc["accessors"].push_back({{"componentType", 5126}, {"count", m.positions.size()}, {"type", "VEC3"}});
+    doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 2;
+    doc["meshes"][0]["primitives"][0]["extensions"] = {
+        {"KHR_draco_mesh_compression",
+         {{"bufferView", 0},
+          {"attributes", {{"POSITION", mesh.attribute(positionId)->unique_id()}, {"NORMAL", mesh.attribute(normalId)->unique_id()}}}}}};
+    const Scene s = loadJson(doc, "draco_normals.gltf");
+    ASSERT_EQ(s.triangleCount(), m.indices.size() / 3);
+    ASSERT_EQ(s.corners.normals.size(), s.triangleCount());
+    for (std::size_t t = 0; t < s.triangleCount(); ++t) {
+        const glm::vec3 v[3] = {s.triangles[t].v0, s.triangles[t].v1, s.triangles[t].v2};
+        for (int k = 0; k < 3; ++k)
+            ASSERT_NEAR(glm::distance(s.corners.normals[t][std::size_t(k)], glm::normalize(v[k] - glm::vec3(0.2f, -0.1f, 0.3f))), 0.0f, 1e-5f)
+                << t << " " << k;
+    }
 }
