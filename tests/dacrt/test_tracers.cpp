@@ -235,22 +235,6 @@ TEST(BackendsAgree, StanfordModelsAt640x480) {
     }
 }
 
-namespace {
-
-// An orthographic view of the shapes scene from `eye` towards the origin, 2 ymag high.
-Camera orthographicView(glm::dvec3 eye, double ymag) {
-    Camera c;
-    c.eye = eye;
-    c.forward = glm::normalize(-eye);
-    const glm::dvec3 right = glm::normalize(glm::cross(c.forward, glm::dvec3(0, 1, 0)));
-    c.up = glm::cross(right, c.forward);
-    c.projection = Projection::Orthographic;
-    c.ymag = ymag;
-    return c;
-}
-
-}  // namespace
-
 TEST(BackendsAgree, OrthographicCameras) {
     // Rays of many origins sharing one direction: each split's near child is the one the
     // direction's sign points away from, for every ray (FrameGeometry::nearSide).

@@ -206,14 +206,7 @@ TEST(GpuImages, OrthographicCameras) {
     // start, they are read per ray, and the near child comes from the direction's signs.
     DACRT_REQUIRE_GPU(context);
     for (const glm::dvec3 eye : {glm::dvec3(4.0, 3.0, 5.0), glm::dvec3(0.6, 0.35, 0.45)}) {  // outside; inside, oblique
-        Camera c;
-        c.eye = eye;
-        c.forward = glm::normalize(-eye);
-        const glm::dvec3 right = glm::normalize(glm::cross(c.forward, glm::dvec3(0, 1, 0)));
-        c.up = glm::cross(right, c.forward);
-        c.projection = Projection::Orthographic;
-        c.ymag = 1.8;
-        const Frame frame(shapes(), c, 64, 48);
+        const Frame frame(shapes(), orthographicView(eye, 1.8), 64, 48);
         ASSERT_FALSE(frame.geometry.raysShareStart);
         EXPECT_TRUE(identicalHits(frame.trace(Backend::Brute, 0, 2).hits, frame.trace(Backend::CpuSeq).hits));
         expectGpuMatchesCpu(*context, frame, {1, 2, 4, 8});

@@ -48,6 +48,18 @@ private:
     }
 };
 
+// An orthographic camera at `eye` looking at the origin, 2 ymag high, y up.
+inline Camera orthographicView(glm::dvec3 eye, double ymag) {
+    Camera c;
+    c.eye = eye;
+    c.forward = glm::normalize(-eye);
+    const glm::dvec3 right = glm::normalize(glm::cross(c.forward, glm::dvec3(0, 1, 0)));
+    c.up = glm::cross(right, c.forward);
+    c.projection = Projection::Orthographic;
+    c.ymag = ymag;
+    return c;
+}
+
 inline Camera defaultCamera(const Scene& scene, int w, int h, CameraOptions options = {}) {
     return makeCameras(scene, sceneBounds(scene.triangles), options, double(w) / double(h)).front();
 }
