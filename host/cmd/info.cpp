@@ -15,6 +15,12 @@ std::string vec(const glm::dvec3& v) {
     return s;
 }
 
+std::string number(double x) {
+    char s[32];
+    std::snprintf(s, sizeof s, "%.6g", x);
+    return s;
+}
+
 void section(const char* title, const std::vector<std::string>& lines) {
     std::cout << title << " (" << lines.size() << ")\n";
     for (const std::string& l : lines) std::cout << "  " << l << "\n";
@@ -52,7 +58,7 @@ int runInfo(const InfoOptions& options) {
     std::vector<std::string> lights;
     for (const Light& l : scene.lights)
         lights.push_back((l.name.empty() ? std::string("(unnamed)") : "'" + l.name + "'") + ": " + std::string(toString(l.type)) +
-                         ", intensity " + std::to_string(l.intensity) + ", colour " + vec(glm::dvec3(l.color)) +
+                         ", intensity " + number(l.intensity) + ", colour " + vec(glm::dvec3(l.color)) +
                          (l.type == LightType::Directional ? "" : ", at " + vec(l.position)) +
                          (l.type == LightType::Point ? "" : ", towards " + vec(l.direction)));
     section("lights placed by the scene (KHR_lights_punctual)", lights);
