@@ -23,6 +23,30 @@ std::uint64_t AccessorReader::mul(std::uint64_t a, std::uint64_t b, const std::s
     return r;
 }
 
+std::int64_t integerMember(const tinygltf::Value& object, const char* key, std::int64_t fallback) {
+    if (!object.Has(key)) return fallback;
+    const tinygltf::Value& v = object.Get(key);
+    if (!v.IsNumber()) return -1;
+    const double d = v.GetNumberAsDouble();
+    return d >= 0.0 && d <= 9.0e15 && d == double(std::int64_t(d)) ? std::int64_t(d) : -1;
+}
+
+std::string stringMember(const tinygltf::Value& object, const char* key, const char* fallback) {
+    if (!object.Has(key)) return fallback;
+    const tinygltf::Value& v = object.Get(key);
+    return v.IsString() ? v.Get<std::string>() : std::string("(not a string)");
+}
+
+double numberMember(const tinygltf::Value& object, const char* key, std::size_t index, double fallback) {
+    if (!object.Has(key)) return fallback;
+    const tinygltf::Value& v = object.Get(key);
+    if (v.IsArray()) {
+        if (index >= v.ArrayLen() || !v.Get(int(index)).IsNumber()) return fallback;
+        return v.Get(int(index)).GetNumberAsDouble();
+    }
+    return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
+}
+
 double readComponent(const unsigned char* p, int componentType, bool normalized) {
     switch (componentType) {
         case TINYGLTF_COMPONENT_TYPE_FLOAT: { float x; std::memcpy(&x, p, 4); return x; }

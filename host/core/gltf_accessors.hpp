@@ -77,6 +77,14 @@ private:
     std::uint64_t byteLimit_ = 0;
 };
 
+// Members of extension objects, which tinygltf leaves as generic JSON values:
+// a non-negative integer (fallback when absent; -1 when present but not one),
+std::int64_t integerMember(const tinygltf::Value& object, const char* key, std::int64_t fallback);
+// a string (fallback when absent; "(not a string)" when present but not one),
+std::string stringMember(const tinygltf::Value& object, const char* key, const char* fallback);
+// a number, or element `index` of an array of numbers (fallback when absent or not one).
+double numberMember(const tinygltf::Value& object, const char* key, std::size_t index, double fallback);
+
 // One component of type `componentType` at p, as glTF reads it (normalized or not).
 double readComponent(const unsigned char* p, int componentType, bool normalized);
 

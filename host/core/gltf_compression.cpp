@@ -15,21 +15,6 @@ const tinygltf::Value* extension(const tinygltf::ExtensionMap& extensions, std::
     return nullptr;
 }
 
-// A non-negative integer member, or fallback when absent; -1 when present but not one.
-std::int64_t integerMember(const tinygltf::Value& object, const char* key, std::int64_t fallback) {
-    if (!object.Has(key)) return fallback;
-    const tinygltf::Value& v = object.Get(key);
-    if (!v.IsNumber()) return -1;
-    const double d = v.GetNumberAsDouble();
-    return d >= 0.0 && d <= 9.0e15 && d == double(std::int64_t(d)) ? std::int64_t(d) : -1;
-}
-
-std::string stringMember(const tinygltf::Value& object, const char* key, const char* fallback) {
-    if (!object.Has(key)) return fallback;
-    const tinygltf::Value& v = object.Get(key);
-    return v.IsString() ? v.Get<std::string>() : std::string("(not a string)");
-}
-
 std::vector<unsigned char> decodeMeshoptView(const AccessorReader& reader, int viewIndex, const tinygltf::Value& ext,
                                              std::uint64_t& budget) {
     const std::string where = "buffer view " + std::to_string(viewIndex) + " (EXT_meshopt_compression)";

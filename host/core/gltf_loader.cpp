@@ -9,6 +9,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string_view>
 
 #include <tiny_gltf.h>
@@ -37,7 +38,13 @@ constexpr std::uint64_t kBytesPerTriangle =
 // Primitive ids are 32-bit and kMissPrim is reserved.
 constexpr std::uint64_t kMaxTriangles = std::numeric_limits<std::uint32_t>::max() - 1;
 
-std::string str(std::uint64_t v) { return std::to_string(v); }
+using gltf::str;
+
+// A scene or camera chosen by number: the choice as an index when it is all digits (and small).
+std::optional<int> indexChoice(const std::string& choice) {
+    if (choice.empty() || choice.size() >= 10 || choice.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+    return std::stoi(choice);
+}
 
 // ---- before parsing ---------------------------------------------------------------------
 
@@ -250,10 +257,7 @@ public:
         }
         for (std::size_t i = 0; i < model_.scenes.size(); ++i)
             if (model_.scenes[i].name == choice) return int(i);
-        if (choice.find_first_not_of("0123456789") == std::string::npos && choice.size() < 10) {
-            const int index = std::stoi(choice);
-            if (index < int(model_.scenes.size())) return index;
-        }
+        if (const std::optional<int> index = indexChoice(choice); index && *index < int(model_.scenes.size())) return *index;
         std::vector<std::string> names;
         for (std::size_t i = 0; i < model_.scenes.size(); ++i) names.push_back(str(i) + (model_.scenes[i].name.empty() ? "" : " '" + model_.scenes[i].name + "'"));
         fail("no scene is called or numbered '" + choice + "' (the file has " + joined(names) + ")");
@@ -782,14 +786,12 @@ void selectCamera(Scene& scene, const std::string& choice) {
             scene.camera = c;
             return;
         }
-    if (choice.find_first_not_of("0123456789") == std::string::npos && choice.size() < 10) {
-        const int index = std::stoi(choice);
+    if (const std::optional<int> index = indexChoice(choice))
         for (const SceneCamera& c : scene.cameras)
-            if (c.cameraIndex == index) {
+            if (c.cameraIndex == *index) {
                 scene.camera = c;
                 return;
             }
-    }
     throw InputError(scene.name + ": no camera is called or numbered '" + choice + "' (" + describe() + ")");
 }
 

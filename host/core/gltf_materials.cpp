@@ -97,20 +97,10 @@ TextureWrap wrapOf(int mode) {
     return TextureWrap::Repeat;
 }
 
-double number(const tinygltf::Value& object, const char* key, std::size_t index, double fallback) {
-    if (!object.Has(key)) return fallback;
-    const tinygltf::Value& v = object.Get(key);
-    if (v.IsArray()) {
-        if (index >= v.ArrayLen() || !v.Get(int(index)).IsNumber()) return fallback;
-        return v.Get(int(index)).GetNumberAsDouble();
-    }
-    return v.IsNumber() ? v.GetNumberAsDouble() : fallback;
-}
-
-// An index held as a JSON number: -1 unless it is an integer in [0, 2^31).
+// An index held as a JSON number: fallback when absent, -1 unless an integer in [0, 2^31).
 int indexOf(const tinygltf::Value& object, const char* key, int fallback) {
-    const double d = number(object, key, 0, double(fallback));
-    return d >= 0.0 && d < 2147483648.0 && d == std::floor(d) ? int(d) : -1;
+    const std::int64_t i = integerMember(object, key, fallback);
+    return i < 2147483648ll ? int(i) : -1;
 }
 
 // A textureInfo object held in an extension's JSON (tinygltf parses only the core ones).
@@ -145,8 +135,8 @@ private:
         // among them): its diffuse colour is what the preview shows as the base colour.
         if (auto sg = m.extensions.find("KHR_materials_pbrSpecularGlossiness"); sg != m.extensions.end() && sg->second.IsObject()) {
             const tinygltf::Value& x = sg->second;
-            mat.baseColor = glm::vec4(float(number(x, "diffuseFactor", 0, 1.0)), float(number(x, "diffuseFactor", 1, 1.0)),
-                                      float(number(x, "diffuseFactor", 2, 1.0)), float(number(x, "diffuseFactor", 3, 1.0)));
+            mat.baseColor = glm::vec4(float(numberMember(x, "diffuseFactor", 0, 1.0)), float(numberMember(x, "diffuseFactor", 1, 1.0)),
+                                      float(numberMember(x, "diffuseFactor", 2, 1.0)), float(numberMember(x, "diffuseFactor", 3, 1.0)));
             info = tinygltf::TextureInfo{};
             if (x.Has("diffuseTexture") && x.Get("diffuseTexture").IsObject()) info = textureInfoOf(x.Get("diffuseTexture"));
         }
@@ -164,13 +154,13 @@ private:
         b.texCoord = std::uint32_t(std::max(info.texCoord, 0));
         if (auto t = info.extensions.find("KHR_texture_transform"); t != info.extensions.end() && t->second.IsObject()) {
             const tinygltf::Value& x = t->second;
-            const double ox = number(x, "offset", 0, 0.0), oy = number(x, "offset", 1, 0.0);
-            const double sx = number(x, "scale", 0, 1.0), sy = number(x, "scale", 1, 1.0), r = number(x, "rotation", 0, 0.0);
+            const double ox = numberMember(x, "offset", 0, 0.0), oy = numberMember(x, "offset", 1, 0.0);
+            const double sx = numberMember(x, "scale", 0, 1.0), sy = numberMember(x, "scale", 1, 1.0), r = numberMember(x, "rotation", 0, 0.0);
             if (!std::isfinite(ox + oy + sx + sy + r)) reader_.fail(where + ": KHR_texture_transform has a non-finite number");
             const double c = std::cos(r), s = std::sin(r);
             // uv' = T R S uv (the extension's order), as columns.
             b.transform = glm::mat3(glm::dmat3(sx * c, -sx * s, 0.0, sy * s, sy * c, 0.0, ox, oy, 1.0));
-            const double texCoord = number(x, "texCoord", 0, -1.0);
+            const double texCoord = numberMember(x, "texCoord", 0, -1.0);
             if (texCoord >= 0.0 && texCoord < 256.0) b.texCoord = std::uint32_t(texCoord);
         }
         if (tex.sampler >= 0) {
