@@ -4,15 +4,16 @@
 #ifndef DACRT_LAYOUT_H
 #define DACRT_LAYOUT_H
 
-// A primary ray. Everything a backend needs is computed once on the host in float32,
-// so that every backend starts from bit-identical inputs (no division on the device).
+// A ray. Primary rays are made on the host (makeRay); secondary rays on the host or the
+// device by shaders/secondary_rays.glsl, whose division and square root are correctly rounded
+// in integer arithmetic: every backend starts from bit-identical inputs.
 struct Ray {
     vec3 origin;
     float tmin;     // hits must have t > tmin
-    vec3 dir;
+    vec3 dir;       // of any length: t is in units of it
     uint axes;      // watertight test permutation: kx | ky << 2 | kz << 4
     vec3 invDir;    // 1/dir per component, 0 where dir is 0 (the box test branches on dir == 0)
-    float pad0;
+    float tmax;     // hits must have t <= tmax: kNoHitT for a whole ray, the segment's end otherwise
     vec3 shear;     // watertight test: (dir[kx]/dir[kz], dir[ky]/dir[kz], 1/dir[kz])
     float pad1;
 };
@@ -37,7 +38,11 @@ struct Bounds {
 const uint kMissPrim = 0xFFFFFFFFu;
 const float kNoHitT = 3.402823466e+38;          // FLT_MAX: finite, so no inf arithmetic anywhere
 
-// Per-ray result. prim == kMissPrim means no hit; t is then kNoHitT.
+// Per-ray result. prim == kMissPrim means no hit; t is then the ray's tmax (kNoHitT for a
+// whole ray): every backend starts each ray's best hit there (missHit), so a segment's end
+// bounds its filters like a hit. Secondary passes mark the slots of rays they did not make
+// (a surface facing away from the light, say) with kNotTracedPrim.
+const uint kNotTracedPrim = 0xFFFFFFFEu;
 struct Hit {
     float t;
     uint prim;
@@ -56,10 +61,12 @@ struct Region {
     uint terminated;     // rays [rayBegin, terminated) have their final hit
     uint rayItemsDone;   // gpu: finished work items that traced this region's rays
     uint triItemsDone;   // gpu: finished work items that used this region's triangles
-    uint pad0;
-    uint pad1;
+    uint directions;     // gpu: kTowardLow | kTowardHigh where some ray of the region moves that way
+    uint cursor;         // gpu: the next free ray id slot while secondary rays are binned
     uint pad2;
 };
+const uint kTowardLow = 1u;
+const uint kTowardHigh = 2u;
 
 // One work item of a dispatch: the live rays of one region against the triangles of another
 // (the same region in Step 1). retire: 0 = rays that do not move along the division axis,
@@ -95,7 +102,7 @@ struct TraversalState {
     uint pad1;
 };
 
-struct StackEntry {   // a far child waiting, with its parent's ranges
+struct StackEntry {   // a child waiting, with its parent's ranges
     vec3 lo;
     uint rayEnd;
     vec3 hi;
@@ -103,12 +110,16 @@ struct StackEntry {   // a far child waiting, with its parent's ranges
     uint triEnd;
     uint depth;
     uint stalls;      // the parent's stalled splits
-    uint pad0;
+    uint rayRule;     // which of the parent's live rays visit it (kKeepCrossing*)
 };
+
+// Which child of a split each ray meets first (FrameGeometry::order).
+const uint kOrderNearSide = 0u;   // the child on rayOrigin's side, for every ray
+const uint kOrderPerRay = 1u;     // per split, by the sign of each ray's direction
 
 // Push constants of the DACRT kernel.
 struct DacrtPush {
-    vec3 rayOrigin;        // the rays' near side (FrameGeometry::nearSide), their origin when they share it: the near child is the one on its side
+    vec3 rayOrigin;        // FrameGeometry::nearSide (kOrderNearSide): the shared origin when there is one
     float margin;          // filter widening (filterMargin)
     uint firstWorkItem;    // this dispatch's work items are [firstWorkItem, + group count)
     uint axis;             // division axis
@@ -116,8 +127,44 @@ struct DacrtPush {
     uint triScratchHalf;   // triangle id count: likewise in the triangle id buffer
     uint loopProbe;        // 2; a loop of this many iterations at the end detects a loop limiter
     float rayTmin;         // every ray's tmin, where DACRT_SPEC_SHARED_START says they share it
-    uint pad1;
+    uint order;            // kOrder*
     uint pad2;
+};
+
+// A light as a secondary pass traces it (from Scene::lights or --light), in float32.
+const uint kLightPoint = 0u;
+const uint kLightSpot = 1u;
+const uint kLightDirectional = 2u;
+struct ShadowLight {
+    vec3 position;         // point, spot
+    uint type;             // kLight*
+    vec3 direction;        // spot, directional: where the light travels, unit
+    float range;           // 0: unlimited
+    float cosOuterSquared; // spot: cos^2 of the outer cone angle (at most pi/2)
+    float pad0;
+    float pad1;
+    float pad2;
+};
+
+// What a secondary pass makes from each primary hit.
+const uint kPassShadow = 0u;      // one ray towards the light
+const uint kPassOcclusion = 1u;   // raysPerHit cosine-distributed rays of length occlusionDistance
+
+// Push constants of shaders/secondary.comp: ray generation and binning of one secondary pass.
+struct SecondaryPush {
+    ShadowLight light;
+    uint kind;             // kPass*
+    uint step;             // 0: make rays and count them per region, 1: region ranges, 2: ray ids
+    uint sourceCount;      // primary rays (pixels)
+    uint raysPerHit;       // rays per primary hit: slot s * raysPerHit + k
+    float occlusionDistance;
+    uint sampleSeed;       // kPassOcclusion: the sample sequence (a frame's)
+    uint regionCount;      // slabs along axis
+    uint groups;           // ray groups: region k's group g is slot k * groups + g
+    uint axis;
+    float margin;          // filterMargin of the frame
+    uint pad0;
+    uint pad1;
 };
 
 // Counters the kernel adds to with atomics (32-bit: a frame stays far below 2^32 tests).
@@ -166,7 +213,9 @@ struct WorkgroupTestPush {
 #define DACRT_BINDING_COUNTERS 8
 #define DACRT_BINDING_STATES 9
 #define DACRT_BINDING_STACKS 10
-#define DACRT_BINDING_COUNT 11
+#define DACRT_BINDING_SOURCE_RAYS 11   // secondary passes: the primary rays, read by shaders/secondary.comp
+#define DACRT_BINDING_SOURCE_HITS 12   // secondary passes: the primary hits
+#define DACRT_BINDING_COUNT 13
 
 // A split whose child keeps every ray and every triangle of its parent made no progress;
 // after this many such splits in a row the node is a leaf. Identical rays meeting coincident
@@ -181,6 +230,7 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_MAX_DEPTH 3
 #define DACRT_SPEC_LOOP_BUDGET 4
 #define DACRT_SPEC_SHARED_START 5   // 1: every ray has origin rayOrigin and tmin rayTmin (DacrtPush)
+#define DACRT_SPEC_ANY_HIT 6        // 1: a ray ends at its first hit in its segment (shadow, occlusion)
 
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 32);
@@ -190,9 +240,16 @@ static_assert(sizeof(TraversalState) == 64 && offsetof(TraversalState, phase) ==
 static_assert(offsetof(TraversalState, stalls) == 48 && offsetof(TraversalState, leafNext) == 52);
 static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalState, stackSize) == 44);
 static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depth) == 36);
-static_assert(offsetof(StackEntry, stalls) == 40);
+static_assert(offsetof(StackEntry, stalls) == 40 && offsetof(StackEntry, rayRule) == 44);
 static_assert(sizeof(DacrtPush) == 48 && offsetof(DacrtPush, loopProbe) == 32);
-static_assert(offsetof(DacrtPush, rayTmin) == 36);
+static_assert(offsetof(DacrtPush, rayTmin) == 36 && offsetof(DacrtPush, order) == 40);
+static_assert(sizeof(ShadowLight) == 48 && offsetof(ShadowLight, type) == 12);
+static_assert(offsetof(ShadowLight, direction) == 16 && offsetof(ShadowLight, range) == 28);
+static_assert(offsetof(ShadowLight, cosOuterSquared) == 32);
+static_assert(sizeof(SecondaryPush) == 96 && offsetof(SecondaryPush, kind) == 48);
+static_assert(offsetof(SecondaryPush, sourceCount) == 56 && offsetof(SecondaryPush, occlusionDistance) == 64);
+static_assert(offsetof(SecondaryPush, sampleSeed) == 68 && offsetof(SecondaryPush, groups) == 76);
+static_assert(offsetof(SecondaryPush, axis) == 80 && offsetof(SecondaryPush, margin) == 84);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
@@ -207,7 +264,7 @@ static_assert(offsetof(WorkgroupTestPush, loopProbe) == 60);
 static_assert(sizeof(Ray) == 64);
 static_assert(offsetof(Ray, origin) == 0 && offsetof(Ray, tmin) == 12);
 static_assert(offsetof(Ray, dir) == 16 && offsetof(Ray, axes) == 28);
-static_assert(offsetof(Ray, invDir) == 32 && offsetof(Ray, shear) == 48);
+static_assert(offsetof(Ray, invDir) == 32 && offsetof(Ray, tmax) == 44 && offsetof(Ray, shear) == 48);
 static_assert(sizeof(Triangle) == 48);
 static_assert(offsetof(Triangle, cullBackFace) == 12);
 static_assert(offsetof(Triangle, v0) == 0 && offsetof(Triangle, v1) == 16 && offsetof(Triangle, v2) == 32);
@@ -220,6 +277,7 @@ static_assert(offsetof(Region, lo) == 0 && offsetof(Region, rayBegin) == 12);
 static_assert(offsetof(Region, hi) == 16 && offsetof(Region, rayEnd) == 28);
 static_assert(offsetof(Region, triBegin) == 32 && offsetof(Region, triEnd) == 36);
 static_assert(offsetof(Region, terminated) == 40);
+static_assert(offsetof(Region, directions) == 52 && offsetof(Region, cursor) == 56);
 #endif
 
 #endif

@@ -117,7 +117,8 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
         r.threads = threadPool.size();
         r.memory.add("hits", std::uint64_t(geometry.rays->size()) * sizeof(Hit));
         if (!planWithSkips || planWithSkips(r.memory)) {
-            r.hits.assign(geometry.rays->size(), missHit());
+            r.hits.reserve(geometry.rays->size());
+            for (const Ray& ray : *geometry.rays) r.hits.push_back(missHit(ray));
             r.counters.raysCulled = geometry.rays->size();
         }
         return withSkipLines(std::move(r));

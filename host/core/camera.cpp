@@ -116,6 +116,7 @@ Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
     Ray r{};
     r.origin = origin;
     r.tmin = tmin;
+    r.tmax = kNoHitT;
     r.dir = d;
     for (int a = 0; a < 3; ++a) r.invDir[a] = d[a] == 0.0f ? 0.0f : 1.0f / d[a];
     int kz = 0;

@@ -25,5 +25,6 @@ using shared::TraversalState;
 using shared::Region;
 using shared::Triangle;
 using shared::kMissPrim;
+using shared::kNotTracedPrim;
 using shared::kNoHitT;
 }  // namespace dacrt

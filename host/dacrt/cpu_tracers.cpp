@@ -19,6 +19,12 @@ void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
     plan.add("triangle bounds", std::uint64_t(g.triangles->size()) * sizeof(Bounds));
 }
 
+// Every ray's best hit starts at its segment's end (missHit).
+void startHits(const FrameGeometry& g, std::vector<Hit>& hits) {
+    hits.resize(g.rays->size());
+    for (std::size_t i = 0; i < hits.size(); ++i) hits[i] = missHit((*g.rays)[i]);
+}
+
 Box regionBox(const Region& r) {
     Box b;
     b.lo = r.lo;
@@ -35,16 +41,18 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
     const std::vector<Ray>& rays = *g.rays;
     const std::vector<Triangle>& tris = *g.triangles;
     const std::size_t traced = g.tracedTriangleCount();
-    result.hits.assign(rays.size(), missHit());
+    result.hits.resize(rays.size());
+    const bool anyHit = g.query == HitQuery::Any;
     const std::size_t blocks = (rays.size() + 63) / 64;
     std::atomic<std::size_t> blocksDone{0};
     pool.parallelFor(blocks, [&](std::size_t block, unsigned) {
         const std::size_t end = std::min(rays.size(), (block + 1) * 64);
         for (std::size_t i = block * 64; i < end; ++i) {
-            Hit best = missHit();
+            Hit best = missHit(rays[i]);
             for (std::size_t k = 0; k < traced; ++k) {
                 const std::uint32_t p = g.tracedTriangle(k);
                 testTriangle(rays[i], tris[p], p, best);
+                if (anyHit && best.prim != kMissPrim) break;
             }
             result.hits[i] = best;
         }
@@ -56,7 +64,6 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
 }
 
 TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options, const PlanHook& onPlan) {
-    requireNearSide(g, "cpu-seq");
     TraceResult result;
     const std::uint32_t rayCount = std::uint32_t(g.rays->size());
     const std::uint32_t triCount = std::uint32_t(g.tracedTriangleCount());
@@ -69,7 +76,7 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     planPacketBuffers(g, resolved, scratchIds, 1, result.memory);
     if (onPlan && !onPlan(result.memory)) return result;
 
-    result.hits.assign(rayCount, missHit());
+    startHits(g, result.hits);
     std::vector<std::uint32_t> rayIds(rayCount), triIds(triCount);
     std::iota(rayIds.begin(), rayIds.end(), 0u);
     for (std::uint32_t i = 0; i < triCount; ++i) triIds[i] = g.tracedTriangle(i);
@@ -88,7 +95,6 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
 
 TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool,
                           const PlanHook& onPlan) {
-    requireNearSide(g, "cpu");
     TraceResult result;
     result.threads = pool.size();
     const unsigned regions = options.regions ? options.regions : pool.size();
@@ -108,7 +114,7 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     };
     Division division = divideScene(g, regions, axis, pool, result.memory, onPlan, planWorkers);
     if (!division.complete) return result;
-    result.hits.assign(g.rays->size(), missHit());
+    startHits(g, result.hits);
     const std::vector<TransferRound> schedule = transferSchedule(division);
     result.phaseMs.emplace_back("divide", msSince(start));
     result.counters.raysCulled = division.culledRays;

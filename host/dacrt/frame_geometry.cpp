@@ -17,14 +17,6 @@ float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin) {
     return std::max(m * 0x1p-18f, 0x1p-100f);
 }
 
-void requireNearSide(const FrameGeometry& g, const char* tracer) {
-    if (!g.nearSideKnown)
-        throw InputError(std::string(tracer) +
-                         ": these rays start at different points and travel both ways along an axis; the DACRT tracers "
-                         "take rays that share an origin (pinhole cameras) or whose directions agree in sign per axis "
-                         "(orthographic cameras); use brute or embree for others");
-}
-
 bool raysShareStart(const std::vector<Ray>& rays) {
     return std::all_of(rays.begin(), rays.end(), [&](const Ray& r) {
         return std::memcmp(&r.origin, &rays.front().origin, sizeof(r.origin)) == 0 &&
@@ -39,12 +31,11 @@ FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::v
     g.triangleBounds = &bounds;
     g.rays = &rays;
     g.sceneBox = sceneBox;
-    g.rayOrigin = rays.front().origin;
-    g.raysShareStart = raysShareStart(rays);
+    g.rayOrigin = rays.empty() ? glm::vec3(0.0f) : rays.front().origin;
+    g.raysShareStart = !rays.empty() && raysShareStart(rays);
     if (g.raysShareStart) {
         g.farthestOrigin = glm::abs(g.rayOrigin);
         g.nearSide = g.rayOrigin;
-        g.nearSideKnown = true;
     } else {
         bool towardLow[3] = {false, false, false}, towardHigh[3] = {false, false, false};
         for (const Ray& r : rays)
@@ -53,11 +44,11 @@ FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::v
                 towardLow[a] |= r.dir[a] < 0.0f;
                 towardHigh[a] |= r.dir[a] > 0.0f;
             }
-        g.nearSideKnown = true;
         for (int a = 0; a < 3; ++a) {
             g.nearSide[a] = towardLow[a] ? std::numeric_limits<float>::max() : -std::numeric_limits<float>::max();
-            g.nearSideKnown &= !(towardLow[a] && towardHigh[a]);
+            if (towardLow[a] && towardHigh[a]) g.order = ChildOrder::PerRay;
         }
+        if (g.order == ChildOrder::PerRay) g.nearSide = glm::vec3(0.0f);
     }
     g.margin = filterMargin(sceneBox, g.farthestOrigin);
     g.imageWidth = imageWidth && rays.size() % imageWidth == 0 ? imageWidth : 0;

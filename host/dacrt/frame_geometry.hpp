@@ -11,6 +11,24 @@
 
 namespace dacrt {
 
+// Which child of a split each ray meets first: what lets a hit inside the first child end the
+// ray (docs/correctness.md, "Front to back").
+enum class ChildOrder {
+    // The child on nearSide's side, for every ray: rays that share an origin (nearSide), or
+    // whose direction signs agree per axis (nearSide at -FLT_MAX or +FLT_MAX per axis).
+    NearSide,
+    // Rays of many origins travelling both ways: each split classifies its live rays by the
+    // sign of their direction along its axis, and the low child is visited by the rays moving
+    // up, then the high child by all, then the low child again by the rays moving down. For
+    // any hit, where the order changes no result, every ray visits the low child, then the high.
+    PerRay,
+};
+
+// What a tracer returns for each ray: the closest hit (primary rays), or any hit in the ray's
+// segment (shadow and occlusion rays: the visibility bit is exact, the hit itself may be any
+// of those in the segment).
+enum class HitQuery { Closest, Any };
+
 struct FrameGeometry {
     const std::vector<Triangle>* triangles = nullptr;
     const std::vector<Bounds>* triangleBounds = nullptr;
@@ -19,13 +37,11 @@ struct FrameGeometry {
     glm::vec3 rayOrigin{};  // the first ray's origin: every ray's when raysShareStart
     // Per axis, the largest |origin| over the rays (the filter margin's input).
     glm::vec3 farthestOrigin{};
-    // A point on the side every ray comes from, per axis: the shared origin, or -FLT_MAX
-    // (+FLT_MAX) on an axis along which no ray travels towards - (+). The child of a split on
-    // this point's side is the one every crossing ray meets first (nearSideKnown), which is
-    // what lets a hit inside the first child end the ray. Rays of many origins travelling
-    // both ways along an axis have no such point.
+    // ChildOrder::NearSide: a point on the side every ray comes from, per axis: the shared
+    // origin, or -FLT_MAX (+FLT_MAX) on an axis along which no ray travels towards - (+).
     glm::vec3 nearSide{};
-    bool nearSideKnown = false;
+    ChildOrder order = ChildOrder::NearSide;
+    HitQuery query = HitQuery::Closest;
     float margin = 0.0f;    // filter widening, see filterMargin()
     bool raysShareStart = false;  // see raysShareStart()
     std::uint32_t imageWidth = 0;  // rays are an image's pixels, row by row, this many a row (0: unknown)
@@ -54,12 +70,9 @@ bool raysShareStart(const std::vector<Ray>& rays);
 // the largest |origin|).
 float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin);
 
-// Throws InputError naming `tracer` when the rays have no near side (nearSideKnown): the DACRT
-// tracers need one until rays are classified by direction per ray.
-void requireNearSide(const FrameGeometry& g, const char* tracer);
-
 // The frame every tracer reads: the arrays (which must outlive it), the scene box, the rays'
-// origins and near side, and the filter margin derived from them.
+// origins and child order (NearSide where one exists, else PerRay), and the filter margin
+// derived from them.
 // imageWidth: the rays' row length when they are an image's pixels (packets group them in
 // tiles), else 0.
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,

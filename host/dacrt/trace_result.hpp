@@ -61,7 +61,9 @@ struct TraceResult {
     std::optional<GpuReport> gpu;
 };
 
-// A hit record meaning "nothing yet".
+// A hit record meaning "nothing yet" on a whole ray...
 inline Hit missHit() { return Hit{kNoHitT, kMissPrim, 0.0f, 0.0f}; }
+// ... and on this ray: its segment's end bounds every later test like a hit would.
+inline Hit missHit(const Ray& ray) { return Hit{ray.tmax, kMissPrim, 0.0f, 0.0f}; }
 
 }  // namespace dacrt

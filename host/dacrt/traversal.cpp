@@ -91,7 +91,9 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
     : rays_(g.rays->data()),
       triangles_(g.triangles->data()),
       triangleBounds_(g.triangleBounds->data()),
-      nearSide_(g.nearSide),
+      order_(g.order),
+      orderPoint_(g.nearSide),
+      anyHit_(g.query == HitQuery::Any),
       margin_(g.margin),
       options_(options.resolvedFor(Backend::Cpu)),
       hits_(buffers.hits),
@@ -141,6 +143,15 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
     return std::uint32_t(first - rayIds_);
 }
 
+std::uint32_t DacrtTraversal::filterRaysMoving(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
+                                               int moving) {
+    if (moving == 0) return filterRays(cell, begin, end);
+    std::uint32_t* moved = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
+        return (rays_[id].dir[axis] < 0.0f) == (moving < 0);
+    });
+    return filterRays(cell, begin, std::uint32_t(moved - rayIds_));
+}
+
 std::uint32_t DacrtTraversal::filterTriangles(const Box& child, const Box& cell, std::uint32_t begin,
                                               std::uint32_t end, int axis, bool lowChild) {
     std::uint32_t* first = triIds_ + begin;
@@ -187,11 +198,14 @@ float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triB
 }
 
 // The split both recursions share (node over rays, nodePackets over packets): the longest
-// axis at the split position, then the two children front to back (the child on the rays'
-// near side is crossed first by every ray that crosses both), each with its items and triangles
-// filtered from the node's. itemBegin is read again for the second child: a ray recursion
-// moves the rays the first child finished before it. False (nothing done) where the node
-// must end here instead: fewItems, too few triangles, too deep, stalled, or no split inside.
+// axis at the split position, then the children front to back, each with its items and
+// triangles filtered from the node's. With a common order (ChildOrder::NearSide) or
+// for any hit (where order changes no result) every item visits the near child, then the far
+// one; with ChildOrder::PerRay the rays moving up visit the low child, then all rays the high
+// one, then the rays moving down the low one, so that each ray meets its children in the
+// order it crosses them. itemBegin is read again for each visit: a ray recursion moves the
+// rays an earlier visit finished before it. False (nothing done) where the node must end here
+// instead: fewItems, too few triangles, too deep, stalled, or no split inside.
 template <typename FilterItems, typename Descend>
 bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, std::uint32_t itemEnd,
                                std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
@@ -204,14 +218,25 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     Box low = box, high = box;
     low.hi[axis] = split;
     high.lo[axis] = split;
-    const bool lowFirst = nearSide_[axis] <= split;
-    for (const Box* child : {lowFirst ? &low : &high, lowFirst ? &high : &low}) {
-        const Box cell = widen(*child, margin_);
-        const std::uint32_t childItems = filterItems(cell, itemBegin, itemEnd);
+    struct Visit {
+        const Box* child;
+        int moving;  // the rays that visit it: +1 moving up (or not at all along axis), -1 down, 0 all
+    };
+    const bool lowFirst = order_ == ChildOrder::PerRay || orderPoint_[axis] <= split;
+    Visit visits[3] = {{lowFirst ? &low : &high, 0}, {lowFirst ? &high : &low, 0}, {nullptr, 0}};
+    if (order_ == ChildOrder::PerRay) {
+        visits[0] = {&low, anyHit_ ? 0 : 1};
+        visits[1] = {&high, 0};
+        visits[2] = {anyHit_ ? nullptr : &low, -1};
+    }
+    for (const Visit& visit : visits) {
+        if (!visit.child) break;
+        const Box cell = widen(*visit.child, margin_);
+        const std::uint32_t childItems = filterItems(cell, itemBegin, itemEnd, axis, visit.moving);
         if (childItems == itemBegin) continue;
-        const std::uint32_t childTris = filterTriangles(*child, cell, triBegin, triEnd, axis, child == &low);
+        const std::uint32_t childTris = filterTriangles(*visit.child, cell, triBegin, triEnd, axis, visit.child == &low);
         const bool stalled = childItems == itemEnd && childTris == triEnd;
-        descend(*child, childItems, childTris, depth + 1, stalled ? stalls + 1 : 0);
+        descend(*visit.child, childItems, childTris, depth + 1, stalled ? stalls + 1 : 0);
     }
     return true;
 }
@@ -221,7 +246,9 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
     if (terminated >= rayEnd || triBegin >= triEnd) return;
     const bool split = splitNode(
         box, terminated, rayEnd, triBegin, triEnd, depth, stalls, rayEnd - terminated < options_.rayLimit,
-        [&](const Box& cell, std::uint32_t begin, std::uint32_t end) { return filterRays(cell, begin, end); },
+        [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving) {
+            return filterRaysMoving(cell, begin, end, axis, moving);
+        },
         [&](const Box& child, std::uint32_t childRays, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
             node(child, terminated, childRays, triBegin, childTris, d, s);
         });
@@ -302,7 +329,7 @@ void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std:
     if (packetBegin >= packetEnd || triBegin >= triEnd) return;
     const bool split = splitNode(
         box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls, packetEnd - packetBegin < options_.packetFlush,
-        [&](const Box& cell, std::uint32_t begin, std::uint32_t end) { return filterPackets(cell, begin, end); },
+        [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int) { return filterPackets(cell, begin, end); },
         [&](const Box& child, std::uint32_t childPackets, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
             nodePackets(child, packetBegin, childPackets, triBegin, childTris, d, s);
         });
@@ -376,7 +403,8 @@ void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::ui
 void DacrtTraversal::endRaysHitInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd) {
     for (std::uint32_t k = terminated; k < rayEnd; ++k) {
         const std::uint32_t rayId = rayIds_[k];
-        if (hits_[rayId].prim != kMissPrim && shared::hitEndsInBox(rays_[rayId], box.lo, box.hi, hits_[rayId].t)) {
+        if (hits_[rayId].prim != kMissPrim &&
+            (anyHit_ || shared::hitEndsInBox(rays_[rayId], box.lo, box.hi, hits_[rayId].t))) {
             std::swap(rayIds_[k], rayIds_[terminated]);
             ++terminated;
         }

@@ -108,6 +108,8 @@ private:
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd);
     std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);
+    // filterRays over the rays moving `moving` along axis (+1: up or not at all, -1: down, 0: all).
+    std::uint32_t filterRaysMoving(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving);
     void tracePackets(const Box& box, std::uint32_t& terminated, std::uint32_t crossing, std::uint32_t triBegin,
                       std::uint32_t triEnd);
     std::uint32_t buildPackets(std::uint32_t begin, std::uint32_t end);
@@ -134,7 +136,9 @@ private:
     const Ray* rays_;
     const Triangle* triangles_;
     const Bounds* triangleBounds_;
-    glm::vec3 nearSide_;  // FrameGeometry::nearSide
+    ChildOrder order_;
+    glm::vec3 orderPoint_;  // FrameGeometry::nearSide
+    bool anyHit_;           // HitQuery::Any: a ray ends at its first hit
     float margin_;
     DacrtOptions options_;
     Hit* hits_;

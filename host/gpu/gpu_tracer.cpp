@@ -109,7 +109,9 @@ gpu::DacrtBindingSet uploadFrame(const GpuFrame& frame, const gpu::Context& cont
     gpu::DacrtBindingSet set(context, frame.buffers, resident);
     const FrameGeometry& g = frame.geometry;
     const std::vector<std::uint32_t> slotTriIds = gpu::groupTriangleIds(frame.division, frame.work.groups);
-    const std::vector<Hit> misses(g.rays->size(), missHit());
+    std::vector<Hit> misses;
+    misses.reserve(g.rays->size());
+    for (const Ray& ray : *g.rays) misses.push_back(missHit(ray));
     const GpuCounters zero{};
     const std::vector<TraversalState> fresh(frame.work.items.size(), TraversalState{});
     auto upload = [&](std::uint32_t binding, const auto& v) { set[binding].upload(v.data(), v.size() * sizeof(v[0])); };
@@ -274,7 +276,7 @@ TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options,
                      gpu::ResidentTriangles* resident) {
     const gpu::DeviceInfo& device = context.info();
     checkGpuOptions(options);
-    requireNearSide(geometry, "gpu");
+    if (geometry.order == ChildOrder::PerRay) throw InputError("gpu: per-ray order not yet");
     if (!device.subgroupOperations)
         throw InputError("device '" + device.name +
                          "' lacks subgroup arithmetic or shuffles in compute shaders, which the gpu backend needs");

@@ -245,30 +245,27 @@ TEST(BackendsAgree, OrthographicCameras) {
         SCOPED_TRACE("eye " + std::to_string(eye.x) + " " + std::to_string(eye.y) + " " + std::to_string(eye.z));
         const Frame frame(test::shapesScene(), orthographicView(eye, 1.8), 64, 48);
         ASSERT_FALSE(frame.geometry.raysShareStart);
-        ASSERT_TRUE(frame.geometry.nearSideKnown);
+        ASSERT_EQ(frame.geometry.order, ChildOrder::NearSide);
         expectAllBackendsAgree(frame, {1, 2, 4, 8});
     }
 }
 
-TEST(BackendsAgree, RaysWithoutANearSideAreRefusedByTheDacrtTracers) {
-    // Two rays from different points travelling opposite ways along x: brute traces them, the
-    // DACRT tracers say why they cannot (yet).
+TEST(BackendsAgree, RaysWithoutANearSideGoFrontToBackRayByRay) {
+    // Two rays from different points travelling opposite ways along x through the same shapes:
+    // no one near side, so every split classifies them by direction (ChildOrder::PerRay).
     const Scene s = test::shapesScene();
     const std::vector<Bounds> bounds = allTriangleBounds(s.triangles);
-    const std::vector<Ray> rays = {makeRay({-5, 0, 0}, {1, 0, 0}), makeRay({5, 0.1f, 0}, {-1, 0, 0})};
-    const FrameGeometry g = frameGeometry(s.triangles, bounds, rays, sceneBounds(s.triangles));
-    EXPECT_FALSE(g.nearSideKnown);
-    ThreadPool pool(1);
-    TraceOptions o;
-    o.backend = Backend::Brute;
-    EXPECT_EQ(hitCount(traceCpu(g, o, pool).hits), 2u);
-    for (Backend b : {Backend::CpuSeq, Backend::Cpu}) {
-        o.backend = b;
-        try {
-            traceCpu(g, o, pool);
-            ADD_FAILURE() << toString(b) << " traced";
-        } catch (const InputError& e) {
-            EXPECT_NE(std::string(e.what()).find("travel both ways"), std::string::npos) << e.what();
-        }
+    std::vector<Ray> rays;
+    for (int i = 0; i < 64; ++i) {
+        const float y = -0.9f + 0.03f * float(i);
+        rays.push_back(makeRay({-5, y, 0.1f}, {1, 0.01 * i, 0}));
+        rays.push_back(makeRay({5, y, 0}, {-1, 0, 0.01 * i}));
     }
+    const FrameGeometry g = frameGeometry(s.triangles, bounds, rays, sceneBounds(s.triangles));
+    EXPECT_EQ(g.order, ChildOrder::PerRay);
+    const TraceResult reference = traceFrame(g, Backend::Brute);
+    EXPECT_GT(hitCount(reference.hits), 20u);
+    EXPECT_TRUE(identicalHits(reference.hits, traceFrame(g, Backend::CpuSeq).hits));
+    for (unsigned regions : {1u, 2u, 5u})
+        EXPECT_TRUE(identicalHits(reference.hits, traceFrame(g, Backend::Cpu, regions, 2).hits)) << regions;
 }

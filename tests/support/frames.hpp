@@ -9,9 +9,23 @@
 #include "core/camera.hpp"
 #include "core/scene.hpp"
 #include "dacrt/cpu_tracers.hpp"
+#include "dacrt/secondary_rays.hpp"
 #include "support/fixtures.hpp"
 
 namespace dacrt::test {
+
+// One frame on one of the CPU backends.
+inline TraceResult traceFrame(const FrameGeometry& geometry, Backend backend, unsigned regions = 0, unsigned threads = 1,
+                              DivisionAxis axis = DivisionAxis::Best, const DacrtOptions& dacrt = {}) {
+    TraceOptions o;
+    o.dacrt = dacrt;
+    o.backend = backend;
+    o.regions = regions;
+    o.threads = threads;
+    o.axis = axis;
+    ThreadPool pool(threads);
+    return traceCpu(geometry, o, pool);
+}
 
 // A scene, its bounds and one camera's rays: everything a tracer reads.
 struct Frame {
@@ -30,14 +44,7 @@ struct Frame {
 
     TraceResult trace(Backend backend, unsigned regions = 0, unsigned threads = 1,
                       DivisionAxis axis = DivisionAxis::Best, const DacrtOptions& dacrt = {}) const {
-        TraceOptions o;
-        o.dacrt = dacrt;
-        o.backend = backend;
-        o.regions = regions;
-        o.threads = threads;
-        o.axis = axis;
-        ThreadPool pool(threads);
-        return traceCpu(geometry, o, pool);
+        return traceFrame(geometry, backend, regions, threads, axis, dacrt);
     }
 
 private:
@@ -47,6 +54,60 @@ private:
         geometry = frameGeometry(scene.triangles, bounds, rays, sceneBounds(scene.triangles), std::uint32_t(width));
     }
 };
+
+// A secondary pass of a frame, made on the host from the primary hits: its rays and the frame
+// they are traced as (any hit, or the closest when `query` asks for it).
+struct PassFrame {
+    SecondaryRays rays;
+    FrameGeometry geometry;
+    PassFrame(const Frame& primary, const std::vector<Hit>& primaryHits, const SecondaryPass& pass,
+              HitQuery query = HitQuery::Any) {
+        ThreadPool pool(2);
+        rays = makeSecondaryRays(pass, primary.rays, primaryHits, primary.scene.triangles, pool);
+        geometry = secondaryFrame(primary.scene.triangles, primary.bounds, rays.rays, sceneBounds(primary.scene.triangles));
+        geometry.query = query;
+    }
+    PassFrame(const PassFrame&) = delete;
+    TraceResult trace(Backend backend, unsigned regions = 0, unsigned threads = 1,
+                      DivisionAxis axis = DivisionAxis::Best, const DacrtOptions& dacrt = {}) const {
+        return traceFrame(geometry, backend, regions, threads, axis, dacrt);
+    }
+};
+
+// An occlusion pass of `samples` rays per hit, `length` long.
+inline SecondaryPass occlusionPass(std::uint32_t samples, float length, std::uint32_t seed = 7) {
+    SecondaryPass p;
+    p.name = "occlusion";
+    p.kind = shared::kPassOcclusion;
+    p.raysPerHit = samples;
+    p.occlusionDistance = length;
+    p.sampleSeed = seed;
+    return p;
+}
+
+// A shadow pass towards a point light at `position`.
+inline SecondaryPass pointShadowPass(glm::vec3 position) {
+    SecondaryPass p;
+    p.name = "shadow";
+    p.kind = shared::kPassShadow;
+    p.light.type = shared::kLightPoint;
+    p.light.position = position;
+    return p;
+}
+
+// The same visibility (hit or not) ray by ray; reports the first few differing rays.
+inline ::testing::AssertionResult identicalVisibility(const std::vector<Hit>& a, const std::vector<Hit>& b) {
+    if (a.size() != b.size()) return ::testing::AssertionFailure() << "sizes " << a.size() << " and " << b.size();
+    std::size_t differing = 0;
+    std::string examples;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        if ((a[i].prim == kMissPrim) == (b[i].prim == kMissPrim)) continue;
+        if (++differing <= 5)
+            examples += " [ray " + std::to_string(i) + ": prim " + std::to_string(a[i].prim) + " vs " + std::to_string(b[i].prim) + "]";
+    }
+    if (differing == 0) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << differing << " rays differ in visibility:" << examples;
+}
 
 // An orthographic camera at `eye` looking at the origin, 2 ymag high, y up.
 inline Camera orthographicView(glm::dvec3 eye, double ymag) {

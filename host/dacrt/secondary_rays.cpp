@@ -1,0 +1,86 @@
+#include "dacrt/secondary_rays.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+
+namespace dacrt {
+
+ShadowLight shadowLightOf(const Light& light) {
+    ShadowLight s{};
+    s.type = light.type == LightType::Point ? shared::kLightPoint
+                                            : (light.type == LightType::Spot ? shared::kLightSpot : shared::kLightDirectional);
+    s.position = glm::vec3(light.position);
+    s.direction = glm::vec3(glm::normalize(light.direction));
+    s.range = light.range;
+    const double cosOuter = std::cos(light.outerConeAngle);
+    s.cosOuterSquared = light.type == LightType::Spot ? float(cosOuter * cosOuter) : 0.0f;
+    return s;
+}
+
+std::uint64_t secondarySlots(const SecondaryPass& pass, std::uint64_t primaryRays) {
+    const std::uint64_t slots = primaryRays * pass.raysPerHit;
+    if (pass.raysPerHit == 0 || slots > kMaxSecondarySlots)
+        throw InputError(pass.name + ": " + std::to_string(primaryRays) + " pixels x " + std::to_string(pass.raysPerHit) +
+                         " rays per hit is more than the " + std::to_string(kMaxSecondarySlots) +
+                         " rays a pass can hold (32-bit slots); lower --size or --ao");
+    return slots;
+}
+
+SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray>& primary,
+                                const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
+                                ThreadPool& pool) {
+    SecondaryRays out;
+    out.slotCount = secondarySlots(pass, primary.size());
+    const std::uint32_t perHit = pass.raysPerHit;
+    // Chunks of primary rays, made in parallel and joined in slot order.
+    const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(256, primary.size() / 1024 + 1));
+    std::vector<std::vector<Ray>> chunkRays(chunks);
+    std::vector<std::vector<std::uint32_t>> chunkSlots(chunks);
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        const std::size_t begin = primary.size() * c / chunks, end = primary.size() * (c + 1) / chunks;
+        for (std::size_t i = begin; i < end; ++i) {
+            const Hit& hit = primaryHits[i];
+            if (hit.prim == kMissPrim || hit.prim == kNotTracedPrim) continue;
+            const shared::SurfaceSample surface = shared::surfaceOfHit(primary[i], hit, triangles[hit.prim]);
+            for (std::uint32_t k = 0; k < perHit; ++k) {
+                const std::uint32_t slot = std::uint32_t(i) * perHit + k;
+                const shared::GeneratedRay g =
+                    pass.kind == shared::kPassShadow
+                        ? shared::shadowRay(surface, pass.light)
+                        : shared::occlusionRay(surface, slot, pass.sampleSeed, pass.occlusionDistance);
+                if (!g.traced) continue;
+                chunkRays[c].push_back(g.ray);
+                chunkSlots[c].push_back(slot);
+            }
+        }
+    });
+    std::size_t total = 0;
+    for (const auto& r : chunkRays) total += r.size();
+    out.rays.reserve(total);
+    out.slots.reserve(total);
+    for (std::size_t c = 0; c < chunks; ++c) {
+        out.rays.insert(out.rays.end(), chunkRays[c].begin(), chunkRays[c].end());
+        out.slots.insert(out.slots.end(), chunkSlots[c].begin(), chunkSlots[c].end());
+    }
+    return out;
+}
+
+std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced) {
+    if (traced.size() != rays.rays.size())
+        throw InternalError("a secondary pass traced " + std::to_string(traced.size()) + " rays of " +
+                            std::to_string(rays.rays.size()));
+    std::vector<Hit> slots(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f});
+    for (std::size_t i = 0; i < traced.size(); ++i) slots[rays.slots[i]] = traced[i];
+    return slots;
+}
+
+FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles,
+                             const std::vector<Bounds>& bounds, const std::vector<Ray>& rays, const Box& sceneBox) {
+    FrameGeometry g = frameGeometry(triangles, bounds, rays, sceneBox);
+    g.query = HitQuery::Any;
+    return g;
+}
+
+}  // namespace dacrt
