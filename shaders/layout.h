@@ -43,6 +43,8 @@ const float kNoHitT = 3.402823466e+38;          // FLT_MAX: finite, so no inf ar
 // bounds its filters like a hit. Secondary passes mark the slots of rays they did not make
 // (a surface facing away from the light, say) with kNotTracedPrim.
 const uint kNotTracedPrim = 0xFFFFFFFEu;
+// An any-hit answer that does not name its triangle (Embree's occlusion query): a hit, prim unknown.
+const uint kUnnamedHitPrim = 0xFFFFFFFDu;
 struct Hit {
     float t;
     uint prim;

@@ -26,5 +26,6 @@ using shared::Region;
 using shared::Triangle;
 using shared::kMissPrim;
 using shared::kNotTracedPrim;
+using shared::kUnnamedHitPrim;
 using shared::kNoHitT;
 }  // namespace dacrt
