@@ -77,6 +77,7 @@ void loadFrameParameters() {
     gRayOrigin = push.rayOrigin;
     gRayTmin = push.rayTmin;
     gAxis = push.axis;
+    gOrder = push.order;
     gRayScratchHalf = push.rayScratchHalf;
     gTriScratchHalf = push.triScratchHalf;
 }
@@ -140,7 +141,7 @@ void resumeSaved(ItemContext c, TraversalState state, inout Slice s) {
     s.stalls = state.stalls;
     s.leafNext = state.leafNext;
     s.progressed = false;
-    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) sStack[i] = stacks[c.index * (kMaxDepth + 1u) + i];
+    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) sStack[i] = stacks[c.index * kStackCapacity + i];
     s.spent = s.stackSize / kWorkgroupSize + 1u;
     workgroupSync();
 }
@@ -170,8 +171,23 @@ uint runLeaf(ItemContext c, inout Slice s, uint rayCount, uint triCount) {
     return kStepContinue;
 }
 
-// Front to back: the child on the rays' origin side first; the other waits on the stack with
-// this node's ranges, which it filters again later.
+// Front to back: the child on the rays' near side first; the other waits on the stack with
+// this node's ranges, which it filters again later. Rays classified per split (kOrderPerRay,
+// closest hits) visit the low child if they move up, then all of them the high child, then
+// the low child if they move down: two children wait, the high one on top.
+void pushChild(uint slot, vec3 lo, vec3 hi, Slice s, uint rayRule) {
+    StackEntry e;
+    e.lo = lo;
+    e.hi = hi;
+    e.rayEnd = s.nodeRayEnd;
+    e.triBegin = s.triBegin;
+    e.triEnd = s.triEnd;
+    e.depth = s.depth + 1u;
+    e.stalls = s.stalls;
+    e.rayRule = rayRule;
+    sStack[slot] = e;
+}
+
 uint splitNode(ItemContext c, inout Slice s, int axis, float split, uint rayCount, uint triCount) {
     uint cost = partitionCost(rayCount) + partitionCost(triCount) + kStepOverhead;
     if (overBudget(s.spent, cost + c.retireCost)) return kStepOutOfBudget;
@@ -180,21 +196,24 @@ uint splitNode(ItemContext c, inout Slice s, int axis, float split, uint rayCoun
     vec3 lowHi = s.hi, highLo = s.lo;
     lowHi[axis] = split;
     highLo[axis] = split;
-    bool lowFirst = gRayOrigin[axis] <= split;
+    bool perRay = gOrder == kOrderPerRay;
+    bool classified = perRay && !kAnyHit;
+    bool lowFirst = perRay || gRayOrigin[axis] <= split;
     vec3 nearLo = lowFirst ? s.lo : highLo, nearHi = lowFirst ? lowHi : s.hi;
     if (c.lane == 0) {
-        StackEntry far;
-        far.lo = lowFirst ? highLo : s.lo;
-        far.hi = lowFirst ? s.hi : lowHi;
-        far.rayEnd = s.nodeRayEnd;
-        far.triBegin = s.triBegin;
-        far.triEnd = s.triEnd;
-        far.depth = s.depth + 1u;
-        far.stalls = s.stalls;
-        sStack[s.stackSize] = far;
+        if (classified) {
+            pushChild(s.stackSize, s.lo, lowHi, s, crossingMovingRule(axis, true));
+            pushChild(s.stackSize + 1u, highLo, s.hi, s, kKeepCrossing);
+        } else {
+            pushChild(s.stackSize, lowFirst ? highLo : s.lo, lowFirst ? s.hi : lowHi, s, kKeepCrossing);
+        }
     }
-    ++s.stackSize;
-    uint childRayEnd = partitionRays(s.terminated, s.nodeRayEnd, kKeepCrossing, nearLo - c.margin, nearHi + c.margin);
+    s.stackSize += classified ? 2u : 1u;
+    // A rule known only at run time makes every branch of keepRay run under a mask on llvmpipe:
+    // the common rule gets a call of its own, where it is a constant.
+    uint childRayEnd = classified ? partitionRays(s.terminated, s.nodeRayEnd, crossingMovingRule(axis, false),
+                                                  nearLo - c.margin, nearHi + c.margin)
+                                  : partitionRays(s.terminated, s.nodeRayEnd, kKeepCrossing, nearLo - c.margin, nearHi + c.margin);
     uint childTriEnd = s.triEnd;
     if (childRayEnd > s.terminated)
         childTriEnd = partitionTriangles(s.triBegin, s.triEnd, nearLo - c.margin, nearHi + c.margin);
@@ -220,7 +239,9 @@ uint popFarChild(ItemContext c, inout Slice s) {
     workgroupSync();  // the slot may be written again before everyone has read it
     s.lo = far.lo;
     s.hi = far.hi;
-    s.nodeRayEnd = partitionRays(s.terminated, far.rayEnd, kKeepCrossing, s.lo - c.margin, s.hi + c.margin);
+    s.nodeRayEnd = far.rayRule == kKeepCrossing  // as in splitNode: the common rule as a constant
+                       ? partitionRays(s.terminated, far.rayEnd, kKeepCrossing, s.lo - c.margin, s.hi + c.margin)
+                       : partitionRays(s.terminated, far.rayEnd, far.rayRule, s.lo - c.margin, s.hi + c.margin);
     s.triBegin = far.triBegin;
     s.triEnd = s.nodeRayEnd > s.terminated ? partitionTriangles(far.triBegin, far.triEnd, s.lo - c.margin, s.hi + c.margin)
                                            : far.triBegin;
@@ -249,7 +270,7 @@ uint stepTraversal(ItemContext c, inout Slice s) {
 void saveSlice(ItemContext c, Slice s) {
     if (!s.progressed && c.lane == 0) atomicAdd(counters.tooLarge, 1u);
     workgroupSync();
-    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) stacks[c.index * (kMaxDepth + 1u) + i] = sStack[i];
+    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) stacks[c.index * kStackCapacity + i] = sStack[i];
     bool cutShort = loopLimiterFired(push.loopProbe);
     if (c.lane == 0) {
         TraversalState saved;
@@ -303,7 +324,11 @@ void main() {
     c.margin = vec3(gMargin);
     c.retireCost = partitionCost(c.rayEnd - s.terminated) + 4u;
 
-    if (state.phase == kPhaseNew && s.terminated >= c.rayEnd) {  // nothing to trace: finish at once
+    // Nothing to trace (no live ray, or, in a transfer, none moving towards the triangles'
+    // region): finish at once.
+    uint towards = c.item.retire == 1u ? kTowardHigh : (c.item.retire == 2u ? kTowardLow : kTowardLow | kTowardHigh);
+    bool noneMoving = c.item.retire != 0u && (regions[c.item.rayRegion].directions & towards) == 0u;
+    if (state.phase == kPhaseNew && (s.terminated >= c.rayEnd || noneMoving)) {
         if (c.lane == 0) {
             atomicAdd(counters.workItemsEmpty, 1u);
             markFinished(c);

@@ -55,6 +55,13 @@ const uint kKeepFinished = 1u;     // rays whose best hit ends them in the (unwi
 const uint kKeepStill = 2u;        // rays with no motion along gAxis
 const uint kKeepStuckHigh = 3u;    // rays moving up gAxis that cannot reach the cell
 const uint kKeepStuckLow = 4u;     // rays moving down gAxis that cannot reach the cell
+// Rays that may cross the cell and move up (or not at all) along axis a: kKeepCrossingUp + 2a;
+// those moving down: kKeepCrossingUp + 2a + 1 (the children of a kOrderPerRay split).
+const uint kKeepCrossingUp = 6u;
+
+uint crossingMovingRule(int axis, bool down) {
+    return kKeepCrossingUp + 2u * uint(axis) + (down ? 1u : 0u);
+}
 
 // A ray with only its origin and tmin read, from push constants where all rays share them
 // (llvmpipe loads a buffer component one invocation at a time, so every field counts).
@@ -76,7 +83,12 @@ bool keepRay(uint id, uint rule, vec3 lo, vec3 hi) {
     Ray ray = filterRay(id);
     float bestT = hits[id].t;
     if (rule == kKeepCrossing) return rayMayCrossCell(ray, lo, hi, bestT);
-    if (rule == kKeepFinished) return hits[id].prim != kMissPrim && hitEndsInBox(ray, lo, hi, bestT);
+    if (rule == kKeepFinished) return hits[id].prim != kMissPrim && (kAnyHit || hitEndsInBox(ray, lo, hi, bestT));
+    if (rule >= kKeepCrossingUp) {
+        uint axis = (rule - kKeepCrossingUp) >> 1u;
+        bool down = ((rule - kKeepCrossingUp) & 1u) == 1u;
+        return (ray.invDir[axis] < 0.0) == down && rayMayCrossCell(ray, lo, hi, bestT);  // invDir has dir's sign
+    }
     float d = ray.invDir[gAxis];  // 0 exactly where dir is 0 (slabInterval)
     if (rule == kKeepStill) return d == 0.0;
     bool moving = rule == kKeepStuckHigh ? d > 0.0 : d < 0.0;
@@ -174,7 +186,7 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         }
     }
     workgroupSync();
-    if (rule == kKeepCrossing && lane == 0) atomicAdd(counters.rayBoxTests, end - begin);
+    if ((rule == kKeepCrossing || rule >= kKeepCrossingUp) && lane == 0) atomicAdd(counters.rayBoxTests, end - begin);
     return keptEnd;
 }
 

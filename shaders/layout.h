@@ -165,7 +165,7 @@ struct SecondaryPush {
     uint groups;           // ray groups: region k's group g is slot k * groups + g
     uint axis;
     float margin;          // filterMargin of the frame
-    uint pad0;
+    uint firstInvocation;  // this dispatch's invocations are [firstInvocation, + its size)
     uint pad1;
 };
 
@@ -252,6 +252,7 @@ static_assert(sizeof(SecondaryPush) == 96 && offsetof(SecondaryPush, kind) == 48
 static_assert(offsetof(SecondaryPush, sourceCount) == 56 && offsetof(SecondaryPush, occlusionDistance) == 64);
 static_assert(offsetof(SecondaryPush, sampleSeed) == 68 && offsetof(SecondaryPush, groups) == 76);
 static_assert(offsetof(SecondaryPush, axis) == 80 && offsetof(SecondaryPush, margin) == 84);
+static_assert(offsetof(SecondaryPush, firstInvocation) == 88);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);

@@ -19,6 +19,7 @@ layout(push_constant) uniform Push {
     uint rayCount;
     uint firstRay;
     uint cullBackFaces;  // 1: some triangles are single-sided (Triangle::cullBackFace)
+    uint anyHit;         // 1: any hit in the segment will do (HitQuery::Any: shadow and occlusion rays)
 } push;
 
 void main() {
@@ -30,9 +31,12 @@ void main() {
     // rule), every candidate comes back here and is confirmed unless it is one's back face:
     // per triangle, which the ray flag gl_RayFlagsCullBackFacingTrianglesEXT is not (and
     // lavapipe, Mesa 25.0.7, ignores that flag: docs/skips.md).
+    // For any hit, the traversal ends at the first hit committed: the first opaque one found,
+    // or the first candidate confirmed below, so the face rule holds there too.
     bool cull = push.cullBackFaces != 0u;
-    rayQueryInitializeEXT(query, scene, cull ? gl_RayFlagsNoOpaqueEXT : gl_RayFlagsOpaqueEXT, 0xFFu, ray.origin,
-                          ray.tmin, ray.dir, kNoHitT);
+    uint flags = cull ? gl_RayFlagsNoOpaqueEXT : gl_RayFlagsOpaqueEXT;
+    if (push.anyHit != 0u) flags |= gl_RayFlagsTerminateOnFirstHitEXT;
+    rayQueryInitializeEXT(query, scene, flags, 0xFFu, ray.origin, ray.tmin, ray.dir, ray.tmax);
     while (rayQueryProceedEXT(query)) {
         if (rayQueryGetIntersectionTypeEXT(query, false) != gl_RayQueryCandidateIntersectionTriangleEXT) continue;
         uint prim = uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, false));
@@ -40,7 +44,7 @@ void main() {
             rayQueryConfirmIntersectionEXT(query);
     }
     Hit h;
-    h.t = kNoHitT;
+    h.t = ray.tmax;  // a miss, as every backend reports it (missHit)
     h.prim = kMissPrim;
     h.u = 0.0;
     h.v = 0.0;

@@ -84,12 +84,18 @@ float largestMagnitude(float a, float b, float c, float d) {
     return max(max(abs(a), abs(b)), max(abs(c), abs(d)));
 }
 
-SurfaceSample surfaceOfHit(IN(Ray) primary, IN(Hit) hit, IN(Triangle) tri) {
+SurfaceSample noSurface() {
     SurfaceSample s;
     s.point = vec3(0.0f);
     s.normal = vec3(0.0f);
     s.origin = vec3(0.0f);
     s.valid = false;
+    return s;
+}
+
+// tri is the hit's triangle (anything for a miss).
+SurfaceSample surfaceOfHit(IN(Ray) primary, IN(Hit) hit, IN(Triangle) tri) {
+    SurfaceSample s = noSurface();
     if (hit.prim == kMissPrim || hit.prim == kNotTracedPrim) return s;
     precise float w = 1.0f - hit.u - hit.v;
     precise vec3 p = tri.v0 * w + tri.v1 * hit.u + tri.v2 * hit.v;

@@ -15,6 +15,8 @@ using uint = std::uint32_t;
 namespace dacrt {
 using shared::Bounds;
 using shared::DacrtPush;
+using shared::SecondaryPush;
+using shared::ShadowLight;
 using shared::GpuCounters;
 using shared::WorkgroupTestPush;
 using shared::WorkItem;

@@ -253,21 +253,21 @@ Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& p
     return d;
 }
 
-std::vector<TransferRound> transferSchedule(const Division& d) {
+std::vector<TransferRound> transferSchedule(const Division& d, bool raysKnown) {
     const std::uint32_t n = std::uint32_t(d.regions.size());
-    auto hasRays = [&](std::uint32_t k) { return d.regions[k].rayEnd > d.regions[k].rayBegin; };
+    auto hasRays = [&](std::uint32_t k) { return !raysKnown || d.regions[k].rayEnd > d.regions[k].rayBegin; };
     auto hasTris = [&](std::uint32_t k) { return d.regions[k].triEnd > d.regions[k].triBegin; };
     std::vector<TransferRound> rounds;
     for (std::uint32_t s = 1; s < n; ++s) {
         TransferRound round{"toward-low " + std::to_string(s), {}};
         for (std::uint32_t i = 0; i + s < n; ++i)
-            if (d.raysTowardLow[i + s] && hasRays(i + s) && hasTris(i)) round.pairs.push_back({i + s, i});
+            if ((!raysKnown || d.raysTowardLow[i + s]) && hasRays(i + s) && hasTris(i)) round.pairs.push_back({i + s, i});
         if (!round.pairs.empty()) rounds.push_back(std::move(round));
     }
     for (std::uint32_t s = 1; s < n; ++s) {
         TransferRound round{"toward-high " + std::to_string(s), {}};
         for (std::uint32_t i = s; i < n; ++i)
-            if (d.raysTowardHigh[i - s] && hasRays(i - s) && hasTris(i)) round.pairs.push_back({i - s, i});
+            if ((!raysKnown || d.raysTowardHigh[i - s]) && hasRays(i - s) && hasTris(i)) round.pairs.push_back({i - s, i});
         if (!round.pairs.empty()) rounds.push_back(std::move(round));
     }
     return rounds;

@@ -52,7 +52,8 @@ Division divideScene(const FrameGeometry& geometry, unsigned regionCount, int ax
 
 // Round s pairs region j's live rays with region j - s (first pass) or j + s (second pass),
 // only where region j has rays travelling that way: for rays leaving one camera this is the
-// source's CameraIntersect test, made exact.
-std::vector<TransferRound> transferSchedule(const Division& division);
+// source's CameraIntersect test, made exact. raysKnown false: the rays are binned later (on the
+// device), so every region's rays may travel both ways.
+std::vector<TransferRound> transferSchedule(const Division& division, bool raysKnown = true);
 
 }  // namespace dacrt

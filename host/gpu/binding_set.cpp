@@ -1,5 +1,6 @@
 #include "gpu/binding_set.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "core/errors.hpp"
@@ -18,7 +19,9 @@ DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& c) {
     p[DACRT_BINDING_WORK_ITEMS] = {"work items", c.workItems * sizeof(WorkItem)};
     p[DACRT_BINDING_COUNTERS] = {"counters", sizeof(GpuCounters)};
     p[DACRT_BINDING_STATES] = {"traversal states", c.workItems * sizeof(TraversalState)};
-    p[DACRT_BINDING_STACKS] = {"traversal stacks", c.workItems * (std::uint64_t(c.maxDepth) + 1) * sizeof(StackEntry)};
+    p[DACRT_BINDING_STACKS] = {"traversal stacks", c.workItems * (2 * std::uint64_t(c.maxDepth) + 1) * sizeof(StackEntry)};
+    p[DACRT_BINDING_SOURCE_RAYS] = {"primary rays (secondary passes)", std::max<std::uint64_t>(c.sourceRays, 1) * sizeof(Ray)};
+    p[DACRT_BINDING_SOURCE_HITS] = {"primary hits (secondary passes)", std::max<std::uint64_t>(c.sourceRays, 1) * sizeof(Hit)};
     return p;
 }
 

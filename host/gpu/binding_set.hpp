@@ -22,6 +22,7 @@ struct DacrtBufferCounts {
     std::uint64_t regions = 0;       // region slots
     std::uint64_t workItems = 0;
     std::uint32_t maxDepth = 0;      // traversal stack depth per work item
+    std::uint64_t sourceRays = 0;    // secondary passes: the primary rays they start from (0: a primary pass)
 };
 
 struct PlannedBuffer {

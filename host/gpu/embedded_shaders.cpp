@@ -2,11 +2,16 @@
 
 #include "dacrt.spv.h"
 #include "rayquery.spv.h"
+#include "secondary.spv.h"
 #include "workgroup_test.spv.h"
 
 namespace dacrt::gpu {
 
 std::span<const std::uint32_t> dacrtKernelSpirv() { return {dacrt_spv, sizeof(dacrt_spv) / sizeof(dacrt_spv[0])}; }
+
+std::span<const std::uint32_t> secondarySpirv() {
+    return {secondary_spv, sizeof(secondary_spv) / sizeof(secondary_spv[0])};
+}
 
 std::span<const std::uint32_t> workgroupTestSpirv() {
     return {workgroup_test_spv, sizeof(workgroup_test_spv) / sizeof(workgroup_test_spv[0])};

@@ -6,6 +6,7 @@
 namespace dacrt::gpu {
 
 std::span<const std::uint32_t> dacrtKernelSpirv();    // shaders/dacrt.comp
+std::span<const std::uint32_t> secondarySpirv();      // shaders/secondary.comp
 std::span<const std::uint32_t> workgroupTestSpirv();  // shaders/workgroup_test.comp
 std::span<const std::uint32_t> rayQuerySpirv();       // shaders/rayquery.comp
 

@@ -8,13 +8,14 @@
 namespace dacrt::gpu {
 
 std::vector<std::uint32_t> KernelSpecialization::values() const {
-    std::vector<std::uint32_t> v(6);
+    std::vector<std::uint32_t> v(7);
     v[DACRT_SPEC_WORKGROUP_SIZE] = workgroupSize;
     v[DACRT_SPEC_RAY_LIMIT] = rayLimit;
     v[DACRT_SPEC_TRI_LIMIT] = triLimit;
     v[DACRT_SPEC_MAX_DEPTH] = maxDepth;
     v[DACRT_SPEC_LOOP_BUDGET] = loopBudget;
     v[DACRT_SPEC_SHARED_START] = sharedStart ? 1u : 0u;
+    v[DACRT_SPEC_ANY_HIT] = anyHit ? 1u : 0u;
     return v;
 }
 
@@ -52,13 +53,24 @@ ComputePipeline& PipelineCache::kernel(const KernelSpecialization& specializatio
     return *slot;
 }
 
+ComputePipeline& PipelineCache::secondary() {
+    if (!secondary_) {
+        std::vector<std::uint32_t> values(7, 0);
+        values[DACRT_SPEC_WORKGROUP_SIZE] = kSecondaryWorkgroup;
+        values[DACRT_SPEC_MAX_DEPTH] = 1;  // the kernel has no traversal stack to size
+        secondary_ = std::make_unique<ComputePipeline>(context_, secondarySpirv(), DACRT_BINDING_COUNT,
+                                                       sizeof(SecondaryPush), values, "secondary");
+    }
+    return *secondary_;
+}
+
 ComputePipeline& PipelineCache::rayQuery() {
     if (!rayQuery_)
         rayQuery_ = std::make_unique<ComputePipeline>(
             context_, rayQuerySpirv(),
             std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                           VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-            3 * sizeof(std::uint32_t), std::vector<std::uint32_t>{}, "rayquery");
+            4 * sizeof(std::uint32_t), std::vector<std::uint32_t>{}, "rayquery");
     return *rayQuery_;
 }
 

@@ -18,13 +18,19 @@ struct KernelSpecialization {
     std::uint32_t maxDepth = 0;
     std::uint32_t loopBudget = 0;
     bool sharedStart = false;
+    bool anyHit = false;
     std::vector<std::uint32_t> values() const;  // in constant_id order
 };
+
+constexpr std::uint32_t kSecondaryWorkgroup = 64;
 
 class PipelineCache {
 public:
     explicit PipelineCache(Context& context) : context_(context) {}
     ComputePipeline& kernel(const KernelSpecialization& specialization);
+    // shaders/secondary.comp: a secondary pass's rays made and binned on the device (the DACRT
+    // binding set; kSecondaryWorkgroup invocations a workgroup).
+    ComputePipeline& secondary();
     // shaders/rayquery.comp: rays, hits, the top-level acceleration structure.
     ComputePipeline& rayQuery();
     // Whether the ray-query pipeline has run once (its caller primes it: the shader binds an
@@ -35,6 +41,7 @@ public:
 private:
     Context& context_;
     std::unique_ptr<ComputePipeline> rayQuery_;
+    std::unique_ptr<ComputePipeline> secondary_;
     bool rayQueryPrimed_ = false;
     std::map<std::vector<std::uint32_t>, std::unique_ptr<ComputePipeline>> pipelines_;
 };

@@ -13,6 +13,15 @@ namespace {
 
 constexpr std::uint32_t kRaysPerWorkgroup = 64;  // local_size_x of shaders/rayquery.comp
 
+// shaders/rayquery.comp's push constants.
+struct RayQueryPush {
+    std::uint32_t rayCount = 0;
+    std::uint32_t firstRay = 0;
+    std::uint32_t cullBackFaces = 0;
+    std::uint32_t anyHit = 0;
+};
+static_assert(sizeof(RayQueryPush) == 4 * sizeof(std::uint32_t), "the push range PipelineCache::rayQuery declares");
+
 gpu::AccelerationBuild accelerationBuildOf(RayQueryBuild b) {
     switch (b) {
         case RayQueryBuild::Dynamic: return gpu::AccelerationBuild::FastBuild;
@@ -30,9 +39,9 @@ struct RayQueryScene::Impl {
     const std::vector<Triangle>& triangles;
     RayQueryBuild build;
     gpu::Buffer vertices;
+    gpu::Faces faces;  // before structure, which is made with it
     gpu::TriangleAccelerationStructure structure;
     std::unique_ptr<gpu::Buffer> rays, hits;
-    gpu::Faces faces;
     bool built = false;
 
     Impl(gpu::Context& c, gpu::PipelineCache& p, const std::vector<Triangle>& t, RayQueryBuild b)
@@ -55,7 +64,7 @@ RayQueryScene::RayQueryScene(gpu::Context& context, gpu::PipelineCache& pipeline
 
 RayQueryScene::~RayQueryScene() = default;
 
-TraceResult RayQueryScene::trace(const std::vector<Ray>& rays) {
+TraceResult RayQueryScene::trace(const std::vector<Ray>& rays, HitQuery query) {
     Impl& m = *impl_;
     TraceResult result;
     result.gpu = GpuReport{};
@@ -92,9 +101,9 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays) {
             recorder.buildAccelerationStructures(refit ? "refit" : "build",
                                                  [&](VkCommandBuffer commands) { m.structure.record(commands, refit); });
         for (std::uint32_t done = 0; traceSteps && done < groups; done += perDispatch) {
-            const std::uint32_t push[3] = {std::uint32_t(rays.size()), done * kRaysPerWorkgroup,
-                                           m.faces == gpu::Faces::FrontOnly ? 1u : 0u};
-            recorder.dispatch("trace", pipeline, std::min(perDispatch, groups - done), push);
+            const RayQueryPush push{std::uint32_t(rays.size()), done * kRaysPerWorkgroup,
+                                    m.faces == gpu::Faces::FrontOnly ? 1u : 0u, query == HitQuery::Any ? 1u : 0u};
+            recorder.dispatch("trace", pipeline, std::min(perDispatch, groups - done), &push);
         }
         recorder.submitAndWait();
         for (const auto& t : recorder.timingsMs()) timings.push_back(t);
@@ -104,8 +113,8 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays) {
         if (rebuild || refit) runSteps(true, false);
         const auto compileStart = Clock::now();
         gpu::DispatchRecorder recorder(m.context, 1);
-        const std::uint32_t noRays[3] = {0, 0, 0};
-        recorder.dispatch("prime", pipeline, 1, noRays);
+        const RayQueryPush noRays{};
+        recorder.dispatch("prime", pipeline, 1, &noRays);
         recorder.submitAndWait();
         m.pipelines.markRayQueryPrimed();
         compileMs = msSince(compileStart);
@@ -153,7 +162,7 @@ TraceResult traceRayQuery(const FrameGeometry& geometry, gpu::Context& context, 
     const auto start = Clock::now();
     RayQueryScene scene(context, pipelines, *geometry.triangles, RayQueryBuild::Dynamic);
     const double allocateMs = msSince(start);
-    TraceResult result = scene.trace(*geometry.rays);
+    TraceResult result = scene.trace(*geometry.rays, geometry.query);
     result.phaseMs.insert(result.phaseMs.begin(), {"allocate", allocateMs});
     return result;
 }

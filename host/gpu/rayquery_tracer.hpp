@@ -36,17 +36,20 @@ public:
 
     // One frame in one command buffer: the vertices uploaded again and the structure built
     // (the first frame, and every frame of a dynamic scene) or updated (refit), then the rays
-    // traced. phaseMs holds upload, build (or refit: the structure's part alone), dispatch
-    // (build and trace together, as the device ran them) and readback; the gpu report the
-    // timestamps.
-    TraceResult trace(const std::vector<Ray>& rays);
+    // traced within their segments (ray.tmin <= t <= ray.tmax as Vulkan specifies it, which
+    // differs from dacrt's t > tmin only at a triangle through a ray's start; a miss is
+    // missHit(ray)): the closest hit, or for HitQuery::Any the first hit the traversal commits
+    // (gl_RayFlagsTerminateOnFirstHitEXT), its t and primitive. phaseMs holds upload, build
+    // (or refit: the structure's part alone), dispatch (build and trace together, as the
+    // device ran them) and readback; the gpu report the timestamps.
+    TraceResult trace(const std::vector<Ray>& rays, HitQuery query = HitQuery::Closest);
 
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
 
-// A single frame: the scene built for it (dynamic), then traced.
+// A single frame: the scene built for it (dynamic), then traced for the frame's query.
 TraceResult traceRayQuery(const FrameGeometry& geometry, gpu::Context& context, gpu::PipelineCache& pipelines,
                           const PlanHook& onPlan = {});
 

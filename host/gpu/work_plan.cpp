@@ -14,10 +14,12 @@ std::vector<Region> groupRegions(const Division& division, std::uint32_t groups)
                          " ray groups exceed the kernel's 32-bit ids; use fewer ray groups");
     std::vector<Region> slots;
     std::uint32_t triNext = 0;
-    for (const Region& r : division.regions) {
+    for (std::size_t k = 0; k < division.regions.size(); ++k) {
+        const Region& r = division.regions[k];
         const std::uint32_t rays = r.rayEnd - r.rayBegin;
         for (std::uint32_t g = 0; g < groups; ++g) {
             Region slot = r;
+            slot.directions = (division.raysTowardLow[k] ? shared::kTowardLow : 0u) | (division.raysTowardHigh[k] ? shared::kTowardHigh : 0u);
             slot.rayBegin = r.rayBegin + std::uint32_t(std::uint64_t(rays) * g / groups);
             slot.rayEnd = r.rayBegin + std::uint32_t(std::uint64_t(rays) * (g + 1) / groups);
             slot.terminated = slot.rayBegin;

@@ -66,6 +66,78 @@ TEST(GpuImages, ProceduralShapes) {
     expectGpuMatchesCpu(*context, frame, {1, 4}, 32);
 }
 
+TEST(GpuImages, RaysFromSurfacesInEveryDirection) {
+    // Occlusion and shadow rays made on the host from the primary hits: no common near side
+    // (kOrderPerRay: rays classified per split for closest hits), any hit or the closest, with
+    // transfer rounds in both directions and ray groups.
+    DACRT_REQUIRE_GPU(context);
+    CameraOptions view;
+    view.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(shapes(), 40, 30, view);
+    const TraceResult primary = frame.trace(Backend::CpuSeq);
+    for (const SecondaryPass& p : {occlusionPass(3, 0.8f), occlusionPass(2, kNoHitT), pointShadowPass({0.3f, 1.6f, 0.4f})}) {
+        for (HitQuery query : {HitQuery::Closest, HitQuery::Any}) {
+            SCOPED_TRACE(p.name + (query == HitQuery::Any ? ", any hit" : ", closest hit"));
+            const PassFrame pass(frame, primary.hits, p, query);
+            const TraceResult reference = pass.trace(Backend::CpuSeq);
+            for (unsigned regions : {1u, 3u})
+                for (std::uint32_t groups : {1u, 2u}) {
+                    TraceOptions o;
+                    o.backend = Backend::Gpu;
+                    o.regions = regions;
+                    ThreadPool pool(2);
+                    const TraceResult r = traceGpu(pass.geometry, o, GpuTuning{0, groups}, *context, pool);
+                    EXPECT_TRUE(query == HitQuery::Closest ? identicalHits(reference.hits, r.hits)
+                                                           : identicalVisibility(reference.hits, r.hits))
+                        << regions << " regions, " << groups << " ray groups";
+                }
+        }
+    }
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
+TEST(GpuImages, SecondaryPassesMadeOnTheDeviceMatchTheHost) {
+    // The primary hits stay on the device; shaders/secondary.comp makes each pass's rays there
+    // (the host's code, bit for bit) and bins them; the visibility of every slot equals the
+    // host-made pass traced by cpu-seq, and so do the slots without a ray.
+    DACRT_REQUIRE_GPU(context);
+    CameraOptions view;
+    view.eye = glm::dvec3(-1.0, 2.0, 4.0);
+    const Frame frame(shapes(), 40, 30, view);
+    SecondaryPass directional = pointShadowPass({});
+    directional.light.type = shared::kLightDirectional;
+    directional.light.direction = glm::vec3(glm::normalize(glm::dvec3(0.4, -1.0, -0.3)));
+    for (unsigned regions : {1u, 3u})
+        for (std::uint32_t groups : {1u, 2u}) {
+            TraceOptions o;
+            o.backend = Backend::Gpu;
+            o.regions = regions;
+            ThreadPool pool(2);
+            GpuPassSourcePtr source;
+            const TraceResult primary = traceGpu(frame.geometry, o, GpuTuning{0, groups}, *context, pool, {}, nullptr,
+                                                 nullptr, &source);
+            ASSERT_TRUE(source);
+            for (const SecondaryPass& p : {occlusionPass(3, 0.8f), pointShadowPass({0.3f, 1.6f, 0.4f}), directional}) {
+                SCOPED_TRACE(p.name + ", " + std::to_string(regions) + " regions, " + std::to_string(groups) + " groups");
+                const PassFrame host(frame, primary.hits, p);
+                const std::vector<Hit> expected = hitsPerSlot(host.rays, host.trace(Backend::CpuSeq).hits);
+                const TraceResult device =
+                    traceGpuSecondary(*source, frame.geometry, p, o, GpuTuning{0, groups}, *context, pool);
+                ASSERT_EQ(device.hits.size(), expected.size());
+                std::size_t notTraced = 0, occluded = 0;
+                for (std::size_t i = 0; i < expected.size(); ++i) {
+                    ASSERT_EQ(device.hits[i].prim == kNotTracedPrim, expected[i].prim == kNotTracedPrim) << "slot " << i;
+                    notTraced += expected[i].prim == kNotTracedPrim;
+                    occluded += expected[i].prim != kNotTracedPrim && expected[i].prim != kMissPrim;
+                }
+                EXPECT_TRUE(identicalVisibility(expected, device.hits));
+                EXPECT_GT(occluded, expected.size() / 50);
+                EXPECT_GT(notTraced, 0u);
+            }
+        }
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
 TEST(GpuImages, RayGroupsGiveTheSameHits) {
     // Groups split each region's rays into bands with private triangle ids; with transfer
     // rounds (camera inside, 4 regions) and with more groups than some regions have rays.
