@@ -7,7 +7,10 @@
 // identical on the host, on lavapipe and on any GPU. Callers keep their operands normal
 // (docs/correctness.md, "Secondary rays"): no subnormal, infinite or NaN input or result.
 // DACRT_UNROLL is [[unroll]] in GLSL (llvmpipe's loop limiter counts loop iterations) and
-// nothing in C++.
+// nothing in C++. The host's own division and square root are IEEE's, correctly rounded, so
+// C++ (DACRT_HOST_IEEE_ARITHMETIC) takes them: the same bits, several times faster;
+// tests/dacrt/test_secondary_rays.cpp compiles the integer versions too and checks them
+// against the host's on millions of operands.
 #ifndef DACRT_EXACT_MATH_GLSL
 #define DACRT_EXACT_MATH_GLSL
 
@@ -33,6 +36,9 @@ float packRounded(uint sign, int exponent, uint q, bool sticky) {
 // subnormal a reads as zero). Restoring division of the 24-bit significands: 25 quotient bits,
 // the remainder's being nonzero the sticky bit.
 float divideRounded(float a, float b) {
+#ifdef DACRT_HOST_IEEE_ARITHMETIC
+    return a / b;
+#else
     uint ua = floatBitsToUint(a);
     uint ub = floatBitsToUint(b);
     uint sign = (ua ^ ub) & kSignBit;
@@ -48,21 +54,23 @@ float divideRounded(float a, float b) {
     }
     uint q = 0u;
     uint r = ma;
-    DACRT_UNROLL for (int i = 0; i < 25; ++i) {
-        q <<= 1u;
-        if (r >= mb) {
-            r -= mb;
-            q |= 1u;
-        }
+    DACRT_UNROLL for (int i = 0; i < 25; ++i) {  // without branches: their outcome is a coin toss
+        uint take = r >= mb ? 1u : 0u;
+        r -= mb & (0u - take);
+        q = (q << 1u) | take;
         r <<= 1u;
     }
     return packRounded(sign, exponent, q, r != 0u);
+#endif
 }
 
 // sqrt(x), correctly rounded, for x zero or normal and non-negative (anything else gives 0).
 // Digit-by-digit integer square root of the significand shifted left by 25 (50 bits, taken
 // two at a time from a high and a low word): 25 root bits, the remainder the sticky bit.
 float sqrtRounded(float x) {
+#ifdef DACRT_HOST_IEEE_ARITHMETIC
+    return x > 0.0f ? sqrt(x) : 0.0f;
+#else
     uint ux = floatBitsToUint(x);
     uint ex = (ux >> 23u) & 0xFFu;
     if (ex == 0u || (ux & kSignBit) != 0u) return 0.0f;
@@ -80,23 +88,29 @@ float sqrtRounded(float x) {
         uint pair = 2 * i >= 32 ? (high >> uint(2 * i - 32)) & 3u : (low >> uint(2 * i)) & 3u;
         r = (r << 2u) | pair;
         uint trial = (q << 2u) | 1u;
-        if (r >= trial) {
-            r -= trial;
-            q = (q << 1u) | 1u;
-        } else {
-            q <<= 1u;
-        }
+        uint take = r >= trial ? 1u : 0u;
+        r -= trial & (0u - take);
+        q = (q << 1u) | take;
     }
     return packRounded(0u, (exponent >> 1) + 127, q, r != 0u);
+#endif
 }
 
+// Components below this are flushed to zero where a normal is made, so that no product of
+// up to three of them is subnormal: devices may flush subnormals, the host does not.
+const float kSmallestNormalComponent = 9.094947017729282e-13f;  // 2^-40
+
 // v / |v| for a vector whose largest component is normal and at most 2^63: scaled by a power
-// of two first (exact), so that the sum of squares neither overflows nor underflows.
+// of two first (exact), so that the sum of squares neither overflows nor underflows; components
+// below 2^-40 of the largest are flushed to zero.
 vec3 normalizeRounded(vec3 v) {
     float largest = max(abs(v.x), max(abs(v.y), abs(v.z)));
     uint e = (floatBitsToUint(largest) >> 23u) & 0xFFu;
     float scale = uintBitsToFloat(uint(254 - int(e)) << 23u);  // 2^(127 - e): largest * scale in [1, 2)
     precise vec3 s = v * scale;
+    if (abs(s.x) < kSmallestNormalComponent) s.x = 0.0f;
+    if (abs(s.y) < kSmallestNormalComponent) s.y = 0.0f;
+    if (abs(s.z) < kSmallestNormalComponent) s.z = 0.0f;
     precise float lengthSquared = s.x * s.x + s.y * s.y + s.z * s.z;
     float norm = sqrtRounded(lengthSquared);
     return vec3(divideRounded(s.x, norm), divideRounded(s.y, norm), divideRounded(s.z, norm));

@@ -27,12 +27,11 @@ void main() {
     if (i >= push.rayCount) return;
     Ray ray = rays[i];
     rayQueryEXT query;
-    // Opaque: the closest hit, no any-hit shaders. With single-sided triangles (dacrt's face
-    // rule), every candidate comes back here and is confirmed unless it is one's back face:
-    // per triangle, which the ray flag gl_RayFlagsCullBackFacingTrianglesEXT is not (and
-    // lavapipe, Mesa 25.0.7, ignores that flag: docs/skips.md).
-    // For any hit, the traversal ends at the first hit committed: the first opaque one found,
-    // or the first candidate confirmed below, so the face rule holds there too.
+    // Opaque: every hit found is committed, no any-hit shaders. With single-sided triangles
+    // (dacrt's face rule), every candidate comes back here and is confirmed unless it is one's
+    // back face: per triangle, which the ray flag gl_RayFlagsCullBackFacingTrianglesEXT is not
+    // (and lavapipe, Mesa 25.0.7, ignores that flag: docs/skips.md). For any hit, the traversal
+    // ends at the first hit committed, so the face rule holds there too.
     bool cull = push.cullBackFaces != 0u;
     uint flags = cull ? gl_RayFlagsNoOpaqueEXT : gl_RayFlagsOpaqueEXT;
     if (push.anyHit != 0u) flags |= gl_RayFlagsTerminateOnFirstHitEXT;

@@ -50,7 +50,7 @@ Ray segmentRay(vec3 origin, vec3 direction, float tmax) {
         ky = swap;
     }
     r.axes = uint(kx) | (uint(ky) << 2u) | (uint(kz) << 4u);
-    r.shear = vec3(divideRounded(d[kx], d[kz]), divideRounded(d[ky], d[kz]), divideRounded(1.0f, d[kz]));
+    r.shear = vec3(divideRounded(d[kx], d[kz]), divideRounded(d[ky], d[kz]), r.invDir[kz]);  // 1/d[kz] once
     r.pad1 = 0.0f;
     return r;
 }

@@ -134,8 +134,9 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
     switch (request.trace.backend) {
         case Backend::Gpu:
             if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
+            passSource_.reset();
             return traceGpu(geometry, request.trace, request.gpuTuning, *gpu_, threadPool, onPlan, pipelines_.get(),
-                            resident_.get());
+                            resident_.get(), request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
         case Backend::Embree:
             // Embree allocates its BVH itself: there is no plan to show or check.
         {
@@ -153,6 +154,38 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
         case Backend::Cpu: return traceCpu(geometry, request.trace, threadPool, onPlan, onProgress);
     }
     throw InternalError("unknown backend");
+}
+
+BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeometry& primary,
+                                                               const std::vector<Hit>& primaryHits,
+                                                               const SecondaryPass& pass, const BackendRequest& request,
+                                                               const PlanHook& onPlan) {
+    checkBackendRequest(request);
+    ThreadPool& threadPool = pool(threadsOf(request.trace));
+    PassTrace out;
+    if (request.trace.backend == Backend::Gpu) {
+        if (!gpu_ || !passSource_)
+            throw InternalError("a gpu secondary pass was asked for without a primary frame kept on the device");
+        out.result = traceGpuSecondary(*passSource_, primary, pass, request.trace, request.gpuTuning, *gpu_, threadPool,
+                                       onPlan, pipelines_.get());
+        for (const Hit& h : out.result.hits) out.rays += h.prim != kNotTracedPrim;
+        return out;
+    }
+    const auto start = Clock::now();
+    const SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
+    const double makeMs = msSince(start);
+    out.rays = rays.rays.size();
+    if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
+        out.result.hits = hitsPerSlot(rays, {});
+    } else {
+        FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays.rays, primary.sceneBox);
+        g.trianglesVersion = primary.trianglesVersion;
+        out.result = traceOnBackend(g, request, onPlan, {});
+        if (out.result.hits.empty()) return out;  // stopped at the plan
+        out.result.hits = hitsPerSlot(rays, out.result.hits);
+    }
+    out.result.phaseMs.insert(out.result.phaseMs.begin(), {"make rays", makeMs});
+    return out;
 }
 
 std::uint32_t BackendDispatcher::validationErrors() const { return gpu_ ? gpu_->validationErrors() : 0; }

@@ -14,6 +14,7 @@
 #include "dacrt/frame_geometry.hpp"
 #include "dacrt/memory_plan.hpp"
 #include "dacrt/options.hpp"
+#include "dacrt/secondary_rays.hpp"
 #include "dacrt/trace_result.hpp"
 #include "gpu/context.hpp"
 #include "gpu/gpu_tracer.hpp"
@@ -25,6 +26,8 @@ namespace dacrt {
 
 struct BackendRequest {
     TraceOptions trace;
+    // gpu: keep the frame's rays, hits and triangles on the device for traceSecondary.
+    bool keepForPasses = false;
     GpuTuning gpuTuning;        // gpu only
     EmbreeOptions embree;       // embree only (threads: the request's)
     RayQueryBuild rayQueryBuild = RayQueryBuild::Dynamic;  // rayquery only (bench: persistent scenes)
@@ -63,6 +66,18 @@ public:
     TraceResult trace(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan = {},
                       const ProgressHook& onProgress = {});
 
+    // A secondary pass of the frame the last trace() traced (with request.keepForPasses on
+    // gpu): its rays made from the primary hits (on the device for gpu, where the primary pass
+    // left them; on the host for the others) and traced for any hit by the same backend, over
+    // every triangle (no skips: a shadow may fall from anywhere). `primary` is the frame as
+    // given to trace(). Returns one hit per slot (hitsPerSlot) and the rays made.
+    struct PassTrace {
+        TraceResult result;
+        std::uint64_t rays = 0;
+    };
+    PassTrace traceSecondary(const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const SecondaryPass& pass,
+                             const BackendRequest& request, const PlanHook& onPlan = {});
+
     std::uint32_t validationErrors() const;
     // Under --validate: prints every validation message and returns kExitValidation when
     // there were errors; otherwise returns kExitSuccess.
@@ -78,6 +93,7 @@ private:
     std::unique_ptr<gpu::Context> gpu_;
     std::unique_ptr<gpu::PipelineCache> pipelines_;
     std::unique_ptr<gpu::ResidentTriangles> resident_;  // gpu: the triangles kept on the device
+    GpuPassSourcePtr passSource_;                       // gpu: the last frame kept for its secondary passes
 };
 
 }  // namespace dacrt

@@ -179,16 +179,26 @@ Subcommand addRenderCommand(CLI::App& app) {
     };
     auto s = std::make_shared<State>();
     RenderOptions& render = s->render;
-    CLI::App* cmd = app.add_subcommand("render", "trace primary rays through a glTF scene");
+    CLI::App* cmd = app.add_subcommand("render", "trace a glTF scene: primary rays, then shadow and occlusion rays");
     cmd->add_option("scene", render.scenePath, "glTF 2.0 scene (.gltf or .glb)")->required();
     cmd->add_option("--scene", render.sceneChoice, "which of the file's scenes, by index or name (default: the file's default scene; 'dacrt info' lists them)");
     cmd->add_option("--camera", render.cameraChoice, "which camera the scene places, by glTF camera index or name (default: the first; 'dacrt info' lists them)");
     cmd->add_option("-o,--output", render.outputPath, "shaded image (PNG or any OpenImageIO format)");
-    cmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id and hit mask");
+    cmd->add_option("--aov", render.aovPath, "EXR with depth, normal, primitive id, hit mask, albedo, and per light (shadow.K) and for --ao (ao) the secondary passes' visibility");
     cmd->add_option("--stats", render.statsPath, "JSON with timings, memory plan and counters");
     cmd->add_option("--spp", render.samplesPerPixel,
                     "samples per pixel of the shaded image, k x k strata (1, 4, 9, ...); AOVs keep the pixel centre")
         ->default_str("1");
+    cmd->add_option("--light", render.passes.lights,
+                    "a light, repeatable: point:X,Y,Z[:CANDELA[:R,G,B]], directional:DX,DY,DZ[:LUX[:R,G,B]] (the way it "
+                    "shines), or headlight (the unlit preview, no shadow rays); default: the scene's lights, else a key "
+                    "light over the first camera's left shoulder")
+        ->take_all();
+    cmd->add_option("--ao", render.passes.occlusionSamples,
+                    "ambient occlusion: rays per primary hit, cosine-distributed (0: none)")
+        ->check(CLI::Range(0u, 1024u))->default_str("0");
+    cmd->add_option("--ao-distance", render.passes.occlusionDistance,
+                    "length of the occlusion rays (default: a tenth of the scene box's diagonal)");
     cmd->add_option("--depth-png", render.depthPngPath, "viewable depth: near bright, far dark, misses black");
     cmd->add_option("--normal-png", render.normalPngPath, "viewable normals: n * 0.5 + 0.5 as RGB, misses black");
     addEnumOption(cmd, "--backend", render.request.trace.backend, "tracer");

@@ -13,6 +13,7 @@
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
 #include "core/image_io.hpp"
+#include "core/lights.hpp"
 #include "core/shading.hpp"
 #include "core/system_memory.hpp"
 #include "core/timing.hpp"
@@ -27,6 +28,7 @@ void checkRenderOptions(const RenderOptions& o) {
         throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
     checkBackendRequest(o.request);
     checkDeviceChoice(o.devices, {o.request.trace.backend});
+    checkPassOptions(o.passes);
     // With several cameras the files get "_camN" before the extension, in the same folder.
     checkOutputs({{"-o", o.outputPath, OutputFormat::Image},
                   {"--aov", o.aovPath, OutputFormat::Exr},
@@ -42,12 +44,15 @@ void checkRenderOptions(const RenderOptions& o) {
         throw InputError("--spp antialiases the shaded image; name it with -o (AOVs keep the pixel centre's sample)");
 }
 
-// What every camera of the orbit shares: the scene, its bounds and the cameras.
+// What every camera of the orbit shares: the scene, its bounds, the cameras and the lights
+// (fixed in the world: a key light follows the first camera only).
 struct PreparedScene {
     Scene scene;
     std::vector<Bounds> triangleBounds;
     Box box;
     std::vector<Camera> cameras;
+    std::vector<Light> lights;
+    bool headlight = false;
     double loadMs = 0.0;
     double prepareMs = 0.0;
 };
@@ -64,6 +69,7 @@ PreparedScene loadAndPrepare(const RenderOptions& o) {
     p.triangleBounds = allTriangleBounds(p.scene.triangles);
     p.box = sceneBounds(p.scene.triangles);
     p.cameras = makeCameras(p.scene, p.box, o.camera, double(o.width) / double(o.height));
+    p.lights = frameLights(p.scene, p.cameras.front(), p.box, o.passes.lights, p.headlight);
     p.prepareMs = msSince(prepareStart);
     return p;
 }
@@ -101,28 +107,81 @@ PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t r
     };
 }
 
+// Pipeline compilation within a trace: a cost of the process, not of the frame.
+double compiledMs(const TraceResult& r) {
+    double ms = 0.0;
+    for (const auto& [name, t] : r.phaseMs)
+        if (name == kPipelinePhase) ms += t;
+    return ms;
+}
+
+// A traced frame: the primary pass and its secondary passes.
+struct TracedFrame {
+    std::vector<Ray> rays;
+    TraceResult primary;
+    std::vector<TracedPass> passes;
+};
+
+// Traces one sample of a camera's frame: the primary rays through `offset` of each pixel, then
+// the secondary passes from their hits (seed: the occlusion sequence of this sample).
+TracedFrame traceFrame(const RenderOptions& o, const PreparedScene& p, const Camera& camera, glm::dvec2 offset,
+                       std::uint32_t seed, BackendDispatcher& backends, const PlanHook& onPlan, const ProgressHook& onProgress) {
+    TracedFrame f;
+    f.rays = primaryRays(camera, o.width, o.height, offset);
+    const FrameGeometry g = cameraFrame(o, p, camera, f.rays);
+    const std::vector<SecondaryPass> passes = secondaryPasses(p.lights, o.passes, p.box, seed);
+    BackendRequest request = o.request;
+    request.keepForPasses = !passes.empty();
+    f.primary = backends.trace(g, request, onPlan, onProgress);
+    if (f.primary.hits.empty()) return f;  // stopped at the plan
+    f.passes = traceSecondaryPasses(passes, g, f.primary.hits, backends, request, onPlan);
+    return f;
+}
+
 // The shaded image: the centre sample alone, or the mean of k x k strata per pixel (the extra
-// samples are traced here, by the same backend; their time is returned in `samplesMs`).
+// samples are traced here, by the same backend, secondary passes included; their time is
+// returned in `samplesMs`). The exposure is the centre sample's.
 std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScene& p, const Camera& camera,
-                                      const HitImage& centre, BackendDispatcher& backends, double& samplesMs) {
+                                      const HitImage& centre, const Lighting& lighting, BackendDispatcher& backends,
+                                      double& samplesMs) {
     samplesMs = 0.0;
-    if (o.samplesPerPixel == 1) return shadeImage(p.scene, centre);
+    if (o.samplesPerPixel == 1) return shadeImage(p.scene, centre, &lighting);
     const auto start = Clock::now();
     const int k = int(std::lround(std::sqrt(double(o.samplesPerPixel))));
     std::vector<glm::vec3> sum;
     for (int j = 0; j < k; ++j)
         for (int i = 0; i < k; ++i) {
-            const std::vector<Ray> rays = primaryRays(camera, o.width, o.height, {(i + 0.5) / k, (j + 0.5) / k});
-            const TraceResult r = backends.trace(cameraFrame(o, p, camera, rays), o.request);
-            accumulateShading(p.scene, HitImage{o.width, o.height, &rays, &r.hits}, 1.0f / float(k * k), sum);
+            const std::uint32_t seed = std::uint32_t(1 + j * k + i);
+            const TracedFrame f = traceFrame(o, p, camera, {(i + 0.5) / k, (j + 0.5) / k}, seed, backends, {}, {});
+            Lighting sample = lightingOf(p.lights, f.passes);
+            sample.exposure = lighting.exposure;
+            accumulateShading(p.scene, HitImage{o.width, o.height, &f.rays, &f.primary.hits}, 1.0f / float(k * k), sum,
+                              &sample);
         }
     samplesMs = msSince(start);
     return encodeSrgb8(sum);
 }
 
+// The AOV channels of the secondary passes: per light 1 where it reaches the pixel's surface
+// unshadowed, else 0; the open fraction of the occlusion rays.
+std::vector<AovChannel> visibilityChannels(const Lighting& lighting, std::size_t pixels) {
+    std::vector<AovChannel> channels;
+    for (std::size_t k = 0; k < lighting.shadows.size(); ++k) {
+        AovChannel c{"shadow." + std::to_string(k), std::vector<float>(pixels)};
+        for (std::size_t i = 0; i < pixels; ++i) c.values[i] = litBy(lighting, k, i) ? 1.0f : 0.0f;
+        channels.push_back(std::move(c));
+    }
+    if (lighting.occlusion) {
+        AovChannel c{"ao", std::vector<float>(pixels)};
+        for (std::size_t i = 0; i < pixels; ++i) c.values[i] = openFraction(lighting, i);
+        channels.push_back(std::move(c));
+    }
+    return channels;
+}
+
 // The shade and write stages of one camera, each file complete or absent. Appends the paths
 // written to `written`.
-void writeImages(const RenderOptions& o, const PreparedScene& p, int k, const HitImage& image,
+void writeImages(const RenderOptions& o, const PreparedScene& p, int k, const HitImage& image, const Lighting& lighting,
                  const std::vector<std::uint8_t>& shaded, std::vector<std::string>& written) {
     const int count = int(p.cameras.size());
     auto writeRgb = [&](const std::string& option, const std::vector<std::uint8_t>& rgb) {
@@ -133,7 +192,8 @@ void writeImages(const RenderOptions& o, const PreparedScene& p, int k, const Hi
     };
     writeRgb(o.outputPath, shaded);
     if (const std::string aov = pathForCamera(o.aovPath, k, count); !aov.empty()) {
-        writeThrough(aov, [&](const std::string& to) { writeAov(to, p.scene, image); });
+        const std::vector<AovChannel> extra = visibilityChannels(lighting, image.hits->size());
+        writeThrough(aov, [&](const std::string& to) { writeAov(to, p.scene, image, extra); });
         written.push_back(aov);
     }
     if (!o.depthPngPath.empty()) writeRgb(o.depthPngPath, depthPreview(image));
@@ -188,6 +248,17 @@ std::string pathForCamera(const std::string& path, int camera, int cameraCount) 
     return (p.parent_path() / (p.stem().string() + "_cam" + index + p.extension().string())).string();
 }
 
+// Under --plan: what each secondary pass will allocate at most (how many rays it makes
+// depends on the primary hits, which --plan does not trace).
+void printPassBounds(const RenderOptions& o, const PreparedScene& p, std::size_t primaryRays) {
+    for (const SecondaryPass& pass : secondaryPasses(p.lights, o.passes, p.box, 0)) {
+        const MemoryPlan bound = secondaryPassBound(pass, primaryRays, o.request.trace.backend);
+        std::cout << "pass '" << pass.name << "', after the primary pass: work plan:\n"
+                  << bound.describeWork() << "memory plan (at most; plus the buffers of a pass over every triangle):\n"
+                  << bound.describe();
+    }
+}
+
 int runRender(const RenderOptions& o) {
     checkRenderOptions(o);
     BackendDispatcher backends(o.devices, {o.request.trace.backend});
@@ -199,42 +270,57 @@ int runRender(const RenderOptions& o) {
     for (int k = 0; k < int(p.cameras.size()); ++k) {
         const Camera& camera = p.cameras[std::size_t(k)];
         const auto frameStart = Clock::now();
-        const std::vector<Ray> rays = primaryRays(camera, o.width, o.height);
-        const FrameGeometry g = cameraFrame(o, p, camera, rays);
-        const double prepareMs = p.prepareMs + msSince(frameStart);
+        const std::size_t pixels = std::size_t(o.width) * std::size_t(o.height);
+        const double prepareMs = p.prepareMs;
 
         const auto traceStart = Clock::now();
         const bool brute = o.request.trace.backend == Backend::Brute;
-        if (brute && !o.planOnly) announceBruteForce(p.scene.triangleCount(), rays.size(), BackendDispatcher::threadsOf(o.request.trace));
+        const std::vector<SecondaryPass> passes = secondaryPasses(p.lights, o.passes, p.box, 0);
+        std::size_t frameRays = pixels;
+        for (const SecondaryPass& pass : passes) frameRays += pixels * pass.raysPerHit;
+        if (brute && !o.planOnly) announceBruteForce(p.scene.triangleCount(), frameRays, BackendDispatcher::threadsOf(o.request.trace));
         Progress progress("dacrt render", 1);
-        const TraceResult result = backends.trace(g, o.request, planCheck(o, p, rays.size(), k),
-                                                  brute ? ProgressHook([&](double f) { progress.fraction(f, "brute force"); })
-                                                        : ProgressHook());
-        if (o.planOnly) continue;
+        const TracedFrame frame = traceFrame(o, p, camera, {0.5, 0.5}, 0, backends, planCheck(o, p, pixels, k),
+                                             brute ? ProgressHook([&](double f) { progress.fraction(f, "brute force"); })
+                                                   : ProgressHook());
+        if (o.planOnly) {
+            printPassBounds(o, p, pixels);
+            continue;
+        }
         // Pipeline compilation is a cost of the process, not of the frame: reported apart.
-        double compileMs = 0.0;
-        for (const auto& [name, ms] : result.phaseMs)
-            if (name == kPipelinePhase) compileMs += ms;
-        const double traceMs = msSince(traceStart) - compileMs;
+        double compileMs = compiledMs(frame.primary), passesMs = 0.0;
+        for (const TracedPass& t : frame.passes) {
+            passesMs += t.ms - compiledMs(t.result);
+            compileMs += compiledMs(t.result);
+        }
+        const double traceMs = msSince(traceStart) - compileMs - passesMs;  // the primary pass
 
-        const HitImage image{o.width, o.height, &rays, &result.hits};
+        const HitImage image{o.width, o.height, &frame.rays, &frame.primary.hits};
+        Lighting lighting = lightingOf(p.lights, frame.passes);
+        lighting.exposure = autoExposure(p.scene, image, lighting.lights);
         double samplesMs = 0.0;
         const std::vector<std::uint8_t> shaded =
-            o.outputPath.empty() ? std::vector<std::uint8_t>() : shadedImage(o, p, camera, image, backends, samplesMs);
+            o.outputPath.empty() ? std::vector<std::uint8_t>() : shadedImage(o, p, camera, image, lighting, backends, samplesMs);
         const auto writeStart = Clock::now();
-        writeImages(o, p, k, image, shaded, written);
+        writeImages(o, p, k, image, lighting, shaded, written);
         const double writeMs = msSince(writeStart);
         traceTimes.push_back(traceMs);
-        raysPerFrame = rays.size();
+        raysPerFrame = frame.rays.size();
         const double totalMs = (k == 0 ? p.loadMs + p.prepareMs : 0.0) + msSince(frameStart);
 
         writeStats(o, k, int(p.cameras.size()),
-                   RenderedFrame{p.scene, camera, k, rays.size(), result,
+                   RenderedFrame{p.scene, camera, k, frame.rays.size(), frame.primary,
                                  {{"load", p.loadMs}, {"prepare", prepareMs}, {"shader_compile", compileMs}, {"trace", traceMs},
-                                  {"antialiasing_samples", samplesMs}, {"write", writeMs}, {"total", totalMs}}},
+                                  {"secondary_passes", passesMs}, {"antialiasing_samples", samplesMs}, {"write", writeMs},
+                                  {"total", totalMs}},
+                                 &frame.passes, p.lights, lighting.exposure},
                    written);
         std::cerr << "dacrt: " << toString(o.request.trace.backend) << " camera " << k << ": "
-                  << p.scene.triangleCount() << " triangles, " << rays.size() << " rays, trace " << traceMs << " ms\n";
+                  << p.scene.triangleCount() << " triangles, " << frame.rays.size() << " rays";
+        for (const TracedPass& t : frame.passes) std::cerr << " + " << t.rays << " " << t.pass.name;
+        std::cerr << ", trace " << traceMs << " ms";
+        if (!frame.passes.empty()) std::cerr << " + " << passesMs << " ms";
+        std::cerr << "\n";
     }
     const int code = backends.validationEpilogue(std::cerr);
     if (!o.planOnly) reportRender(o, traceTimes, raysPerFrame, written);

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "cmd/backend_dispatcher.hpp"
+#include "cmd/frame_passes.hpp"
 #include "core/camera.hpp"
 
 namespace dacrt {
@@ -24,6 +25,7 @@ struct RenderOptions {
     DeviceChoice devices;     // gpu
     BackendRequest request;
     CameraOptions camera;
+    PassOptions passes;       // lights (shadow passes) and ambient occlusion
 };
 
 // With K cameras, each output name gets "_camN" before its extension.

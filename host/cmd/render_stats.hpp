@@ -18,6 +18,9 @@ struct RenderedFrame {
     std::size_t rayCount = 0;
     const TraceResult& result;
     std::vector<std::pair<std::string, double>> timingsMs;  // load, prepare, trace, write, total
+    const std::vector<TracedPass>* passes = nullptr;        // the secondary passes
+    std::vector<Light> lights;                              // the lights shaded with (none: headlight)
+    float exposure = 1.0f;
 };
 
 nlohmann::ordered_json renderStatsJson(const RenderOptions& options, const RenderedFrame& frame);

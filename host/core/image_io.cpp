@@ -1,6 +1,8 @@
 #include "core/image_io.hpp"
 #include "core/shading.hpp"
 
+#include <algorithm>
+#include <cstring>
 #include <limits>
 
 #include <OpenImageIO/imageio.h>
@@ -30,7 +32,7 @@ void writeRgb8(const std::string& path, int width, int height, const std::vector
     writePixels(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
 }
 
-void writeAov(const std::string& path, const Scene& scene, const HitImage& image) {
+void writeAov(const std::string& path, const Scene& scene, const HitImage& image, const std::vector<AovChannel>& extra) {
     struct Pixel {
         float z, nx, ny, nz;
         std::uint32_t primId;
@@ -49,13 +51,23 @@ void writeAov(const std::string& path, const Scene& scene, const HitImage& image
             p = Pixel{h.t, n.x, n.y, n.z, h.prim, 1.0f, h.u, h.v, albedo.r, albedo.g, albedo.b};
         }
     }
-    OIIO::ImageSpec spec(image.width, image.height, 11, OIIO::TypeDesc::FLOAT);
+    // Native per-channel formats, pixel by pixel: the fixed channels, then the extra ones.
+    const std::size_t stride = sizeof(Pixel) + extra.size() * sizeof(float);
+    std::vector<unsigned char> packed(pixels.size() * stride);
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        std::memcpy(&packed[i * stride], &pixels[i], sizeof(Pixel));
+        for (std::size_t c = 0; c < extra.size(); ++c)
+            std::memcpy(&packed[i * stride + sizeof(Pixel) + c * sizeof(float)], &extra[c].values.at(i), sizeof(float));
+    }
+    const int channels = 11 + int(extra.size());
+    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::FLOAT);
     spec.channelnames = {"Z", "N.X", "N.Y", "N.Z", "primId", "hit", "u", "v", "albedo.R", "albedo.G", "albedo.B"};
-    spec.channelformats.assign(11, OIIO::TypeDesc::FLOAT);
+    for (const AovChannel& c : extra) spec.channelnames.push_back(c.name);
+    spec.channelformats.assign(std::size_t(channels), OIIO::TypeDesc::FLOAT);
     spec.channelformats[4] = OIIO::TypeDesc::UINT32;
     spec.z_channel = 0;
     spec.attribute("compression", "zip");
-    writePixels(path, spec, OIIO::TypeDesc::UNKNOWN, pixels.data());
+    writePixels(path, spec, OIIO::TypeDesc::UNKNOWN, packed.data());
 }
 
 Aov readAov(const std::string& path) {
@@ -91,6 +103,16 @@ Aov readAov(const std::string& path) {
         aov.albedo.resize(n);
         if (!in->read_image(0, 0, albedo, albedo + 3, OIIO::TypeDesc::FLOAT, aov.albedo.data()))
             throw InputError(path + ": reading failed: " + in->geterror());
+    }
+    static const std::vector<std::string> fixed = {"Z", "N.X", "N.Y", "N.Z", "primId", "hit", "u", "v",
+                                                   "albedo.R", "albedo.G", "albedo.B"};
+    for (int c = 0; c < spec.nchannels; ++c) {
+        const std::string& name = spec.channelnames[std::size_t(c)];
+        if (std::find(fixed.begin(), fixed.end(), name) != fixed.end()) continue;
+        AovChannel extra{name, std::vector<float>(n)};
+        if (!in->read_image(0, 0, c, c + 1, OIIO::TypeDesc::FLOAT, extra.values.data()))
+            throw InputError(path + ": reading failed: " + in->geterror());
+        aov.extra.push_back(std::move(extra));
     }
     return aov;
 }

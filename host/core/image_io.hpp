@@ -19,7 +19,12 @@ void writeRgb8(const std::string& path, int width, int height, const std::vector
 // N.X N.Y N.Z (unit geometric normal), primId (exact uint32, 0xFFFFFFFF on a miss),
 // hit (1 or 0), u v (barycentric weights of the second and third vertex), albedo.R albedo.G
 // albedo.B (linear base colour: factor x texture x vertex colour; 0 on a miss).
-void writeAov(const std::string& path, const Scene& scene, const HitImage& image);
+// Then `extra` float channels, one value per pixel each (the secondary passes' visibility).
+struct AovChannel {
+    std::string name;
+    std::vector<float> values;
+};
+void writeAov(const std::string& path, const Scene& scene, const HitImage& image, const std::vector<AovChannel>& extra = {});
 
 struct Aov {
     int width = 0;
@@ -29,6 +34,7 @@ struct Aov {
     std::vector<std::uint32_t> primId;
     std::vector<float> hit;
     std::vector<glm::vec3> albedo;  // empty when the file has no albedo channels
+    std::vector<AovChannel> extra;  // the float channels after albedo.B, in the file's order
 };
 
 // Reads an AOV written by writeAov; throws InputError on a missing file, a non-image, or

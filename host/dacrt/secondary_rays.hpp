@@ -3,6 +3,7 @@
 // shaders/secondary_rays.glsl compiled as C++ (the gpu backend runs the same file on the
 // device, so both make the same rays bit for bit), and the pass's results slot by slot.
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -15,15 +16,18 @@
 namespace dacrt::shared {
 inline uint floatBitsToUint(float x) { return std::bit_cast<uint>(x); }
 inline float uintBitsToFloat(uint x) { return std::bit_cast<float>(x); }
+inline float sqrt(float x) { return std::sqrt(x); }
 #define precise
 #define IN(T) const T&
 #define DACRT_UNROLL
+#define DACRT_HOST_IEEE_ARITHMETIC
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-function"
 namespace {  // GLSL has no `inline`: internal linkage keeps one copy per translation unit legal
 #include "secondary_rays.glsl"
 }
 #pragma GCC diagnostic pop
+#undef DACRT_HOST_IEEE_ARITHMETIC
 #undef DACRT_UNROLL
 #undef IN
 #undef precise

@@ -28,16 +28,34 @@ CompareReport compareAovs(const Aov& a, const Aov& b, const CompareOptions& opti
     r.options = options;
     r.pixels = a.depth.size();
     r.perPixel.assign(r.pixels, PixelComparison::Identical);
+    std::vector<std::string> namesA, namesB;
+    for (const AovChannel& c : a.extra) namesA.push_back(c.name);
+    for (const AovChannel& c : b.extra) namesB.push_back(c.name);
+    if (namesA != namesB)
+        throw InputError("the images have different secondary-pass channels (shadow.*, ao): rendered with other "
+                         "lights or --ao?");
+    auto visibilityDiffers = [&](std::size_t i) {
+        for (std::size_t c = 0; c < a.extra.size(); ++c)
+            if (std::memcmp(&a.extra[c].values[i], &b.extra[c].values[i], sizeof(float)) != 0) return true;
+        return false;
+    };
     double sumSq = 0.0;
     std::uint64_t bothHit = 0;
     for (std::size_t i = 0; i < a.depth.size(); ++i) {
+        if (visibilityDiffers(i)) {
+            ++r.differingVisibility;
+            r.perPixel[i] = PixelComparison::Differs;
+        }
         const bool hitA = a.primId[i] != 0xFFFFFFFFu, hitB = b.primId[i] != 0xFFFFFFFFu;
         const bool samePrim = a.primId[i] == b.primId[i];
         const bool sameDepth = std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) == 0;
         r.differingPrimId += !samePrim;
         r.differingDepth += !sameDepth;
         r.differingHitMask += hitA != hitB;
-        if (samePrim && sameDepth) continue;
+        if (samePrim && sameDepth) {
+            r.realDifferences += r.perPixel[i] == PixelComparison::Differs;
+            continue;
+        }
         PixelComparison& kind = r.perPixel[i];
         kind = PixelComparison::Differs;
         if (hitA && hitB) {
@@ -45,8 +63,9 @@ CompareReport compareAovs(const Aov& a, const Aov& b, const CompareOptions& opti
             ++bothHit;
             sumSq += rel * rel;
             r.maxRelDepthDiff = std::max(r.maxRelDepthDiff, rel);
-            if (!samePrim && rel <= options.nearTieBound) kind = PixelComparison::NearTie;
-            if (samePrim && rel <= options.depthTolerance) kind = PixelComparison::ToleratedDepth;
+            const bool visible = !visibilityDiffers(i);
+            if (visible && !samePrim && rel <= options.nearTieBound) kind = PixelComparison::NearTie;
+            if (visible && samePrim && rel <= options.depthTolerance) kind = PixelComparison::ToleratedDepth;
         }
         r.nearTies += kind == PixelComparison::NearTie;
         r.toleratedDepth += kind == PixelComparison::ToleratedDepth;
@@ -80,6 +99,7 @@ std::string CompareReport::json() const {
     j["differing_prim_id"] = differingPrimId;
     j["differing_depth"] = differingDepth;
     j["differing_hit_mask"] = differingHitMask;
+    j["differing_visibility"] = differingVisibility;
     j["near_ties"] = nearTies;
     j["tolerated_depth"] = toleratedDepth;
     j["real_differences"] = realDifferences;
@@ -96,6 +116,7 @@ std::string CompareReport::text() const {
       << "differing prim id   " << differingPrimId << "\n"
       << "differing depth     " << differingDepth << " (bitwise)\n"
       << "differing hit mask  " << differingHitMask << "\n"
+      << "differing shadow/ao " << differingVisibility << " (secondary-pass channels, bitwise)\n"
       << "near ties           " << nearTies << " (prim id differs, depths within " << options.nearTieBound << " relative)\n"
       << "tolerated depth     " << toleratedDepth << " (same prim id, depths within " << options.depthTolerance
       << " relative)\n"

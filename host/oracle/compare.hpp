@@ -39,6 +39,7 @@ struct CompareReport {
     std::uint64_t differingHitMask = 0;  // one hits, the other misses
     std::uint64_t nearTies = 0;          // prim ids differ, depths within nearTieBound
     std::uint64_t toleratedDepth = 0;    // same prim id, depths within depthTolerance but not equal
+    std::uint64_t differingVisibility = 0;  // pixels whose secondary-pass channels (shadow.*, ao) differ
     std::uint64_t realDifferences = 0;   // pixels that are neither identical, near ties nor tolerated
     double maxRelDepthDiff = 0.0;        // over pixels both hit
     double rmsRelDepthDiff = 0.0;
@@ -51,6 +52,8 @@ struct CompareReport {
     std::string text() const;
 };
 
+// The secondary passes' channels (Aov::extra) are compared bitwise where both images have them:
+// a pixel where any differs is a real difference; a channel only one image has is an error.
 CompareReport compareAovs(const Aov& a, const Aov& b, const CompareOptions& options = {});
 
 // An 8-bit RGB picture of the comparison: image a's surfaces in grey (lit by their normals),
