@@ -60,6 +60,15 @@ ComputePipeline& PipelineCache::secondary() {
         values[DACRT_SPEC_MAX_DEPTH] = 1;  // the kernel has no traversal stack to size
         secondary_ = std::make_unique<ComputePipeline>(context_, secondarySpirv(), DACRT_BINDING_COUNT,
                                                        sizeof(SecondaryPush), values, "secondary");
+        // As prime() does for the kernel: a step that does nothing, so that lavapipe compiles now.
+        DacrtBindingSet set(context_, planDacrtBuffers(DacrtBufferCounts{
+                                          .rays = 1, .triangles = 1, .rayIds = 1, .triangleIds = 1, .regions = 1, .workItems = 1, .maxDepth = 0}));
+        set.bindTo(*secondary_);
+        DispatchRecorder recorder(context_, 1);
+        SecondaryPush push{};
+        push.step = 3;  // none of shaders/secondary.comp's steps
+        recorder.dispatch("prime", *secondary_, 1, &push);
+        recorder.submitAndWait();
     }
     return *secondary_;
 }

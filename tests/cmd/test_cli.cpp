@@ -138,7 +138,23 @@ INSTANTIATE_TEST_SUITE_P(
         BadCommand{"RegionsWithCpuSeq", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu-seq --regions 4 --axis x",
                    "--regions and --axis are not options of --backend cpu-seq"},
         BadCommand{"EmbreeFastOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --embree-fast", "--embree-fast"},
-        BadCommand{"CompareNotAnAov", "compare " + dacrt::test::fixture("bad_not_gltf.gltf") + " x.exr", "bad_not_gltf.gltf"}),
+        BadCommand{"CompareNotAnAov", "compare " + dacrt::test::fixture("bad_not_gltf.gltf") + " x.exr", "bad_not_gltf.gltf"},
+        BadCommand{"UnknownLightType", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light spot:0,1,2",
+                   "--light spot:0,1,2: not a light"},
+        BadCommand{"NanLight", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light point:nan,1,2",
+                   "'nan' is not a finite number"},
+        BadCommand{"LightTwoNumbers", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light directional:0,1",
+                   "needs three numbers"},
+        BadCommand{"ZeroLightDirection", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light directional:0,0,0",
+                   "the direction is zero"},
+        BadCommand{"NegativeIntensity", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light point:0,1,2:-3",
+                   "negative"},
+        BadCommand{"HeadlightAndALight",
+                   "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light headlight --light point:0,1,2",
+                   "headlight"},
+        BadCommand{"TooManyOcclusionRays", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --ao 5000", "--ao"},
+        BadCommand{"NegativeOcclusionDistance", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --ao 2 --ao-distance -1",
+                   "--ao-distance"}),
     [](const ::testing::TestParamInfo<BadCommand>& info) { return std::string(info.param.name); });
 
 TEST(Cli, HelpNamesChoicesAndExitCodes) {
@@ -516,4 +532,82 @@ TEST(Cli, PlanAndStatsListEverySkipWithItsCounts) {
     EXPECT_EQ(small.output.find("transfer pairs"), std::string::npos) << small.output;
     const CommandResult forced = run("render " + scene + " --size 48x32 --plan --no-skip subscenes");
     EXPECT_NE(forced.output.find("transfer pairs"), std::string::npos) << forced.output;
+}
+
+// Shadows and ambient occlusion through every DACRT backend: the shaded images and the AOVs
+// (depth, primitive, and the secondary passes' channels shadow.0 and ao) bit for bit alike;
+// the shadow falls somewhere and not everywhere; the occlusion is partial in creases.
+TEST(Cli, ShadowsAndOcclusionAreIdenticalOnEveryBackend) {
+    const std::string scene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
+    std::vector<std::string> backends = {"brute", "cpu-seq", "cpu"};
+    if (run("devices").code == 0) backends.push_back("gpu");
+    std::map<std::string, std::string> images;
+    for (const std::string& b : backends) {
+        const std::string png = temp("lit_" + b + ".png"), aov = temp("lit_" + b + ".exr"), stats = temp("lit_" + b + ".json");
+        const CommandResult r = run("render " + scene + " --size 48x36 --ao 4 --backend " + b + " -o " + png + " --aov " +
+                                    aov + " --stats " + stats + (b == "gpu" ? " --validate" : ""));
+        ASSERT_EQ(r.code, 0) << b << ": " << r.output;
+        std::ifstream f(png, std::ios::binary);
+        images[b] = std::string(std::istreambuf_iterator<char>(f), {});
+        std::ifstream js(stats);
+        const nlohmann::json j = nlohmann::json::parse(js);
+        ASSERT_EQ(j["passes"].size(), 3u) << b;  // primary, the key light's shadow, occlusion
+        EXPECT_EQ(j["passes"][1]["kind"], "shadow");
+        EXPECT_EQ(j["passes"][2]["kind"], "occlusion");
+        EXPECT_GT(j["passes"][1]["rays"], 0);
+        EXPECT_EQ(j["passes"][2]["slots"], 48 * 36 * 4);
+        if (b != "brute") {
+            const nlohmann::json c = nlohmann::json::parse(run("compare " + temp("lit_brute.exr") + " " + aov + " --json").output);
+            EXPECT_EQ(c["verdict"], "identical") << b;
+            EXPECT_EQ(c["differing_visibility"], 0) << b;
+        }
+    }
+    for (const std::string& b : backends) EXPECT_EQ(images[b], images["brute"]) << b << "'s image differs from brute's";
+    const dacrt::Aov aov = dacrt::readAov(temp("lit_cpu.exr"));
+    ASSERT_EQ(aov.extra.size(), 2u);
+    std::size_t lit = 0, shadowed = 0, partial = 0;
+    for (std::size_t i = 0; i < aov.hit.size(); ++i) {
+        if (aov.hit[i] == 0.0f) continue;
+        const float shadow = aov.extra[0].name == "shadow.0" ? aov.extra[0].values[i] : aov.extra[1].values[i];
+        const float ao = aov.extra[0].name == "ao" ? aov.extra[0].values[i] : aov.extra[1].values[i];
+        (shadow == 1.0f ? lit : shadowed) += 1;
+        partial += ao > 0.0f && ao < 1.0f;
+    }
+    EXPECT_GT(lit, aov.hit.size() / 4);
+    EXPECT_GT(shadowed, 20u);
+    EXPECT_GT(partial, 20u);
+}
+
+TEST(Cli, LightsComeFromTheFileOrTheCommandLineAndHeadlightTracesNoPass) {
+    const std::string scene = dacrt::test::fixture("quad_cameras_lights.gltf"), stats = temp("lights.json");
+    auto passes = [&](const std::string& options) {
+        const CommandResult r = run("render " + scene + " --size 16x12 --stats " + stats + " " + options);
+        EXPECT_EQ(r.code, 0) << r.output;
+        std::ifstream f(stats);
+        return nlohmann::json::parse(f);
+    };
+    const nlohmann::json file = passes("");
+    EXPECT_GE(file["lights"].size(), 1u);
+    EXPECT_EQ(file["passes"].size(), file["lights"].size() + 1);
+    const nlohmann::json named = passes("--light point:0,0,3:50:1,0.5,0.25 --light directional:0,0,-1");
+    ASSERT_EQ(named["lights"].size(), 2u);
+    EXPECT_EQ(named["lights"][0]["type"], "point");
+    EXPECT_EQ(named["lights"][0]["intensity"], 50.0);
+    EXPECT_EQ(named["lights"][1]["type"], "directional");
+    EXPECT_EQ(named["passes"].size(), 3u);
+    const nlohmann::json headlight = passes("--light headlight");
+    EXPECT_EQ(headlight["lights"].size(), 0u);
+    EXPECT_EQ(headlight["passes"].size(), 1u);
+    EXPECT_EQ(headlight["shading"]["model"], "headlight");
+    EXPECT_EQ(passes("--light headlight --ao 2")["passes"].size(), 2u);
+}
+
+TEST(Cli, PlanListsEverySecondaryPass) {
+    const std::string png = temp("plan_passes.png");
+    const CommandResult r = run("render " + std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb --size 16x8 --ao 3 --plan -o " + png);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("pass 'shadow: key light (default)'"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("pass 'occlusion'"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("384"), std::string::npos) << "16 x 8 pixels x 3 occlusion rays\n" << r.output;
+    EXPECT_FALSE(std::filesystem::exists(png));
 }
