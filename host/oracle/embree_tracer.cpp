@@ -20,7 +20,9 @@ namespace {
 
 // Large enough that the pool's hand-out of indices costs nothing next to the rays, small
 // enough that a frame of a few hundred thousand rays still balances over the threads.
+// Whole 16-wide packets, so that only a frame's last packet runs partly empty.
 constexpr std::size_t kRaysPerChunk = 4096;
+static_assert(kRaysPerChunk % 16 == 0);
 
 const char* errorName(RTCError code) {
     switch (code) {
@@ -117,7 +119,7 @@ RTCBuildQuality geometryQualityOf(EmbreeBuild build) {
 
 // dacrt's face rule (shaders/triangle_rules.glsl) as Embree 3 users apply it without a build
 // of their own (EMBREE_BACKFACE_CULLING is a compile-time option, off in Debian's): an
-// intersection filter that rejects the back faces of single-sided triangles. Called only for
+// intersection and occluded filter that rejects the back faces of single-sided triangles. Called only for
 // candidate hits, so a frame pays for it per hit found, not per test.
 void rejectCulledBackFaces(const RTCFilterFunctionNArguments* args) {
     const auto& triangles = *static_cast<const std::vector<Triangle>*>(args->geometryUserPtr);
@@ -132,9 +134,57 @@ void rejectCulledBackFaces(const RTCFilterFunctionNArguments* args) {
     }
 }
 
-Hit hitOf(float tfar, unsigned geomID, unsigned primID, float u, float v) {
-    if (geomID == RTC_INVALID_GEOMETRY_ID) return Hit{kNoHitT, kMissPrim, 0.0f, 0.0f};
+// Embree's end of a ray's segment: dacrt's whole ray (kNoHitT, finite only so that dacrt's
+// arithmetic stays finite) is Embree's unbounded one, so primary rays are traced as before.
+float segmentEnd(const Ray& ray) {
+    return ray.tmax == kNoHitT ? std::numeric_limits<float>::infinity() : ray.tmax;
+}
+
+// dacrt accepts only t > tmin while Embree's tnear is inclusive (t >= tnear). The two differ
+// only for a triangle through the point at exactly tmin, which for primary rays (tmin 0)
+// means a triangle through the eye, and for secondary rays (tmin 0, origins offset off their
+// surface) a triangle through the offset origin; that case is left to Embree rather than
+// nudging tnear, which would move every other answer too.
+RTCRay embreeRay(const Ray& ray) {
+    RTCRay r{};
+    r.org_x = ray.origin.x;
+    r.org_y = ray.origin.y;
+    r.org_z = ray.origin.z;
+    r.tnear = ray.tmin;
+    r.dir_x = ray.dir.x;
+    r.dir_y = ray.dir.y;
+    r.dir_z = ray.dir.z;
+    r.tfar = segmentEnd(ray);
+    r.mask = ~0u;
+    return r;
+}
+
+void setLane(RTCRay16& packet, int lane, const Ray& ray) {
+    const RTCRay r = embreeRay(ray);
+    packet.org_x[lane] = r.org_x;
+    packet.org_y[lane] = r.org_y;
+    packet.org_z[lane] = r.org_z;
+    packet.tnear[lane] = r.tnear;
+    packet.dir_x[lane] = r.dir_x;
+    packet.dir_y[lane] = r.dir_y;
+    packet.dir_z[lane] = r.dir_z;
+    packet.time[lane] = 0.0f;
+    packet.tfar[lane] = r.tfar;
+    packet.mask[lane] = r.mask;
+    packet.id[lane] = unsigned(lane);
+    packet.flags[lane] = 0;
+}
+
+Hit closestHitOf(const Ray& ray, float tfar, unsigned geomID, unsigned primID, float u, float v) {
+    if (geomID == RTC_INVALID_GEOMETRY_ID) return missHit(ray);
     return Hit{tfar, primID, u, v};  // Embree's u and v weight v1 and v2, as dacrt's do
+}
+
+// rtcOccluded marks an occluded ray by setting its tfar to -infinity and keeps nothing of the
+// hit; the segment's start is the one depth known to precede it.
+Hit occlusionOf(const Ray& ray, float tfar) {
+    if (tfar == -std::numeric_limits<float>::infinity()) return Hit{ray.tmin, kUnnamedHitPrim, 0.0f, 0.0f};
+    return missHit(ray);
 }
 
 }  // namespace
@@ -170,9 +220,11 @@ struct EmbreeScene::Impl {
         if (!error.empty()) throw std::runtime_error(error);
     }
 
-    void traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, std::vector<Hit>& hits) const;
-    void traceTile(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16],
-                   std::vector<Hit>& hits) const;
+    void traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, HitQuery query,
+                     std::vector<Hit>& hits) const;
+    // One packet: lane l traces rays[index[l]] where valid[l] is -1.
+    void tracePacket(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16], bool coherent,
+                     HitQuery query, std::vector<Hit>& hits) const;
 };
 
 EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOptions& options)
@@ -213,8 +265,12 @@ EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOpt
         impl_->check("rtcSetSharedGeometryBuffer(index)");
         if (options.faceFilter && singleSidedTriangles(triangles) > 0) {
             rtcSetGeometryUserData(geometry.get(), const_cast<std::vector<Triangle>*>(&triangles));
+            // Embree 3 calls a geometry's intersection filter from rtcIntersect only and its
+            // occluded filter from rtcOccluded only: the face rule needs both.
             rtcSetGeometryIntersectFilterFunction(geometry.get(), &rejectCulledBackFaces);
             impl_->check("rtcSetGeometryIntersectFilterFunction");
+            rtcSetGeometryOccludedFilterFunction(geometry.get(), &rejectCulledBackFaces);
+            impl_->check("rtcSetGeometryOccludedFilterFunction");
         }
         rtcCommitGeometry(geometry.get());
         impl_->check("rtcCommitGeometry");
@@ -243,69 +299,62 @@ double EmbreeScene::update() {
     return msSince(start);
 }
 
-void EmbreeScene::Impl::traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end,
+void EmbreeScene::Impl::traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, HitQuery query,
                                     std::vector<Hit>& hits) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     for (std::size_t i = begin; i < end; ++i) {
         const Ray& ray = rays[i];
-        RTCRayHit query{};
-        query.ray.org_x = ray.origin.x;
-        query.ray.org_y = ray.origin.y;
-        query.ray.org_z = ray.origin.z;
-        // dacrt accepts only t > tmin while Embree's tnear is inclusive (t >= tnear). The two
-        // differ only for a triangle through the point at exactly tmin, which for primary rays
-        // (tmin 0) means a triangle through the eye; that case is left to Embree rather than
-        // nudging tnear, which would move every other answer too.
-        query.ray.tnear = ray.tmin;
-        query.ray.dir_x = ray.dir.x;
-        query.ray.dir_y = ray.dir.y;
-        query.ray.dir_z = ray.dir.z;
-        query.ray.tfar = std::numeric_limits<float>::infinity();
-        query.ray.mask = ~0u;
-        query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        query.hit.primID = RTC_INVALID_GEOMETRY_ID;
-        query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(scene, &context, &query);
-        hits[i] = hitOf(query.ray.tfar, query.hit.geomID, query.hit.primID, query.hit.u, query.hit.v);
+        if (query == HitQuery::Any) {
+            RTCRay occlusion = embreeRay(ray);
+            rtcOccluded1(scene, &context, &occlusion);
+            hits[i] = occlusionOf(ray, occlusion.tfar);
+            continue;
+        }
+        RTCRayHit closest{};
+        closest.ray = embreeRay(ray);
+        closest.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        closest.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        closest.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(scene, &context, &closest);
+        hits[i] = closestHitOf(ray, closest.ray.tfar, closest.hit.geomID, closest.hit.primID, closest.hit.u, closest.hit.v);
     }
 }
 
-void EmbreeScene::Impl::traceTile(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16],
-                                  std::vector<Hit>& hits) const {
+void EmbreeScene::Impl::tracePacket(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16],
+                                    bool coherent, HitQuery query, std::vector<Hit>& hits) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    if (coherent) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     // Inactive lanes carry a copy of an active lane's ray (they are masked out, but their
-    // fields must still be finite); a tile with no active lane is skipped.
+    // fields must still be finite); a packet with no active lane is skipped.
     int active = 0;
     while (active < 16 && !valid[active]) ++active;
     if (active == 16) return;
+    auto rayOfLane = [&](int l) -> const Ray& { return rays[valid[l] ? index[l] : index[active]]; };
+    if (query == HitQuery::Any) {
+        alignas(64) RTCRay16 q;
+        for (int l = 0; l < 16; ++l) setLane(q, l, rayOfLane(l));
+        rtcOccluded16(valid, scene, &context, &q);
+        for (int l = 0; l < 16; ++l)
+            if (valid[l]) hits[index[l]] = occlusionOf(rays[index[l]], q.tfar[l]);
+        return;
+    }
     alignas(64) RTCRayHit16 q;
     for (int l = 0; l < 16; ++l) {
-        const Ray& ray = rays[valid[l] ? index[l] : index[active]];
-        q.ray.org_x[l] = ray.origin.x;
-        q.ray.org_y[l] = ray.origin.y;
-        q.ray.org_z[l] = ray.origin.z;
-        q.ray.tnear[l] = ray.tmin;  // see traceSingle
-        q.ray.dir_x[l] = ray.dir.x;
-        q.ray.dir_y[l] = ray.dir.y;
-        q.ray.dir_z[l] = ray.dir.z;
-        q.ray.time[l] = 0.0f;
-        q.ray.tfar[l] = std::numeric_limits<float>::infinity();
-        q.ray.mask[l] = ~0u;
-        q.ray.id[l] = unsigned(l);
-        q.ray.flags[l] = 0;
+        setLane(q.ray, l, rayOfLane(l));
         q.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
         q.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
         q.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
     }
     rtcIntersect16(valid, scene, &context, &q);
     for (int l = 0; l < 16; ++l)
-        if (valid[l]) hits[index[l]] = hitOf(q.ray.tfar[l], q.hit.geomID[l], q.hit.primID[l], q.hit.u[l], q.hit.v[l]);
+        if (valid[l])
+            hits[index[l]] = closestHitOf(rays[index[l]], q.ray.tfar[l], q.hit.geomID[l], q.hit.primID[l], q.hit.u[l], q.hit.v[l]);
 }
 
-TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool) const {
+TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool, HitQuery query,
+                               std::optional<std::uint32_t> imageWidth) const {
     TraceResult result;
     result.hits.resize(rays.size());
     result.threads = pool.size();
@@ -314,42 +363,57 @@ TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool) c
 
     // The pool's workers must not throw (nothing would catch it there), so the first
     // failure is kept and thrown from this thread once every chunk is done.
+    const bool packets = impl_->options.packets, any = query == HitQuery::Any;
+    const char* call = packets ? (any ? "rtcOccluded16" : "rtcIntersect16") : (any ? "rtcOccluded1" : "rtcIntersect1");
     std::mutex failureMutex;
     std::string failure;
     auto keepFailure = [&] {
-        const std::string error = impl_->pendingError(impl_->options.packets ? "rtcIntersect16" : "rtcIntersect1");
+        const std::string error = impl_->pendingError(call);
         if (error.empty()) return;
         std::lock_guard<std::mutex> lock(failureMutex);
         if (failure.empty()) failure = error;
     };
 
     const Clock::time_point start = Clock::now();
-    const std::size_t width = impl_->options.imageWidth ? impl_->options.imageWidth : 16;
-    const std::size_t height = (rays.size() + width - 1) / width;
-    if (!impl_->options.packets) {
-        const std::size_t chunks = (rays.size() + kRaysPerChunk - 1) / kRaysPerChunk;
-        pool.parallelFor(chunks, [&](std::size_t chunk, unsigned) {
-            const FlushDenormals ftz;
-            impl_->traceSingle(rays, chunk * kRaysPerChunk, std::min(rays.size(), (chunk + 1) * kRaysPerChunk), result.hits);
-            keepFailure();
-        });
-    } else {
-        // Tiles of 4x4 pixels; with no image width, 16 consecutive rays. A row of tiles per
-        // work unit.
-        const bool tiled = impl_->options.imageWidth != 0;
-        const std::size_t tileColumns = tiled ? (width + 3) / 4 : 1, tileRows = tiled ? (height + 3) / 4 : height;
+    const std::size_t width = imageWidth.value_or(impl_->options.imageWidth);
+    if (packets && width != 0) {
+        // Tiles of 4x4 pixels, a row of tiles per work unit: rays of one camera through
+        // neighbouring pixels, what the coherent flag is for.
+        const std::size_t height = (rays.size() + width - 1) / width;
+        const std::size_t tileColumns = (width + 3) / 4, tileRows = (height + 3) / 4;
         pool.parallelFor(tileRows, [&](std::size_t row, unsigned) {
             const FlushDenormals ftz;
             for (std::size_t column = 0; column < tileColumns; ++column) {
                 std::size_t index[16];
-                alignas(64) int valid[16];  // rtcIntersect16 wants the mask, like the packet, 64-byte aligned
+                alignas(64) int valid[16];  // the 16-wide calls want the mask, like the packet, 64-byte aligned
                 for (int l = 0; l < 16; ++l) {
-                    const std::size_t x = tiled ? column * 4 + std::size_t(l % 4) : std::size_t(l);
-                    const std::size_t y = tiled ? row * 4 + std::size_t(l / 4) : row;
+                    const std::size_t x = column * 4 + std::size_t(l % 4), y = row * 4 + std::size_t(l / 4);
                     index[l] = y * width + x;
                     valid[l] = x < width && index[l] < rays.size() ? -1 : 0;
                 }
-                impl_->traceTile(rays, index, valid, result.hits);
+                impl_->tracePacket(rays, index, valid, true, query, result.hits);
+            }
+            keepFailure();
+        });
+    } else {
+        // Rays that are not an image (secondary rays leave surfaces every way) have no
+        // neighbourhood to exploit: packets of 16 consecutive rays, without the coherent flag.
+        const std::size_t chunks = (rays.size() + kRaysPerChunk - 1) / kRaysPerChunk;
+        pool.parallelFor(chunks, [&](std::size_t chunk, unsigned) {
+            const FlushDenormals ftz;
+            const std::size_t begin = chunk * kRaysPerChunk, end = std::min(rays.size(), begin + kRaysPerChunk);
+            if (!packets) {
+                impl_->traceSingle(rays, begin, end, query, result.hits);
+            } else {
+                for (std::size_t first = begin; first < end; first += 16) {
+                    std::size_t index[16];
+                    alignas(64) int valid[16];
+                    for (int l = 0; l < 16; ++l) {
+                        index[l] = first + std::size_t(l);
+                        valid[l] = index[l] < end ? -1 : 0;
+                    }
+                    impl_->tracePacket(rays, index, valid, false, query, result.hits);
+                }
             }
             keepFailure();
         });
@@ -361,7 +425,7 @@ TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool) c
 
 TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool) {
     const EmbreeScene scene(*geometry.triangles, options);
-    TraceResult result = scene.trace(*geometry.rays, pool);
+    TraceResult result = scene.trace(*geometry.rays, pool, geometry.query, geometry.imageWidth);
     result.phaseMs.insert(result.phaseMs.begin(), {"build", scene.buildMs()});
     return result;
 }

@@ -3,7 +3,9 @@
 // triangles, traced with the same rays. Its answers are Embree's own (not watertight by
 // construction, ties between coincident triangles unspecified), so dacrt's benchmark
 // measures its error against the float64 reference like any other backend.
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/enum_names.hpp"
@@ -31,13 +33,17 @@ struct EmbreeOptions {
     bool robust = true;
     unsigned threads = 0;  // threads of Embree's BVH build; 0: every core
     EmbreeBuild build = EmbreeBuild::Dynamic;
-    // rtcIntersect16 on 4x4 pixel tiles with the coherent flag (primary rays); false: one
-    // rtcIntersect1 per ray.
+    // 16-wide packets (rtcIntersect16, rtcOccluded16): on 4x4 pixel tiles with the coherent
+    // flag where the rays are an image, else on runs of 16 consecutive rays; false: one
+    // rtcIntersect1 or rtcOccluded1 per ray.
     bool packets = true;
-    std::uint32_t imageWidth = 0;  // the rays' image width, for the tiles; 0: runs of 16 rays
-    // The face rule as an intersection filter where some triangles are single-sided (the
-    // rule every backend applies); false: both faces hit, Embree's fastest, which gives the
-    // same image wherever no back face is visible (closed meshes seen from outside).
+    // The rays' image width, for the tiles, where a trace names none; 0: not an image
+    // (secondary rays).
+    std::uint32_t imageWidth = 0;
+    // The face rule as intersection and occlusion filters where some triangles are
+    // single-sided (the rule every backend applies); false: both faces hit, Embree's fastest,
+    // which gives the same image wherever no back face is visible (closed meshes seen from
+    // outside).
     bool faceFilter = true;
 };
 
@@ -58,10 +64,16 @@ public:
     // Returns the milliseconds it took.
     double update();
 
-    // Closest hit of every ray (t > ray.tmin), traced on the pool's threads with flush-to-zero
-    // and denormals-are-zero on (restored afterwards: the same threads run dacrt). phaseMs
-    // holds {"trace", ms}; counters stay zero (Embree does not report them).
-    TraceResult trace(const std::vector<Ray>& rays, ThreadPool& pool) const;
+    // Every ray's answer within its segment (ray.tmin < t <= ray.tmax), traced on the pool's
+    // threads with flush-to-zero and denormals-are-zero on (restored afterwards: the same
+    // threads run dacrt). Closest: the closest hit (rtcIntersect), missHit(ray) for a miss.
+    // Any: occlusion (rtcOccluded), which stops at any hit and reports none of it: an occluded
+    // ray gets Hit{ray.tmin, kUnnamedHitPrim, 0, 0}, t being only a bound the hit lies beyond,
+    // an unoccluded one missHit(ray). imageWidth: the rays' image width (0: not an image), for
+    // a scene that traces both a camera's rays and secondary rays; unset: the options'.
+    // phaseMs holds {"trace", ms}; counters stay zero (Embree does not report them).
+    TraceResult trace(const std::vector<Ray>& rays, ThreadPool& pool, HitQuery query = HitQuery::Closest,
+                      std::optional<std::uint32_t> imageWidth = std::nullopt) const;
 
 private:
     struct Impl;
@@ -69,7 +81,8 @@ private:
     double buildMs_ = 0.0;
 };
 
-// A dynamic-scene frame: build, then trace. phaseMs holds {"build", ms} and {"trace", ms}.
+// A dynamic-scene frame: build, then trace the frame's rays for its query, in tiles where the
+// frame says its rays are an image. phaseMs holds {"build", ms} and {"trace", ms}.
 TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool);
 
 }  // namespace dacrt

@@ -3,6 +3,7 @@
 // with a message where ../shared is absent), and a procedural shapes scene.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -24,12 +25,11 @@ inline std::string sharedScene(const std::string& name) {
     if (var.empty()) GTEST_SKIP() << "../shared/scenes/" << name << " is absent (fresh clone): skipped"
 
 // Sphere, torus, box and cylinder on a floor: shared edges, silhouettes and occlusion.
-inline Scene shapesScene() {
+inline std::vector<Mesh> shapesMeshes() {
     Mesh floor = grid({-2, -1, 2}, {4, 0, 0}, {0, 0, -4}, 12, 12);
-    return sceneFromMeshes({icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 3), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 40, 16),
-                            box({-0.3f, -1.0f, -1.2f}, {0.4f, 0.6f, -0.6f}), cylinder({1.2f, -1.0f, -1.0f}, 0.3f, 1.5f, 24, 4),
-                            floor},
-                           "shapes");
+    return {icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 3), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 40, 16),
+            box({-0.3f, -1.0f, -1.2f}, {0.4f, 0.6f, -0.6f}), cylinder({1.2f, -1.0f, -1.0f}, 0.3f, 1.5f, 24, 4), floor};
 }
+inline Scene shapesScene() { return sceneFromMeshes(shapesMeshes(), "shapes"); }
 
 }  // namespace dacrt::test

@@ -2,6 +2,7 @@
 // Frames built from scenes for the tracer tests, and hit comparison.
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -93,6 +94,50 @@ inline SecondaryPass pointShadowPass(glm::vec3 position) {
     p.light.type = shared::kLightPoint;
     p.light.position = position;
     return p;
+}
+
+// A frame's primary hits (brute force's) and secondary passes made from them: the inputs on
+// which the peer backends (Embree, ray queries) are compared with brute force on rays that
+// leave surfaces.
+struct SecondaryPassSet {
+    std::string name;
+    Frame frame;
+    TraceResult primary;
+    std::vector<std::pair<std::string, SecondaryPass>> passes;
+
+    SecondaryPassSet(std::string setName, Scene scene, const CameraOptions& camera,
+                     std::vector<std::pair<std::string, SecondaryPass>> setPasses)
+        : name(std::move(setName)), frame(std::move(scene), 48, 36, camera), primary(frame.trace(Backend::Brute, 0, 2)),
+          passes(std::move(setPasses)) {}
+    SecondaryPassSet(const SecondaryPassSet&) = delete;
+};
+
+// The shapes from a raised camera (test_secondary_rays.cpp's view): ambient occlusion rays
+// 0.8 long (shorter than most gaps between the shapes, so the segment's end decides many
+// rays) and unbounded, and shadow rays towards a point light above the shapes and one among
+// them.
+inline SecondaryPassSet shapesSecondaryPasses() {
+    CameraOptions camera;
+    camera.eye = glm::dvec3(0.5, 1.5, 4.0);
+    return SecondaryPassSet("shapes", shapesScene(), camera,
+                            {{"occlusion 0.8", occlusionPass(4, 0.8f)},
+                             {"occlusion unbounded", occlusionPass(4, kNoHitT)},
+                             {"shadow, light above", pointShadowPass({0.3f, 1.6f, 0.4f})},
+                             {"shadow, light among the shapes", pointShadowPass({0.0f, -0.2f, 0.0f})}});
+}
+
+// The shapes under a single-sided ceiling whose front faces up, seen from below it, with a
+// point light above it: every shadow ray crosses the ceiling from behind (every surface lies
+// below the ceiling and within its extent, so the segment from a lit point to the light meets
+// it), and so do the upward occlusion rays. Without the face rule no shadow ray would be clear.
+inline SecondaryPassSet shapesUnderACeilingPasses() {
+    std::vector<Mesh> meshes = shapesMeshes();
+    meshes.push_back(grid({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, 4, 4));
+    CameraOptions camera;
+    camera.eye = glm::dvec3(0.5, 0.6, 4.0);
+    return SecondaryPassSet("shapes under a ceiling", sceneFromMeshes(meshes, "shapes under a ceiling"), camera,
+                            {{"occlusion unbounded", occlusionPass(4, kNoHitT)},
+                             {"shadow, light above the ceiling", pointShadowPass({0.3f, 2.0f, 0.4f})}});
 }
 
 // The same visibility (hit or not) ray by ray; reports the first few differing rays.
