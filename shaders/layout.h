@@ -166,7 +166,11 @@ struct SecondaryPush {
     uint axis;
     float margin;          // filterMargin of the frame
     uint firstInvocation;  // this dispatch's invocations are [firstInvocation, + its size)
+    uint firstSample;      // kPassOcclusion: the pass holds samples [firstSample, + raysPerHit) ...
+    uint samplesPerHit;    // ... of this many per hit: sample k of source s is stream s * samplesPerHit + k
     uint pad1;
+    uint pad2;
+    uint pad3;
 };
 
 // Counters the kernel adds to with atomics (32-bit: a frame stays far below 2^32 tests).
@@ -248,7 +252,8 @@ static_assert(offsetof(DacrtPush, rayTmin) == 36 && offsetof(DacrtPush, order) =
 static_assert(sizeof(ShadowLight) == 48 && offsetof(ShadowLight, type) == 12);
 static_assert(offsetof(ShadowLight, direction) == 16 && offsetof(ShadowLight, range) == 28);
 static_assert(offsetof(ShadowLight, cosOuterSquared) == 32);
-static_assert(sizeof(SecondaryPush) == 96 && offsetof(SecondaryPush, kind) == 48);
+static_assert(sizeof(SecondaryPush) == 112 && offsetof(SecondaryPush, kind) == 48);
+static_assert(offsetof(SecondaryPush, firstSample) == 92 && offsetof(SecondaryPush, samplesPerHit) == 96);
 static_assert(offsetof(SecondaryPush, sourceCount) == 56 && offsetof(SecondaryPush, occlusionDistance) == 64);
 static_assert(offsetof(SecondaryPush, sampleSeed) == 68 && offsetof(SecondaryPush, groups) == 76);
 static_assert(offsetof(SecondaryPush, axis) == 80 && offsetof(SecondaryPush, margin) == 84);

@@ -58,8 +58,9 @@ void makeRays(uint source) {
     uint group = min(source / band, push.groups - 1u);
     for (uint k = 0u; k < push.raysPerHit; ++k) {
         uint slot = source * push.raysPerHit + k;
+        uint stream = source * push.samplesPerHit + push.firstSample + k;
         GeneratedRay g = push.kind == kPassShadow ? shadowRay(surface, push.light)
-                                                  : occlusionRay(surface, slot, push.sampleSeed, push.occlusionDistance);
+                                                  : occlusionRay(surface, stream, push.sampleSeed, push.occlusionDistance);
         rays[slot] = g.ray;
         Hit start;
         start.t = g.traced ? g.ray.tmax : 0.0;

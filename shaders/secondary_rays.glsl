@@ -159,21 +159,21 @@ GeneratedRay shadowRay(IN(SurfaceSample) s, IN(ShadowLight) light) {
     return g;
 }
 
-// Occlusion ray `slot` (primary ray index * rays per hit + sample) of a surface: Malley's
+// Occlusion ray number `stream` (primary ray index * samples per hit + sample) of a surface: Malley's
 // method, a point uniform in the unit disk lifted to the hemisphere about the normal, which is
 // cosine-distributed. The disk point comes from rejection sampling of the square with the PCG
-// hash of the slot and the pass's seed (16 tries, then the pole: a chance of 2e-11); the
+// hash of the stream number and the pass's seed (16 tries, then the pole: a chance of 2e-11); the
 // tangent frame is Duff et al.'s ("Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017).
 // The direction is unit up to rounding, so t is a distance and the segment ends at segmentLength.
-GeneratedRay occlusionRay(IN(SurfaceSample) s, uint slot, uint seed, float segmentLength) {
+GeneratedRay occlusionRay(IN(SurfaceSample) s, uint stream, uint seed, float segmentLength) {
     if (!s.valid) return noRay();
-    uint stream = pcgHash(slot ^ pcgHash(seed));
+    uint hashed = pcgHash(stream ^ pcgHash(seed));
     float x = 0.0f;
     float y = 0.0f;
     float rr = 0.0f;
     for (uint attempt = 0u; attempt < 16u; ++attempt) {
-        precise float cx = 2.0f * unitInterval(pcgHash(stream + 2u * attempt)) - 1.0f;
-        precise float cy = 2.0f * unitInterval(pcgHash(stream + 2u * attempt + 1u)) - 1.0f;
+        precise float cx = 2.0f * unitInterval(pcgHash(hashed + 2u * attempt)) - 1.0f;
+        precise float cy = 2.0f * unitInterval(pcgHash(hashed + 2u * attempt + 1u)) - 1.0f;
         precise float cr = cx * cx + cy * cy;
         if (cr < 1.0f) {
             x = cx;

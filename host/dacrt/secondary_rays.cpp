@@ -19,9 +19,15 @@ ShadowLight shadowLightOf(const Light& light) {
     return s;
 }
 
+std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, std::uint32_t k) {
+    const std::uint32_t perHit = pass.samplesPerHit ? pass.samplesPerHit : pass.raysPerHit;
+    return primary * perHit + pass.firstSample + k;
+}
+
 std::uint64_t secondarySlots(const SecondaryPass& pass, std::uint64_t primaryRays) {
     const std::uint64_t slots = primaryRays * pass.raysPerHit;
-    if (pass.raysPerHit == 0 || slots > kMaxSecondarySlots)
+    const std::uint64_t streams = primaryRays * std::max(pass.raysPerHit, pass.samplesPerHit);
+    if (pass.raysPerHit == 0 || slots > kMaxSecondarySlots || streams > kMaxSecondarySlots)
         throw InputError(pass.name + ": " + std::to_string(primaryRays) + " pixels x " + std::to_string(pass.raysPerHit) +
                          " rays per hit is more than the " + std::to_string(kMaxSecondarySlots) +
                          " rays a pass can hold (32-bit slots); lower --size or --ao");
@@ -53,7 +59,8 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
                 const shared::GeneratedRay g =
                     pass.kind == shared::kPassShadow
                         ? shared::shadowRay(surface, pass.light)
-                        : shared::occlusionRay(surface, slot, pass.sampleSeed, pass.occlusionDistance);
+                        : shared::occlusionRay(surface, occlusionStream(pass, std::uint32_t(i), k), pass.sampleSeed,
+                                               pass.occlusionDistance);
                 if (!g.traced) continue;
                 out.rays[next] = g.ray;
                 out.slots[next++] = slot;

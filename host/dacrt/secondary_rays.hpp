@@ -42,13 +42,19 @@ struct SecondaryPass {
     std::string name;                        // "shadow (key light)", "occlusion"
     std::uint32_t kind = shared::kPassShadow;  // shared::kPassShadow or kPassOcclusion
     ShadowLight light{};                     // kPassShadow
-    std::uint32_t raysPerHit = 1;            // kPassOcclusion: samples per hit
+    std::uint32_t raysPerHit = 1;            // kPassOcclusion: samples per hit in this pass...
+    std::uint32_t firstSample = 0;           // ... [firstSample, + raysPerHit) of samplesPerHit
+    std::uint32_t samplesPerHit = 0;         // 0: raysPerHit (the pass holds every sample)
     float occlusionDistance = 0.0f;          // kPassOcclusion: the rays' length
     std::uint32_t sampleSeed = 0;            // kPassOcclusion: the sample sequence
 };
 
 // The light as the shadow pass traces it, in float32.
 ShadowLight shadowLightOf(const Light& light);
+
+// Sample k of primary ray i draws occlusion stream i * samplesPerHit + firstSample + k, so
+// that a pass split into batches of samples makes the rays the whole pass would.
+std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, std::uint32_t k);
 
 // The rays of a pass: one slot per primary ray and sample (slot = primary index * raysPerHit
 // + sample); slots without a ray (a miss, a surface the light cannot reach) are left out.

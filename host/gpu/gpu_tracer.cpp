@@ -392,6 +392,8 @@ SecondaryPush secondaryPush(const GpuPassSource& source, const SecondaryPass& pa
     push.kind = pass.kind;
     push.sourceCount = std::uint32_t(source.primaryRays);
     push.raysPerHit = pass.raysPerHit;
+    push.firstSample = pass.firstSample;
+    push.samplesPerHit = pass.samplesPerHit ? pass.samplesPerHit : pass.raysPerHit;
     push.occlusionDistance = pass.occlusionDistance;
     push.sampleSeed = pass.sampleSeed;
     push.regionCount = std::uint32_t(source.division.regions.size());

@@ -1,7 +1,9 @@
 // Secondary rays: the exact arithmetic they are made with, the origin offset, the sample
 // sequence, and brute / cpu-seq / cpu agreeing on rays that start on surfaces.
 #include <bit>
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include <gtest/gtest.h>
 
@@ -261,4 +263,33 @@ TEST(BackendsAgree, ShadowRaysTowardsPointAndDirectionalLights) {
             expectPassAgrees(pass, query == HitQuery::Closest);
         }
     }
+}
+
+TEST(SecondaryRays, ABatchOfSamplesMakesTheRaysTheWholePassWould) {
+    // The gpu splits an occlusion pass its device buffers cannot hold into batches of samples
+    // (cmd/frame_passes.cpp): each batch must draw the same random streams as the whole pass.
+    CameraOptions o;
+    o.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(shapesScene(), 24, 18, o);
+    const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
+    ThreadPool pool(2);
+    const SecondaryPass whole = occlusionPass(7, 0.8f);
+    const SecondaryRays all = makeSecondaryRays(whole, frame.rays, primary.hits, frame.scene.triangles, pool);
+    std::size_t compared = 0;
+    for (std::uint32_t first : {0u, 3u, 6u}) {
+        SecondaryPass batch = whole;
+        batch.firstSample = first;
+        batch.raysPerHit = std::min(3u, 7u - first);
+        batch.samplesPerHit = 7;
+        const SecondaryRays part = makeSecondaryRays(batch, frame.rays, primary.hits, frame.scene.triangles, pool);
+        ASSERT_EQ(part.slotCount, frame.rays.size() * batch.raysPerHit);
+        for (std::size_t r = 0; r < part.rays.size(); ++r) {
+            const std::uint32_t pixel = part.slots[r] / batch.raysPerHit, sample = first + part.slots[r] % batch.raysPerHit;
+            const auto at = std::lower_bound(all.slots.begin(), all.slots.end(), pixel * 7 + sample);
+            ASSERT_TRUE(at != all.slots.end() && *at == pixel * 7 + sample);
+            ASSERT_EQ(std::memcmp(&all.rays[std::size_t(at - all.slots.begin())], &part.rays[r], sizeof(Ray)), 0);
+            ++compared;
+        }
+    }
+    EXPECT_EQ(compared, all.rays.size());
 }
