@@ -96,6 +96,7 @@ ThreadPool& BackendDispatcher::pool(unsigned threads) {
 TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const BackendRequest& request,
                                      const PlanHook& onPlan, const ProgressHook& onProgress) {
     checkBackendRequest(request);
+    passSource_.reset();  // a later traceSecondary must not find an earlier frame's buffers
     ThreadPool& threadPool = pool(threadsOf(request.trace));
     if (isPeer(request.trace.backend)) return traceOnBackend(geometry, request, onPlan, onProgress);
 
@@ -134,7 +135,6 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
     switch (request.trace.backend) {
         case Backend::Gpu:
             if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
-            passSource_.reset();
             return traceGpu(geometry, request.trace, request.gpuTuning, *gpu_, threadPool, onPlan, pipelines_.get(),
                             resident_.get(), request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
         case Backend::Embree:
@@ -163,9 +163,9 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     checkBackendRequest(request);
     ThreadPool& threadPool = pool(threadsOf(request.trace));
     PassTrace out;
-    if (request.trace.backend == Backend::Gpu) {
-        if (!gpu_ || !passSource_)
-            throw InternalError("a gpu secondary pass was asked for without a primary frame kept on the device");
+    // On gpu the rays are made where the primary pass left its hits; a frame the skips left
+    // empty (no triangle: every primary ray misses) kept nothing there, and makes no ray.
+    if (request.trace.backend == Backend::Gpu && passSource_) {
         out.result = traceGpuSecondary(*passSource_, primary, pass, request.trace, request.gpuTuning, *gpu_, threadPool,
                                        onPlan, pipelines_.get());
         for (const Hit& h : out.result.hits) out.rays += h.prim != kNotTracedPrim;

@@ -68,7 +68,8 @@ public:
 
     // A secondary pass of the frame the last trace() traced (with request.keepForPasses on
     // gpu): its rays made from the primary hits (on the device for gpu, where the primary pass
-    // left them; on the host for the others) and traced for any hit by the same backend, over
+    // left them; on the host for the others, and for gpu where it kept nothing) and traced for
+    // any hit by the same backend, over
     // every triangle (no skips: a shadow may fall from anywhere). `primary` is the frame as
     // given to trace(). Returns one hit per slot (hitsPerSlot) and the rays made.
     struct PassTrace {

@@ -132,7 +132,7 @@ float autoExposure(const Scene& scene, const HitImage& image, const std::vector<
     if (lit.empty()) return 1.0f;
     const std::size_t k = lit.size() * 9 / 10;
     std::nth_element(lit.begin(), lit.begin() + std::ptrdiff_t(k), lit.end());
-    return float(0.8 / lit[k]);
+    return float(0.6 / lit[k]);
 }
 
 std::vector<std::uint8_t> shadeImage(const Scene& scene, const HitImage& image, const Lighting* lighting) {

@@ -33,7 +33,8 @@ struct Lighting {
 // cosine, unshadowed: glTF's units (candela, lux), its range and spot cone falloffs.
 glm::dvec3 illuminance(const Light& light, const glm::dvec3& point, const glm::dvec3& normal);
 
-// The scale that brings the 90th percentile of the lit pixels' unshadowed direct light to 0.8:
+// The scale that brings the 90th percentile of the lit pixels' unshadowed direct light to 0.6
+// (0.8 with the ambient term):
 // physical light units of any size give a viewable image, and the same primary hits give the
 // same scale whatever traced the shadows.
 float autoExposure(const Scene& scene, const HitImage& image, const std::vector<const Light*>& lights);

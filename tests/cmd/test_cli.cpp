@@ -611,3 +611,20 @@ TEST(Cli, PlanListsEverySecondaryPass) {
     EXPECT_NE(r.output.find("384"), std::string::npos) << "16 x 8 pixels x 3 occlusion rays\n" << r.output;
     EXPECT_FALSE(std::filesystem::exists(png));
 }
+
+// Looking away from the scene every triangle is skipped and every primary ray misses: the
+// secondary passes make no ray (on gpu, nothing was kept on the device to make them from).
+TEST(Cli, AFrameThatSeesNothingMakesNoSecondaryRays) {
+    const std::string scene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb", stats = temp("nothing.json");
+    std::vector<std::string> backends = {"cpu"};
+    if (run("devices").code == 0) backends.push_back("gpu");
+    for (const std::string& b : backends) {
+        const CommandResult r = run("render " + scene + " --size 16x12 --ao 2 --eye 100,0,0 --target 200,0,0 --backend " + b +
+                                    " --stats " + stats);
+        ASSERT_EQ(r.code, 0) << b << ": " << r.output;
+        std::ifstream f(stats);
+        const nlohmann::json j = nlohmann::json::parse(f);
+        ASSERT_EQ(j["passes"].size(), 3u);
+        for (std::size_t k = 1; k < 3; ++k) EXPECT_EQ(j["passes"][k]["rays"], 0) << b;
+    }
+}
