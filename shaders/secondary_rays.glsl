@@ -58,10 +58,12 @@ Ray segmentRay(vec3 origin, vec3 direction, float tmax) {
 // Wachter and Binder's origin offset ("A Fast and Robust Method for Avoiding
 // Self-Intersection", Ray Tracing Gems, 2019): each coordinate moves along the normal by
 // kOffsetSteps times the normal's component float32 steps (truncated: none where that is below
-// one), the steps counted at `reach`. Their steps are the point's own; here they are those of
-// the largest magnitude of that coordinate among the point and the triangle's vertices, because
-// the barycentric point's rounding grows with the vertices (a point near 0 on a large triangle
-// is not known to 0's precision), and no absolute offset is needed near the origin: nothing here
+// one), the steps counted at `reach`. Their steps are each coordinate's own; here they are those
+// of the largest coordinate magnitude among the point and the triangle's vertices, on every
+// axis, because the rounding that could bring the ray back is of that size: the barycentric
+// point's grows with the vertices (a point near 0 on a large triangle is not known to 0's
+// precision), and the watertight test mixes the axes (a triangle in the plane y = 0 is met with
+// the rounding of its x and z). No absolute offset is needed near the origin: nothing here
 // depends on the scene's scale.
 float offsetCoordinate(float p, float n, float reach) {
     int steps = int(kOffsetSteps * n);
@@ -107,13 +109,13 @@ SurfaceSample surfaceOfHit(IN(Ray) primary, IN(Hit) hit, IN(Triangle) tri) {
     if (!(max(abs(n.x), max(abs(n.y), abs(n.z))) >= 1.1754943508222875e-38f)) return s;
     vec3 unit = normalizeRounded(n);
     if (dot3(unit, primary.dir) > 0.0f) unit = -unit;
-    vec3 reach = vec3(largestMagnitude(p.x, tri.v0.x, tri.v1.x, tri.v2.x),
-                      largestMagnitude(p.y, tri.v0.y, tri.v1.y, tri.v2.y),
+    float reach = max(max(largestMagnitude(p.x, tri.v0.x, tri.v1.x, tri.v2.x),
+                          largestMagnitude(p.y, tri.v0.y, tri.v1.y, tri.v2.y)),
                       largestMagnitude(p.z, tri.v0.z, tri.v1.z, tri.v2.z));
     s.point = p;
     s.normal = unit;
-    s.origin = vec3(offsetCoordinate(p.x, unit.x, reach.x), offsetCoordinate(p.y, unit.y, reach.y),
-                    offsetCoordinate(p.z, unit.z, reach.z));
+    s.origin = vec3(offsetCoordinate(p.x, unit.x, reach), offsetCoordinate(p.y, unit.y, reach),
+                    offsetCoordinate(p.z, unit.z, reach));
     s.valid = true;
     return s;
 }

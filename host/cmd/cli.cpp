@@ -314,7 +314,7 @@ Subcommand addStressCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("stress", "try to break every backend numerically (docs/stability.md)");
     addBackendListOption(cmd, "--backends", stress.backends, "backends to run (default: brute,cpu-seq,cpu,gpu)",
                          dacrtBackendNames());
-    cmd->add_option("--families", stress.families, "case families (default: watertight,split-plane,degenerate)")
+    cmd->add_option("--families", stress.families, "case families (default: watertight,split-plane,degenerate,surface-rays)")
         ->check(CLI::IsMember(stressFamilies()))
         ->delimiter(',');
     cmd->add_option("--size", s->size, "small (the test suite's cases) or large")
@@ -348,7 +348,19 @@ Subcommand addBenchCommand(CLI::App& app) {
                          "rayquery with one that has ray query)", enumNameList<Backend>());
     addEnumOption(cmd, "--suite", bench.suite,
                   "sweep (every option value), peers (each DACRT default against every embree and rayquery mode), "
-                  "skips (each skip of the work plan off in turn) or table51 (the source's Table 5.1 and Figure 5.3)");
+                  "skips (each skip of the work plan off in turn), table51 (the source's Table 5.1 and Figure 5.3) or "
+                  "passes (a lit frame's primary, shadow and occlusion passes timed apart, checked against cpu-seq)");
+    CLI::Option* light = cmd->add_option("--light", bench.passes.lights,
+                                         "--suite passes: a light, repeatable, as render's --light (default: the "
+                                         "scene's lights, else a key light over the first camera's left shoulder)")
+                             ->take_all();
+    CLI::Option* ao = cmd->add_option("--ao", bench.passes.occlusionSamples,
+                                      "--suite passes: occlusion rays per primary hit (0: no occlusion pass)")
+                          ->check(CLI::Range(0u, 1024u))
+                          ->default_str("4");
+    CLI::Option* aoDistance = cmd->add_option("--ao-distance", bench.passes.occlusionDistance,
+                                              "--suite passes: length of the occlusion rays (default: a tenth of "
+                                              "the scene box's diagonal)");
     cmd->add_option("--orbit", bench.orbit, "K cameras on a circle about the vertical axis")->check(CLI::Range(1, 1000))->default_str("1");
     addCameraOptions(cmd, s->camera);
     cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
@@ -361,7 +373,10 @@ Subcommand addBenchCommand(CLI::App& app) {
     cmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
     cmd->add_flag("--no-cache", s->noCache, "always recompute the float64 reference");
     addDeviceOptions(cmd, bench.devices);
-    return {cmd, [s, cmd] {
+    return {cmd, [s, cmd, light, ao, aoDistance] {
+                if (s->bench.suite != BenchSuite::Passes && (light->count() || ao->count() || aoDistance->count()))
+                    throw InputError("--light, --ao and --ao-distance light the frames of --suite passes; the other "
+                                     "suites time primary rays alone");
                 parseSize(s->size, s->bench.width, s->bench.height);
                 applyCameraOptions(*cmd, s->camera, s->bench.camera);
                 s->bench.useCache = !s->noCache;

@@ -1,7 +1,9 @@
 // The stress suite (CTest label `stress`; docs/stability.md): the generators of `dacrt
 // stress` at their small size, run through every backend and every non-default option.
-// Each configuration must have 0 leaks, agree with brute force bit for bit and keep the tie
-// rule; every determinism check must hold; bad input must be refused with a message.
+// Each configuration must have 0 leaks and 0 self-intersections, agree with brute force bit for
+// bit (any-hit queries: in visibility) and keep the tie rule; every determinism check must
+// hold; bad input must be refused with a message.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +22,7 @@
 #include "core/procedural.hpp"
 #include "cmd/stress/stress.hpp"
 #include "support/frames.hpp"
+#include "dacrt/secondary_rays.hpp"
 
 using namespace dacrt;
 
@@ -55,6 +58,7 @@ const FamilyData& family(const std::string& name) {
 
 std::string describe(const StressTally& t) {
     std::string text = std::to_string(t.leaks) + " leaks of " + std::to_string(t.mustHit) + " must-hit rays, " +
+                       std::to_string(t.selfIntersections) + " self-intersections, " +
                        std::to_string(t.mismatches) + " differences from brute force, " +
                        std::to_string(t.tieViolations) + " tie-rule violations, " + std::to_string(t.errors) +
                        " errors in " + std::to_string(t.cases) + " cases;";
@@ -163,6 +167,94 @@ TEST(StressCases, CoincidentGroupsAreAnsweredByTheirLowestId) {
             for (const Hit& h : data.brute[i]) hitsOnGroups += h.prim == g.front();
     }
     EXPECT_GT(hitsOnGroups, 100u);  // the groups are actually hit, so the tie rule is exercised
+}
+
+// The surface-rays family starts rays where issue 18 asks: grazing, in creases, inside closed
+// meshes, on shared edges and vertices, at every scale and offset, as closest and any hits.
+TEST(StressCases, SurfaceRaysStartEverywhereTheIssueAsks) {
+    const FamilyData& data = family("surface-rays");
+    std::map<std::string, int> seen;
+    std::uint64_t grazing = 0, mustHitInCreases = 0, segments = 0;
+    for (const StressCase& c : data.cases) {
+        const bool any = c.name.ends_with(" any");
+        EXPECT_EQ(c.query, any ? HitQuery::Any : HitQuery::Closest) << c.name;
+        ++seen[any ? "any" : "closest"];
+        for (const char* label : {"icosphere", "cube", "torus", "knife", "crease 30deg", "crease 90deg",
+                                  "crease 150deg", "scale 0.0001 offset 0", "scale 1e+06 offset 1e+06",
+                                  "scale 100 offset 10000", " inside", " outside"})
+            if (c.name.find(label) != std::string::npos) ++seen[label];
+        for (const SurfaceStart& s : c.starts)
+            for (const char* kind : {"vertex", "edge at", "face at", "crease edge", "crease vertex", "crease 1 steps",
+                                     "crease 256 steps", "crease 4096 steps", "at the start", "behind the start plane",
+                                     "the wall"})
+                if (s.where.find(kind) != std::string::npos) ++seen[kind];
+        ASSERT_EQ(c.startOf.size(), c.rays.size()) << c.name;
+        for (std::size_t i = 0; i < c.rays.size(); ++i) {
+            segments += c.rays[i].tmax != kNoHitT;
+            mustHitInCreases += c.mustHit[i] && c.name.starts_with("crease");
+            if (c.startOf[i] == kNoSurfaceStart) continue;
+            const double sine = glm::dot(glm::normalize(glm::dvec3(c.rays[i].dir)), c.starts[c.startOf[i]].normal);
+            grazing += sine > 0.0 && sine < 1e-6;
+        }
+    }
+    for (const auto& [label, count] : seen) EXPECT_GT(count, 0) << label;
+    EXPECT_EQ(seen.size(), 25u);
+    EXPECT_GT(grazing, 1000u);           // marked rays leaving within 1e-6 rad of their surface
+    EXPECT_GT(mustHitInCreases, 1000u);  // rays and shadow rays towards the other face
+    EXPECT_GT(segments, 10000u);         // occlusion and shadow segments (tmax)
+    std::uint64_t rays = 0, mustHit = 0;
+    for (const StressCase& c : data.cases) {
+        rays += c.rays.size();
+        mustHit += c.mustHitCount();
+    }
+    EXPECT_GT(rays, 200000u);
+    EXPECT_GT(mustHit, 50000u);
+}
+
+// The marks are right and counted: rays from a sphere's inside have no self-intersection for
+// brute force, and the same rays moved back behind their surface hit the triangles they leave.
+TEST(StressCases, SelfIntersectionCountingCatchesOriginsBehindTheSurface) {
+    const FamilyData& data = family("surface-rays");
+    const StressConfig brute = defaultStressConfig(Backend::Brute);
+    for (const char* name : {"icosphere scale 1 offset 0 inside closest", "icosphere scale 1 offset 0 inside any"}) {
+        const auto it =
+            std::find_if(data.cases.begin(), data.cases.end(), [&](const StressCase& c) { return c.name == name; });
+        ASSERT_NE(it, data.cases.end()) << name;
+        const StressTally clean = tallyStressCase(*it, traceStressCase(*it, brute, test::testDispatcher()), nullptr);
+        EXPECT_EQ(clean.selfIntersections, 0u) << name << ": " << describe(clean);
+        EXPECT_EQ(clean.leaks, 0u) << name << ": " << describe(clean);
+        StressCase behind = *it;
+        for (std::size_t i = 0; i < behind.rays.size(); ++i) {
+            if (behind.startOf[i] == kNoSurfaceStart) continue;
+            const Ray& r = behind.rays[i];
+            const glm::vec3 origin(glm::dvec3(r.origin) - behind.starts[behind.startOf[i]].normal * 1e-3);
+            behind.rays[i] = shared::segmentRay(origin, r.dir, r.tmax);
+        }
+        const StressTally moved =
+            tallyStressCase(behind, traceStressCase(behind, brute, test::testDispatcher()), nullptr);
+        EXPECT_GT(moved.selfIntersections, behind.rays.size() / 4) << name << ": " << describe(moved);
+    }
+}
+
+// Any-hit queries are compared by visibility alone, and a hit counts as a self-intersection
+// only when it names a ruled-out triangle.
+TEST(StressCases, AnyHitCasesCompareVisibilityAndNamedTriangles) {
+    StressCase c{"surface-rays", "tally", {}, {}, {}, {}};
+    c.triangles.resize(3);
+    c.rays = {makeRay({0, 0, 0}, {1, 0, 0}), makeRay({0, 0, 0}, {0, 1, 0}), makeRay({0, 0, 0}, {0, 0, 1})};
+    c.mustHit = {0, 0, 1};
+    c.starts = {{"start", {1, 0, 0}, {1}}};
+    c.startOf = {0, 0, kNoSurfaceStart};
+    const std::vector<Hit> hits = {{1.0f, 2u, 0, 0}, {2.0f, 1u, 0, 0}, {3.0f, kUnnamedHitPrim, 0, 0}};
+    const std::vector<Hit> brute = {{0.5f, 0u, 0, 0}, {2.0f, 1u, 0, 0}, {3.0f, kMissPrim, 0, 0}};
+    c.query = HitQuery::Any;
+    StressTally t = tallyStressCase(c, hits, &brute);
+    EXPECT_EQ(t.mismatches, 1u);         // ray 2: a hit where brute force sees none
+    EXPECT_EQ(t.selfIntersections, 1u);  // ray 1 names triangle 1, ruled out
+    EXPECT_EQ(t.leaks, 0u);              // an unnamed hit is a hit
+    c.query = HitQuery::Closest;
+    t = tallyStressCase(c, hits, &brute);
+    EXPECT_EQ(t.mismatches, 2u);
 }
 
 // Stress cases: cameras inside closed meshes, rays in split planes, degenerate triangles,
@@ -300,6 +392,7 @@ TEST(StressCommand, PrintsTheTableAndWritesJson) {
     ASSERT_TRUE(j.contains("rows"));
     for (const nlohmann::json& row : j["rows"]) {
         EXPECT_EQ(row["leaks"], 0) << row.dump();
+        EXPECT_EQ(row["self_intersections"], 0) << row.dump();
         EXPECT_EQ(row["differ_from_brute"], 0) << row.dump();
         EXPECT_GT(row["rays"].get<int>(), 0) << row.dump();
     }

@@ -1,6 +1,7 @@
 #include "cmd/stress/stress.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -29,6 +30,20 @@ std::string describeHit(const Hit& h) {
     return text;
 }
 
+// The ray, and for one that starts on a surface, where and at what angle to the surface
+// (the elevation above the start triangle's plane) it leaves.
+std::string describeRay(const Ray& r, const SurfaceStart* start) {
+    char text[200];
+    std::snprintf(text, sizeof text, "(origin %.9g %.9g %.9g, dir %.9g %.9g %.9g, tmax %.9g)", double(r.origin.x),
+                  double(r.origin.y), double(r.origin.z), double(r.dir.x), double(r.dir.y), double(r.dir.z),
+                  double(r.tmax));
+    if (!start) return text;
+    const double sine = glm::dot(glm::normalize(glm::dvec3(r.dir)), start->normal);
+    char angle[48];
+    std::snprintf(angle, sizeof angle, ", elevation %.3g rad", std::asin(std::clamp(sine, -1.0, 1.0)));
+    return std::string(text) + " from " + start->where + angle;
+}
+
 StressConfig config(const std::string& name, bool isDefault, Backend backend) {
     StressConfig c;
     c.name = name;
@@ -54,6 +69,7 @@ void StressTally::add(const StressTally& o) {
     rays += o.rays;
     mustHit += o.mustHit;
     leaks += o.leaks;
+    selfIntersections += o.selfIntersections;
     mismatches += o.mismatches;
     tieViolations += o.tieViolations;
     errors += o.errors;
@@ -109,7 +125,9 @@ std::vector<StressConfig> stressConfigs(const std::vector<Backend>& backends, bo
 
 FrameGeometry stressGeometry(const StressCase& c, std::vector<Bounds>& bounds) {
     bounds = allTriangleBounds(c.triangles);
-    return frameGeometry(c.triangles, bounds, c.rays, sceneBounds(c.triangles));
+    FrameGeometry g = frameGeometry(c.triangles, bounds, c.rays, sceneBounds(c.triangles));
+    g.query = c.query;
+    return g;
 }
 
 std::vector<Hit> traceStressCase(const StressCase& c, const StressConfig& config, BackendDispatcher& backends) {
@@ -127,23 +145,29 @@ StressTally tallyStressCase(const StressCase& c, const std::vector<Hit>& hits, c
     auto example = [&](const std::string& what) {
         if (t.examples.size() < 5) t.examples.push_back(c.family + " / " + c.name + ": " + what);
     };
+    const bool anyHit = c.query == HitQuery::Any;
     for (std::size_t i = 0; i < c.rays.size(); ++i) {
+        const SurfaceStart* start =
+            i < c.startOf.size() && c.startOf[i] != kNoSurfaceStart ? &c.starts[c.startOf[i]] : nullptr;
         if (c.mustHit[i]) {
             ++t.mustHit;
             if (hits[i].prim == kMissPrim) {
                 ++t.leaks;
-                const Ray& r = c.rays[i];
-                char text[160];
-                std::snprintf(text, sizeof text, "ray %zu leaks (origin %.9g %.9g %.9g, dir %.9g %.9g %.9g)", i,
-                              double(r.origin.x), double(r.origin.y), double(r.origin.z), double(r.dir.x),
-                              double(r.dir.y), double(r.dir.z));
-                example(text);
+                example("ray " + std::to_string(i) + " leaks " + describeRay(c.rays[i], start));
             }
         }
-        if (reference && !sameBits(hits[i], (*reference)[i])) {
+        // An any-hit answer need not name its triangle (kUnnamedHitPrim); one that names a
+        // ruled-out triangle is a self-intersection all the same.
+        if (start && std::binary_search(start->ruledOut.begin(), start->ruledOut.end(), hits[i].prim)) {
+            ++t.selfIntersections;
+            example("ray " + std::to_string(i) + " hits " + describeHit(hits[i]) + ", ruled out, " +
+                    describeRay(c.rays[i], start));
+        }
+        if (reference && (anyHit ? (hits[i].prim == kMissPrim) != ((*reference)[i].prim == kMissPrim)
+                                 : !sameBits(hits[i], (*reference)[i]))) {
             ++t.mismatches;
             example("ray " + std::to_string(i) + ": " + describeHit(hits[i]) + ", brute force " +
-                    describeHit((*reference)[i]));
+                    describeHit((*reference)[i]) + (anyHit ? " (any hit)" : ""));
         }
     }
     std::map<std::uint32_t, std::uint32_t> lowestOfGroup;

@@ -1,6 +1,7 @@
 #pragma once
-// Runs the stress cases through the backends: leaks, disagreements with brute force and
-// tie-rule violations per configuration; the determinism checks; the `dacrt stress` command.
+// Runs the stress cases through the backends: leaks, self-intersections, disagreements with
+// brute force and tie-rule violations per configuration; the determinism checks; the `dacrt
+// stress` command.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -27,17 +28,20 @@ struct StressTally {
     std::uint64_t cases = 0;
     std::uint64_t rays = 0;
     std::uint64_t mustHit = 0;
-    std::uint64_t leaks = 0;          // a must-hit ray that reported a miss
-    std::uint64_t mismatches = 0;     // hit differs from brute force in any bit
-    std::uint64_t tieViolations = 0;  // a coincident group answered by other than its lowest id
-    std::uint64_t errors = 0;         // cases the backend refused or failed with an error
+    std::uint64_t leaks = 0;              // a must-hit ray that reported a miss
+    std::uint64_t selfIntersections = 0;  // a hit on a triangle the ray's surface start rules out
+    std::uint64_t mismatches = 0;         // hit differs from brute force in any bit (any hit: visibility)
+    std::uint64_t tieViolations = 0;      // a coincident group answered by other than its lowest id
+    std::uint64_t errors = 0;             // cases the backend refused or failed with an error
     double traceMs = 0.0;
     double slowestMs = 0.0;   // the slowest case: where a pathology would show
     std::string slowestCase;
     std::vector<std::string> examples;  // the first few failures, described
 
     void add(const StressTally& o);
-    bool clean() const { return leaks == 0 && mismatches == 0 && tieViolations == 0 && errors == 0; }
+    bool clean() const {
+        return leaks == 0 && selfIntersections == 0 && mismatches == 0 && tieViolations == 0 && errors == 0;
+    }
 };
 
 // A case's frame; `bounds` receives the triangle bounds and must outlive the frame.

@@ -11,7 +11,7 @@ std::size_t StressCase::mustHitCount() const {
     return std::size_t(std::count(mustHit.begin(), mustHit.end(), std::uint8_t(1)));
 }
 
-std::vector<std::string> stressFamilies() { return {"watertight", "split-plane", "degenerate"}; }
+std::vector<std::string> stressFamilies() { return {"watertight", "split-plane", "degenerate", "surface-rays"}; }
 
 StressCase determinismCase(StressSize size) {
     StressCase c{"determinism", "room with shapes from the centre", stress::trianglesOf(stress::roomWithShapes()), {}, {}, {}};
@@ -28,7 +28,10 @@ std::vector<StressCase> stressCases(const std::vector<std::string>& families, St
         if (f == "watertight") part = watertightCases(size, seed);
         else if (f == "split-plane") part = splitPlaneCases(size, seed);
         else if (f == "degenerate") part = degenerateCases(size, seed);
-        else throw InputError("stress: unknown family '" + f + "' (choose from watertight, split-plane, degenerate)");
+        else if (f == "surface-rays") part = surfaceCases(size, seed);
+        else
+            throw InputError("stress: unknown family '" + f +
+                             "' (choose from watertight, split-plane, degenerate, surface-rays)");
         for (StressCase& c : part) out.push_back(std::move(c));
     }
     return out;

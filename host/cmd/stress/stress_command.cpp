@@ -99,18 +99,18 @@ std::vector<StressRow> runConfigurations(const std::vector<StressConfig>& config
 bool printReport(const std::vector<StressRow>& rows, const std::vector<DeterminismResult>& determinism,
                  const StressCommand& command, const BackendDispatcher& dispatcher) {
     bool ok = true;
-    std::printf("%-38s %-12s %6s %9s %9s %6s %9s %5s %6s %9s  %s\n", "configuration", "family", "cases", "rays",
-                "must-hit", "leaks", "!= brute", "ties", "errors", "ms", "slowest case (ms)");
+    std::printf("%-38s %-12s %6s %9s %9s %6s %6s %9s %5s %6s %9s  %s\n", "configuration", "family", "cases", "rays",
+                "must-hit", "leaks", "self", "!= brute", "ties", "errors", "ms", "slowest case (ms)");
     for (const StressRow& r : rows) {
         const bool bad = !r.tally.clean();
         if (bad && r.isDefault) ok = false;
-        std::printf("%-38s %-12s %6llu %9llu %9llu %6llu %9llu %5llu %6llu %9.1f  %s (%.1f)%s\n",
+        std::printf("%-38s %-12s %6llu %9llu %9llu %6llu %6llu %9llu %5llu %6llu %9.1f  %s (%.1f)%s\n",
                     (r.config + (r.isDefault ? " (default)" : "")).c_str(), r.family.c_str(),
                     (unsigned long long)r.tally.cases, (unsigned long long)r.tally.rays,
                     (unsigned long long)r.tally.mustHit, (unsigned long long)r.tally.leaks,
-                    (unsigned long long)r.tally.mismatches, (unsigned long long)r.tally.tieViolations,
-                    (unsigned long long)r.tally.errors, r.tally.traceMs, r.tally.slowestCase.c_str(),
-                    r.tally.slowestMs, bad ? "  <-- FAILS" : "");
+                    (unsigned long long)r.tally.selfIntersections, (unsigned long long)r.tally.mismatches,
+                    (unsigned long long)r.tally.tieViolations, (unsigned long long)r.tally.errors, r.tally.traceMs,
+                    r.tally.slowestCase.c_str(), r.tally.slowestMs, bad ? "  <-- FAILS" : "");
     }
     for (const StressRow& r : rows)
         for (const std::string& e : r.tally.examples) std::printf("  %s: %s\n", r.config.c_str(), e.c_str());
@@ -137,7 +137,8 @@ void writeJson(const std::string& path, const std::vector<StressRow>& rows,
     for (const StressRow& r : rows)
         j["rows"].push_back({{"configuration", r.config}, {"default", r.isDefault}, {"family", r.family},
                              {"cases", r.tally.cases}, {"rays", r.tally.rays}, {"must_hit", r.tally.mustHit},
-                             {"leaks", r.tally.leaks}, {"differ_from_brute", r.tally.mismatches},
+                             {"leaks", r.tally.leaks}, {"self_intersections", r.tally.selfIntersections},
+                             {"differ_from_brute", r.tally.mismatches},
                              {"tie_violations", r.tally.tieViolations}, {"errors", r.tally.errors},
                              {"ms", r.tally.traceMs}, {"slowest_case", r.tally.slowestCase},
                              {"slowest_case_ms", r.tally.slowestMs}, {"examples", r.tally.examples}});
