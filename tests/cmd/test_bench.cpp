@@ -2,7 +2,9 @@
 // the promise that every backend's default has no real error against the float64 reference.
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -153,6 +155,116 @@ TEST(Bench, SkipsSuiteTurnsEachSkipOffAndEveryRowIsExact) {
                                             "cpu no-skip=frustum", "cpu no-skip=subscenes", "cpu no-skip=all",
                                             "embree default", "embree face-filter=off"};
     EXPECT_EQ(configs, expected);
+}
+
+// The rows of a --suite passes run, by series and then pass index.
+std::map<std::string, std::vector<nlohmann::json>> passRowsBySeries(const nlohmann::json& j) {
+    std::map<std::string, std::vector<nlohmann::json>> bySeries;
+    for (const auto& row : j["rows"]) bySeries[row["series"].get<std::string>()].push_back(row);
+    return bySeries;
+}
+
+// What every series of a passes run holds: the primary pass, a shadow pass per light, the
+// occlusion pass, then the frame (their sums), each timed and checked slot by slot.
+void expectPassRows(const std::vector<nlohmann::json>& rows, std::size_t lights, std::uint32_t ao, std::size_t pixels,
+                    int cameras) {
+    ASSERT_EQ(rows.size(), lights + 3);
+    const std::string series = rows.front()["series"];
+    double rays = 0.0, slots = 0.0;
+    for (std::size_t p = 0; p < rows.size(); ++p) {
+        const nlohmann::json& r = rows[p];
+        EXPECT_EQ(r["pass_index"].get<std::size_t>(), p) << series;
+        const std::string kind = r["pass_kind"];
+        EXPECT_EQ(kind, p == 0 ? "primary" : p <= lights ? "shadow" : p == lights + 1 ? "occlusion" : "frame") << series;
+        EXPECT_GT(r["ms_min"].get<double>(), 0.0) << series << " " << kind;
+        EXPECT_LE(r["ms_min"].get<double>(), r["ms_median"].get<double>()) << series << " " << kind;
+        const std::uint32_t perHit = kind == "occlusion" ? ao : 1;
+        if (kind != "frame") {
+            EXPECT_EQ(r["rays_per_hit"].get<std::uint32_t>(), perHit);
+            EXPECT_EQ(r["slots_per_frame"].get<double>(), double(pixels * perHit)) << series << " " << kind;
+            EXPECT_LE(r["rays_per_frame"].get<double>(), double(pixels * perHit)) << series << " " << kind;
+            rays += r["rays_per_frame"].get<double>();
+            slots += r["slots_per_frame"].get<double>();
+        } else {
+            EXPECT_DOUBLE_EQ(r["rays_per_frame"].get<double>(), rays) << series;
+            EXPECT_DOUBLE_EQ(r["slots_per_frame"].get<double>(), slots) << series;
+        }
+        EXPECT_EQ(r["checked_slots"].get<double>(), r["slots_per_frame"].get<double>() * cameras) << series << " " << kind;
+        if (r["exact_required"].get<bool>()) {
+            EXPECT_EQ(r["visibility_mismatches"].get<std::uint64_t>(), 0u) << series << " " << kind;
+        }
+    }
+    EXPECT_EQ(rows.front()["rays_per_frame"].get<double>(), double(pixels)) << series;  // a ray per pixel
+    EXPECT_GT(rows[lights + 1]["rays_per_frame"].get<double>(), 0.0) << series;       // the room's walls occlude
+}
+
+TEST(Bench, PassesSuiteTimesEachPassAndDacrtMatchesCpuSeqExactly) {
+    // The room from inside, lit by two lights (a point light under the ceiling, a directional
+    // light the ceiling shadows entirely), with occlusion; cpu-seq, the reference, is not named
+    // and runs first all the same.
+    const BenchOutputs out("passes");
+    const test::CommandResult r = test::runDacrt(
+        "bench " + roomScene() +
+        " --suite passes --backends cpu,embree --size 32x24 --orbit 2 --repeat 2 --warmup 0 --ao 2"
+        " --light point:0,2.2,0 --light directional:0.2,-1,0.1" +
+        out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("cpu-seq runs too"), std::string::npos) << r.output;
+    const nlohmann::json j = out.json();
+    EXPECT_EQ(j["command"]["suite"].get<std::string>(), "passes");
+    EXPECT_EQ(j["command"]["ao"].get<int>(), 2);
+    EXPECT_EQ(j["rows"].front()["series"].get<std::string>(), "cpu-seq");
+    EXPECT_EQ(lines(out.dir / "b.csv"), j["rows"].size() + 1);
+    const auto bySeries = passRowsBySeries(j);
+    const std::set<std::string> expected = {"cpu-seq", "cpu", "embree dynamic", "embree refit", "embree static"};
+    std::set<std::string> series;
+    for (const auto& [name, rows] : bySeries) {
+        series.insert(name);
+        expectPassRows(rows, 2, 2, 32 * 24, 2);
+        // A peer's build or refit is the primary pass's, reported apart; the others have none.
+        const bool rebuilds = name == "embree dynamic" || name == "embree refit";
+        EXPECT_EQ(rows.front()["build_ms"].is_number(), rebuilds) << name;
+        for (std::size_t p = 1; p < rows.size(); ++p) EXPECT_TRUE(rows[p]["build_ms"].is_null()) << name;
+        EXPECT_EQ(rows.front()["exact_required"].get<bool>(), name == "cpu-seq" || name == "cpu") << name;
+    }
+    EXPECT_EQ(series, expected);
+    // The floor faces the directional light: its pass makes rays (which the ceiling stops).
+    EXPECT_GT(bySeries.at("cpu")[2]["rays_per_frame"].get<double>(), 0.0);
+
+    // Its options belong to it alone.
+    const test::CommandResult other =
+        test::runDacrt("bench " + roomScene() + " --backends cpu-seq --size 16x12 --ao 2" + out.args());
+    EXPECT_EQ(other.code, 2);
+    EXPECT_NE(other.output.find("--suite passes"), std::string::npos) << other.output;
+    const test::CommandResult bad = test::runDacrt("bench " + roomScene() + " --suite passes --light sun:1" + out.args());
+    EXPECT_EQ(bad.code, 2);
+}
+
+TEST(Bench, PassesSuiteOnTheDeviceMatchesCpuSeqUnderValidation) {
+    DACRT_REQUIRE_GPU(gpu);
+    // rayquery too where the device has ray query (tools/mesa25.sh here).
+    const bool rayQuery = gpu->info().rayQuery;
+    const BenchOutputs out("passes_gpu");
+    const test::CommandResult r = test::runDacrt(
+        "bench " + roomScene() + " --suite passes --backends cpu-seq,gpu" + (rayQuery ? ",rayquery" : "") +
+        " --size 32x24 --repeat 1 --warmup 0 --ao 2 --validate" + out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json j = out.json();
+    EXPECT_EQ(j["validation_errors"].get<int>(), 0);
+    const auto bySeries = passRowsBySeries(j);
+    EXPECT_EQ(bySeries.size(), rayQuery ? 5u : 2u);
+    for (const auto& [name, rows] : bySeries) {
+        expectPassRows(rows, 1, 2, 32 * 24, 1);
+        // The device's own any-hit answers are counted, not required to match.
+        EXPECT_EQ(rows.front()["exact_required"].get<bool>(), name == "cpu-seq" || name == "gpu") << name;
+        if (name.rfind("rayquery", 0) == 0) {
+            EXPECT_EQ(rows.front()["build_ms"].is_number(), name != "rayquery static") << name;  // built before the frames
+        }
+        // The ray queries rebuild or refit in every trace call; the passes' share is not counted.
+        if (name == "rayquery dynamic") {
+            EXPECT_TRUE(rows[1]["parts_ms"].contains("not_counted_build_repeated_by_the_pass"));
+        }
+    }
 }
 
 TEST(Bench, OutputsDefaultToOneDirectoryAndAreCheckedFirst) {

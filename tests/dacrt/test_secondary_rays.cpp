@@ -250,9 +250,7 @@ TEST(BackendsAgree, ShadowRaysTowardsPointAndDirectionalLights) {
     o.eye = glm::dvec3(-1.0, 2.0, 4.0);
     const Frame frame(shapesScene(), 48, 36, o);
     const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
-    SecondaryPass directional = pointShadowPass({});
-    directional.light.type = shared::kLightDirectional;
-    directional.light.direction = glm::vec3(glm::normalize(glm::dvec3(0.4, -1.0, -0.3)));
+    const SecondaryPass directional = directionalShadowPass({0.4, -1.0, -0.3});
     for (const SecondaryPass& p : {pointShadowPass({0.3f, 1.6f, 0.4f}), pointShadowPass({0.0f, -0.2f, 0.0f}), directional}) {
         for (HitQuery query : {HitQuery::Closest, HitQuery::Any}) {
             const PassFrame pass(frame, primary.hits, p, query);

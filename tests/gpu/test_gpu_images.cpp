@@ -46,6 +46,13 @@ std::uint64_t expectGpuMatchesCpu(gpu::Context& context, const Frame& frame, std
     return transferWorkItems;
 }
 
+TraceOptions gpuOptions(unsigned regions) {
+    TraceOptions o;
+    o.backend = Backend::Gpu;
+    o.regions = regions;
+    return o;
+}
+
 // A frame seen from inside the scene through a 100-degree camera.
 Frame insideView(const std::vector<Mesh>& meshes, glm::dvec3 eye, glm::dvec3 target, int width, int height) {
     CameraOptions o;
@@ -82,11 +89,8 @@ TEST(GpuImages, RaysFromSurfacesInEveryDirection) {
             const TraceResult reference = pass.trace(Backend::CpuSeq);
             for (unsigned regions : {1u, 3u})
                 for (std::uint32_t groups : {1u, 2u}) {
-                    TraceOptions o;
-                    o.backend = Backend::Gpu;
-                    o.regions = regions;
                     ThreadPool pool(2);
-                    const TraceResult r = traceGpu(pass.geometry, o, GpuTuning{0, groups}, *context, pool);
+                    const TraceResult r = traceGpu(pass.geometry, gpuOptions(regions), GpuTuning{0, groups}, *context, pool);
                     EXPECT_TRUE(query == HitQuery::Closest ? identicalHits(reference.hits, r.hits)
                                                            : identicalVisibility(reference.hits, r.hits))
                         << regions << " regions, " << groups << " ray groups";
@@ -104,14 +108,10 @@ TEST(GpuImages, SecondaryPassesMadeOnTheDeviceMatchTheHost) {
     CameraOptions view;
     view.eye = glm::dvec3(-1.0, 2.0, 4.0);
     const Frame frame(shapes(), 40, 30, view);
-    SecondaryPass directional = pointShadowPass({});
-    directional.light.type = shared::kLightDirectional;
-    directional.light.direction = glm::vec3(glm::normalize(glm::dvec3(0.4, -1.0, -0.3)));
+    const SecondaryPass directional = directionalShadowPass({0.4, -1.0, -0.3});
     for (unsigned regions : {1u, 3u})
         for (std::uint32_t groups : {1u, 2u}) {
-            TraceOptions o;
-            o.backend = Backend::Gpu;
-            o.regions = regions;
+            const TraceOptions o = gpuOptions(regions);
             ThreadPool pool(2);
             GpuPassSourcePtr source;
             const TraceResult primary = traceGpu(frame.geometry, o, GpuTuning{0, groups}, *context, pool, {}, nullptr,

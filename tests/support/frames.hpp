@@ -140,6 +140,14 @@ inline SecondaryPassSet shapesUnderACeilingPasses() {
                              {"shadow, light above the ceiling", pointShadowPass({0.3f, 2.0f, 0.4f})}});
 }
 
+// A shadow pass towards a directional light shining along `direction`.
+inline SecondaryPass directionalShadowPass(glm::dvec3 direction) {
+    SecondaryPass p = pointShadowPass({});
+    p.light.type = shared::kLightDirectional;
+    p.light.direction = glm::vec3(glm::normalize(direction));
+    return p;
+}
+
 // The same visibility (hit or not) ray by ray; reports the first few differing rays.
 inline ::testing::AssertionResult identicalVisibility(const std::vector<Hit>& a, const std::vector<Hit>& b) {
     if (a.size() != b.size()) return ::testing::AssertionFailure() << "sizes " << a.size() << " and " << b.size();
