@@ -373,6 +373,9 @@ void divideForSecondaryRays(GpuPassSource& source, const FrameGeometry& frame, c
     FrameGeometry triangles = frame;
     triangles.rays = &noRays;
     triangles.tracedTriangles = nullptr;
+    // The margin the kernel and the device's ray binning filter with: triangles straddle by it.
+    source.margin = secondaryMargin(frame.sceneBox);
+    triangles.margin = source.margin;
     MemoryPlan unused;
     source.division = divideScene(triangles, regions, axis, pool, unused);
     const std::uint32_t groups = tuning.rayGroups ? tuning.rayGroups : gpu::defaultRayGroups(device, regions);
@@ -381,7 +384,6 @@ void divideForSecondaryRays(GpuPassSource& source, const FrameGeometry& frame, c
     source.triangleIds = std::make_unique<gpu::Buffer>(context, std::max<std::uint64_t>(ids.size(), 1) * 8,
                                                        "triangle ids and scratch (secondary passes)");
     source.triangleIds->upload(ids.data(), ids.size() * sizeof(std::uint32_t));
-    source.margin = secondaryMargin(frame.sceneBox);
     source.divided = true;
     result.phaseMs.emplace_back("divide", msSince(start));
 }

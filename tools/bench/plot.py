@@ -7,6 +7,10 @@ joined by a step line, the default configuration ringed.
     tools/bench/plot.py bench.json -o out.png                  # one scene: out.png; several: out_<scene>.png
     tools/bench/plot.py bench.json --check -o out.png          # also fail unless the JSON is complete
 
+A `--suite passes` run gives one PNG per scene and pass (`<scene>_primary`, `<scene>_shadow1`, ...,
+`<scene>_frame`): each configuration's pass time against the fraction of its slots whose answer
+differs from cpu-seq's.
+
 Needs matplotlib (Debian: python3-matplotlib; run it with /usr/bin/python3).
 """
 import argparse
@@ -27,12 +31,39 @@ import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
 REQUIRED = ("scene", "series", "config", "default", "frame_ms_min", "real_error_fraction", "pareto")
+PASSES_REQUIRED = ("scene", "series", "config", "default", "pass_index", "pass_kind", "ms_min", "mismatch_fraction")
+AXES = {"x": "frame time, ms (each camera's min of repeats, mean over the orbit)",
+        "y": "pixels with a real error (fraction)", "title": "frame time against error"}
+PASSES_AXES = {"x": "pass time, ms (each camera's min of repeats, mean over the orbit)",
+               "y": "slots whose answer differs from cpu-seq's (fraction)", "title": "pass time against differences"}
+
+
+def passes_as_plot_rows(rows, check, path):
+    """A `--suite passes` run: one plot per scene and pass, its time against the fraction of
+    slots that differ from cpu-seq's (each series holds one configuration: its own front)."""
+    out = []
+    for i, r in enumerate(rows):
+        missing = [k for k in PASSES_REQUIRED if k not in r]
+        if missing:
+            sys.exit(f"{path}: row {i} lacks {', '.join(missing)}")
+        name = r["pass_kind"] if r["pass_kind"] in ("primary", "frame") else f"{r['pass_kind']}{r['pass_index']}"
+        out.append(dict(r, scene=f"{r['scene']}_{name}", frame_ms_min=r["ms_min"],
+                        real_error_fraction=r["mismatch_fraction"], pareto=True))
+    if check:
+        for i, r in enumerate(out):
+            if not (r["frame_ms_min"] > 0 and 0 <= r["real_error_fraction"] <= 1):
+                sys.exit(f"{path}: row {i} has a time or difference outside the axes")
+    return out
 
 
 def load_rows(path, check):
     with open(path) as f:
         bench = json.load(f)
     rows = bench.get("rows", [])
+    if check and not rows:
+        sys.exit(f"{path}: no rows")
+    if bench.get("command", {}).get("suite") == "passes":
+        return bench, passes_as_plot_rows(rows, check, path), PASSES_AXES
     if check:
         if not rows:
             sys.exit(f"{path}: no rows")
@@ -42,7 +73,7 @@ def load_rows(path, check):
                 sys.exit(f"{path}: row {i} lacks {', '.join(missing)}")
             if not (r["frame_ms_min"] > 0 and 0 <= r["real_error_fraction"] <= 1):
                 sys.exit(f"{path}: row {i} has a time or error outside the axes")
-    return bench, rows
+    return bench, rows, AXES
 
 
 def output_paths(json_path, out, scenes):
@@ -54,7 +85,7 @@ def output_paths(json_path, out, scenes):
     return {s: f"{stem}_{s}{ext or '.png'}" for s in scenes}
 
 
-def plot_scene(scene, rows, command, path):
+def plot_scene(scene, rows, command, path, axes):
     # Errors are drawn on a log axis; a zero error sits in a band of its own below the floor.
     nonzero = [r["real_error_fraction"] for r in rows if r["real_error_fraction"] > 0]
     floor = min(min(nonzero) / 3, 1e-7) if nonzero else 1e-7
@@ -100,11 +131,11 @@ def plot_scene(scene, rows, command, path):
     ticks = [t for t in ax.get_yticks() if floor <= t <= 1.0]
     ax.set_yticks([zero_y] + ticks)
     ax.set_yticklabels(["0"] + [f"$10^{{{int(round(math.log10(t)))}}}$" for t in ticks])
-    ax.set_xlabel("frame time, ms (each camera's min of repeats, mean over the orbit)")
-    ax.set_ylabel("pixels with a real error (fraction)")
+    ax.set_xlabel(axes["x"])
+    ax.set_ylabel(axes["y"])
     size = command.get("size", "?")
     orbit = command.get("orbit", "?")
-    ax.set_title(f"{scene}: frame time against error ({size}, {orbit} cameras)")
+    ax.set_title(f"{scene}: {axes['title']} ({size}, {orbit} cameras)")
     ax.grid(True, which="major", color="0.85", linewidth=0.6)
     ax.legend(loc="upper right", fontsize=8, title="filled: Pareto front; ringed: default")
     fig.tight_layout()
@@ -119,13 +150,13 @@ def main():
     parser.add_argument("-o", "--output", help="PNG path (default: bench.png beside the JSON)")
     parser.add_argument("--check", action="store_true", help="refuse a JSON with missing or out-of-range fields")
     args = parser.parse_args()
-    bench, rows = load_rows(args.json, args.check)
+    bench, rows, axes = load_rows(args.json, args.check)
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     if not scenes:
         sys.exit(f"{args.json}: nothing to plot")
     written = []
     for scene, path in output_paths(args.json, args.output, scenes).items():
-        plot_scene(scene, [r for r in rows if r["scene"] == scene], bench.get("command", {}), path)
+        plot_scene(scene, [r for r in rows if r["scene"] == scene], bench.get("command", {}), path, axes)
         written.append(path)
     print("plot.py: wrote " + ", ".join(written))
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the current figures of docs/benchmarks.md (after `bash .ci/setup`; needs
 # ../shared/scenes): the peers on both lavapipes, the gpu defaults on Mesa 25.0.7 and the
-# source's Table 5.1, the cpu backends' options and SIMD targets. About 30 minutes on the
-# 2-core VM (the Bunny's ray queries take 6 of them, the cpu sweep 9). Then `python3 tools/bench/tables.py update docs/benchmarks.md` refreshes the tables.
+# source's Table 5.1, a lit frame's passes, the cpu backends' options and SIMD targets. About
+# 45 minutes on the 2-core VM (the Bunny's ray queries take 15 of them, the cpu sweep 9). Then `python3 tools/bench/tables.py update docs/benchmarks.md` refreshes the tables.
 # The older option sweeps and Figure 5.3 there came from the sweep commands at the end
 # (about 40 minutes more), run only with ALL=1.
 set -euo pipefail
@@ -24,6 +24,13 @@ tools/mesa25.sh build/dacrt bench $S/bunny.glb $S/dragon.glb --backends gpu --or
   --csv $out/gpu_sweep_mesa25.csv --json $out/gpu_sweep_mesa25.json | tee $out/gpu_sweep_mesa25.txt
 "${mesa22[@]}" build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --orbit 4 --repeat 2 \
   --csv $out/table51.csv --json $out/table51.json | tee $out/table51.txt
+# A lit frame's passes timed apart (the primary pass, the default key light's shadow pass, 4
+# occlusion rays per hit), each checked against cpu-seq's, on both lavapipes, one camera (the
+# front view): 3 and 10 minutes, the Mesa 25.0.7 run mostly the Bunny's ray queries.
+"${mesa22[@]}" build/dacrt bench $S/bunny.glb $S/dragon.glb scenes/room.glb --suite passes --backends cpu-seq,cpu,gpu,embree \
+  --ao 4 --repeat 3 --csv $out/passes_mesa22.csv --json $out/passes_mesa22.json | tee $out/passes_mesa22.txt
+tools/mesa25.sh build/dacrt bench $S/bunny.glb $S/dragon.glb scenes/room.glb --suite passes --ao 4 --repeat 3 \
+  --csv $out/passes_mesa25.csv --json $out/passes_mesa25.json | tee $out/passes_mesa25.txt
 # The cpu backends' options, each from the defaults, and their defaults on every SIMD target
 # this binary can run here (DACRT_SIMD_TARGET).
 build/dacrt bench $S/bunny.glb $S/dragon.glb --backends cpu-seq,cpu --orbit 8 \

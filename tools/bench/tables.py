@@ -161,7 +161,58 @@ def skips(path, scene):
               f"{'-' if upload is None else f'{upload:.1f}'} | {r['real_errors']} | {r['near_ties']} | {saves} |")
 
 
-KINDS = {"skips": skips, "targets": targets, "peers": peers, "sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
+def passes(paths, scene):
+    """One scene of `--suite passes` runs (comma-separated JSON files, each one run, on its own
+    driver): per configuration the time and rays per second of each pass (each camera's fastest
+    frame, mean over the orbit; Mrays/s = rays made per frame / that time), a peer's per-frame
+    build or refit (within its primary pass), the share of a secondary pass's time the host
+    spends making its rays (of the mean pass), the whole frame, dacrt cpu's frame against it (in the same run),
+    and the slots whose answer differs from cpu-seq's per pass."""
+    runs = [json.load(open(p)) for p in paths.split(",")]
+    first = [r for r in runs[0]["rows"] if r["scene"] == scene]
+    kinds = [r["pass_kind"] for r in first if r["series"] == first[0]["series"] and r["pass_kind"] != "frame"]
+    # "shadow", or "shadow 1", "shadow 2" with several lights (the JSON names each light).
+    names = [k if kinds.count(k) == 1 else f"{k} {kinds[:i + 1].count(k)}" for i, k in enumerate(kinds)]
+    head = ["series", "driver"]
+    for name in names:
+        head.append(f"{name} ms")
+        # The host's share of a secondary pass: making its rays from the primary hits (gpu
+        # makes them on the device, within its dispatches), of the mean pass time.
+        head.append("build or refit ms" if name == "primary" else "making rays (share)")
+        head.append(f"{name} Mrays/s")
+    head += ["frame ms", "dacrt cpu's frame against it", "differing slots (" + " / ".join(names) + ")"]
+    print("| " + " | ".join(head) + " |")
+    print("|---|---|" + "---:|" * (len(head) - 4) + "---|---|")
+    for j in runs:
+        driver = driver_of(j)
+        rows = [r for r in j["rows"] if r["scene"] == scene]
+        configs = list(dict.fromkeys(r["series"] for r in rows))
+        cpu = next((r for r in rows if r["series"] == "cpu" and r["pass_kind"] == "frame"), None)
+        for series in configs:
+            mine = {r["pass_index"]: r for r in rows if r["series"] == series}
+            frame = next(r for r in mine.values() if r["pass_kind"] == "frame")
+            cells = [series, "CPU" if series.startswith(("cpu", "embree")) else driver]
+            differ = []
+            for i, name in enumerate(names):
+                r = mine[i]
+                rate = r["rays_per_frame"] / (r["ms_min"] * 1e3) if r["ms_min"] > 0 else 0.0
+                if name == "primary":
+                    part = "-" if r.get("build_ms") is None else f"{r['build_ms']:.1f}"
+                else:
+                    make = r["parts_ms"].get("make_rays")
+                    part = "-" if make is None else f"{100 * make / r['ms_mean']:.0f}%"
+                cells += [f"{r['ms_min']:.1f}", part, f"{rate:.2f}"]
+                differ.append(str(r["visibility_mismatches"]))
+            if cpu is None or frame is cpu:
+                against = "-"
+            else:
+                ratio = cpu["ms_min"] / frame["ms_min"]
+                against = f"{ratio:.2f}x slower" if ratio > 1 else f"{1 / ratio:.2f}x faster"
+            cells += [f"{frame['ms_min']:.1f}", against, " / ".join(differ)]
+            print("| " + " | ".join(cells) + " |")
+
+
+KINDS = {"passes": passes, "skips": skips, "targets": targets, "peers": peers, "sweep": sweep, "table51": table51, "table51-gpu": table51_gpu, "figure53": figure53}
 
 
 def update(doc):

@@ -6,36 +6,28 @@
 #include <iostream>
 #include <map>
 #include <memory>
-#include <chrono>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "cmd/bench/bench_configs.hpp"
+#include "cmd/bench/bench_frame.hpp"
+#include "cmd/bench/bench_passes.hpp"
 #include "cmd/bench/bench_report.hpp"
 #include "cmd/bench/reference_cache.hpp"
 #include "cmd/output_paths.hpp"
 #include "cmd/progress.hpp"
 #include "core/atomic_file.hpp"
 #include "core/camera.hpp"
-#include "core/cpu_model.hpp"
 #include "core/errors.hpp"
-#include "core/gltf_loader.hpp"
 #include "core/shading.hpp"
 #include "core/timing.hpp"
-#include "dacrt/simd_kernels.hpp"
 #include "oracle/compare.hpp"
 #include "gpu/device_defaults.hpp"
 #include "oracle/embree_tracer.hpp"
 
 namespace dacrt {
 namespace {
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // ---- before anything runs ---------------------------------------------------------------
 
@@ -45,6 +37,7 @@ void checkBenchCommand(const BenchCommand& cmd) {
         throw InputError("bench: --orbit and --repeat must be >= 1, --warmup >= 0");
     if (cmd.width < 1 || cmd.height < 1 || cmd.width > 16384 || cmd.height > 16384)
         throw InputError("--size: width and height must lie in 1..16384");
+    if (cmd.suite == BenchSuite::Passes) checkPassOptions(cmd.passes);
 }
 
 // Resolves the output paths and checks that they can be written before anything is timed:
@@ -66,8 +59,18 @@ BenchCommand withOutputs(BenchCommand cmd) {
     return cmd;
 }
 
+// --suite passes checks every pass against cpu-seq's, so cpu-seq runs first, named or not.
+std::vector<Backend> withReferenceFirst(const BenchCommand& cmd, std::vector<Backend> backends) {
+    if (cmd.suite != BenchSuite::Passes || (!backends.empty() && backends.front() == Backend::CpuSeq)) return backends;
+    const auto named = std::find(backends.begin(), backends.end(), Backend::CpuSeq);
+    if (named != backends.end()) backends.erase(named);
+    else std::cerr << "dacrt bench: --suite passes checks every pass against cpu-seq's, so cpu-seq runs too\n";
+    backends.insert(backends.begin(), Backend::CpuSeq);
+    return backends;
+}
+
 std::vector<Backend> chooseBackends(const BenchCommand& cmd) {
-    if (!cmd.backends.empty()) return cmd.backends;
+    if (!cmd.backends.empty()) return withReferenceFirst(cmd, cmd.backends);
     std::vector<Backend> backends = {Backend::CpuSeq, Backend::Cpu};
     const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
     if (!devices.empty())
@@ -103,76 +106,14 @@ std::vector<BenchConfig> chooseConfigs(const BenchCommand& cmd, const std::vecto
     std::vector<BenchConfig> configs;
     for (Backend b : backends) {
         const std::vector<BenchConfig> more =
-            cmd.suite == BenchSuite::Sweep   ? sweepConfigs(b, hardwareThreads, gpuDefaultRegions, gpuDefaultRayGroups)
-            : cmd.suite == BenchSuite::Peers ? peerConfigs(b, hardwareThreads)
-            : cmd.suite == BenchSuite::Skips ? skipConfigs(b, hardwareThreads)
-                                             : table51Configs(b, hardwareThreads);
+            cmd.suite == BenchSuite::Sweep    ? sweepConfigs(b, hardwareThreads, gpuDefaultRegions, gpuDefaultRayGroups)
+            : cmd.suite == BenchSuite::Peers  ? peerConfigs(b, hardwareThreads)
+            : cmd.suite == BenchSuite::Skips  ? skipConfigs(b, hardwareThreads)
+            : cmd.suite == BenchSuite::Passes ? passesConfigs(b, hardwareThreads)
+                                              : table51Configs(b, hardwareThreads);
         configs.insert(configs.end(), more.begin(), more.end());
     }
     return configs;
-}
-
-// ---- one frame --------------------------------------------------------------------------
-
-struct FrameOutcome {
-    double ms = 0.0;
-    std::vector<std::pair<std::string, double>> parts;
-    TraceResult result;
-};
-
-// A whole frame as a user pays for it: rays (and, for dacrt's backends, triangle bounds), then the
-// backend. Embree's scenes persist across frames as its users keep them: a dynamic one is
-// rebuilt each frame (vertex buffer updated, committed: a full LOW-quality build into the
-// memory of the last one), a refitted one refitted, a static one left alone.
-// The frame's rays and bounds live in buffers kept from frame to frame, as a renderer of a
-// dynamic scene keeps them, and are computed on the configuration's threads.
-struct FrameBuffers {
-    std::vector<Ray> rays;
-    std::vector<Bounds> bounds;
-};
-
-FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& camera, int width, int height,
-                        BackendDispatcher& dispatcher, EmbreeScene* persistentEmbree, RayQueryScene* persistentRayQuery,
-                        FrameBuffers& buffers) {
-    FrameOutcome out;
-    const auto start = Clock::now();
-    ThreadPool& pool = dispatcher.pool(c.threads());
-    std::vector<Ray>& rays = buffers.rays;
-    primaryRays(camera, width, height, pool, rays);
-    const bool peer = isPeer(c.backend());
-    // Only dacrt's backends read the frame geometry (bounds, scene box, the scan for a shared
-    // ray start): the peers' frames do not pay for it.
-    FrameGeometry g;
-    if (!peer) {
-        Box box;
-        triangleBoundsInParallel(scene.triangles, pool, buffers.bounds, box);
-        g = frameGeometry(scene.triangles, buffers.bounds, rays, box, std::uint32_t(width));
-        g.frustum = viewFrustum(camera, width, height);
-        g.trianglesVersion = scene.trianglesVersion;  // an orbit: the triangles stay as they are
-    }
-    const double prepareMs = msSince(start);
-    const auto traceStart = Clock::now();
-    if (persistentRayQuery) {
-        out.result = persistentRayQuery->trace(rays);
-    } else if (persistentEmbree) {
-        const EmbreeBuild build = c.request.embree.build;
-        const double updateMs = build == EmbreeBuild::Static ? 0.0 : persistentEmbree->update();
-        out.result = persistentEmbree->trace(rays, dispatcher.pool(c.threads()));
-        if (build != EmbreeBuild::Static)
-            out.result.phaseMs.insert(out.result.phaseMs.begin(), {build == EmbreeBuild::Refit ? "refit" : "build", updateMs});
-    } else {
-        out.result = dispatcher.trace(g, c.request);
-    }
-    out.ms = msSince(start);
-    out.parts.emplace_back(peer ? "rays" : "rays and bounds", prepareMs);
-    out.parts.emplace_back("tracer", msSince(traceStart));
-    for (const auto& p : out.result.phaseMs) out.parts.push_back(p);
-    if (out.result.gpu) {
-        double gpuMs = 0.0;
-        for (const auto& [name, ms] : out.result.gpu->dispatchMs) gpuMs += ms;
-        out.parts.emplace_back("gpu timestamps", gpuMs);
-    }
-    return out;
 }
 
 // ---- one scene --------------------------------------------------------------------------
@@ -183,34 +124,10 @@ struct Accumulator {
     double minSum = 0.0, medianSum = 0.0;
     std::map<std::string, double> partSums;
     std::vector<std::string> partOrder;
-    std::unique_ptr<EmbreeScene> persistentEmbree;  // built before the frames
-    std::unique_ptr<RayQueryScene> persistentRayQuery;  // allocated before the frames; built by the first
+    PeerScenes peers;
     std::vector<double> cameraMs;
     FrameBuffers buffers;
 };
-
-struct BenchScene {
-    std::string name;  // unique among the run's scenes: rows key on it
-    Scene scene;
-    std::vector<Bounds> bounds;
-    std::vector<Camera> cameras;
-    std::string trianglesDigest;
-};
-
-BenchScene loadBenchScene(const std::string& path, const BenchCommand& cmd, const std::vector<BenchRow>& rows) {
-    BenchScene s;
-    s.scene = loadGltf(path);
-    const std::string stem = std::filesystem::path(path).stem().string();
-    s.name = stem;
-    for (int copy = 2; std::any_of(rows.begin(), rows.end(), [&](const BenchRow& r) { return r.scene == s.name; }); ++copy)
-        s.name = stem + "_" + std::to_string(copy);
-    s.bounds = allTriangleBounds(s.scene.triangles);
-    CameraOptions orbit = cmd.camera;
-    orbit.orbit = cmd.orbit;
-    s.cameras = makeCameras(s.scene, sceneBounds(s.scene.triangles), orbit, double(cmd.width) / double(cmd.height));
-    s.trianglesDigest = digestOf(s.scene.triangles.data(), s.scene.triangles.size() * sizeof(Triangle));
-    return s;
-}
 
 std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
                                    BackendDispatcher& dispatcher) {
@@ -223,14 +140,7 @@ std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd,
         row.cameras = int(s.cameras.size());
         row.config = configs[c];
         row.config.request.embree.imageWidth = std::uint32_t(cmd.width);
-        if (configs[c].backend() == Backend::RayQuery)
-            acc[c].persistentRayQuery = std::make_unique<RayQueryScene>(*dispatcher.gpuContext(), *dispatcher.pipelines(),
-                                                                        s.scene.triangles, configs[c].request.rayQueryBuild);
-        if (configs[c].backend() == Backend::Embree) {
-            EmbreeOptions embree = row.config.request.embree;
-            embree.threads = configs[c].threads();
-            acc[c].persistentEmbree = std::make_unique<EmbreeScene>(s.scene.triangles, embree);
-        }
+        acc[c].peers = makePeerScenes(row.config, s.scene, dispatcher);
     }
     return acc;
 }
@@ -238,8 +148,6 @@ std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd,
 // Every configuration's frames of one camera. Configurations are interleaved (repeat, then
 // configuration), so that a slow spell of this shared machine lands on every configuration
 // alike instead of on whichever one happened to run then.
-constexpr int kVulkanSettleMs = 200;
-
 void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, const std::string& cacheDir,
                    std::vector<Accumulator>& acc, BackendDispatcher& dispatcher, unsigned hardwareThreads,
                    Progress& progress) {
@@ -261,14 +169,8 @@ void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, 
             const BenchConfig& config = a.row.config;
             progress.step(s.name + " " + config.series + " " + config.name + " camera " + std::to_string(k));
             const FrameOutcome frame =
-                traceFrame(config, s.scene, camera, cmd.width, cmd.height, dispatcher, a.persistentEmbree.get(),
-                           a.persistentRayQuery.get(), a.buffers);
-            // lavapipe's worker threads spin on for a while after a dispatch; the next frame, on
-            // the same cores, would pay for it (Mesa 25.0.7, Dragon: the ray generation after a gpu
-            // frame took 10.7 ms instead of 5.3 with no pause or a 20 ms one, 5.3 with 200 ms;
-            // docs/benchmarks.md). An untimed pause lets them go to sleep.
-            if (runsOnVulkan(config.backend()))
-                std::this_thread::sleep_for(std::chrono::milliseconds(kVulkanSettleMs));
+                traceFrame(config, s.scene, camera, cmd.width, cmd.height, dispatcher, a.peers, a.buffers);
+            settleAfter(config.backend());
             if (w < cmd.warmup) continue;
             a.cameraMs.push_back(frame.ms);
             for (const auto& [name, ms] : frame.parts) {
@@ -304,7 +206,9 @@ void finishRows(std::vector<Accumulator>& acc, std::size_t cameras, std::vector<
 
 void measureScene(const std::string& path, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
                   BackendDispatcher& dispatcher, unsigned hardwareThreads, std::vector<BenchRow>& rows) {
-    const BenchScene s = loadBenchScene(path, cmd, rows);
+    std::vector<std::string> taken;
+    for (const BenchRow& r : rows) taken.push_back(r.scene);
+    const BenchScene s = loadBenchScene(path, cmd, taken);
     std::vector<Accumulator> acc = startRows(s, cmd, configs, dispatcher);
     Progress progress("dacrt bench", s.cameras.size() * (1 + configs.size() * std::size_t(cmd.warmup + cmd.repeat)));
     const std::string cacheDir = cmd.cacheDir.empty() ? defaultCacheDir() : cmd.cacheDir;
@@ -325,22 +229,9 @@ void compareRows(std::vector<BenchRow>& rows) {
 
 void writeJson(const BenchCommand& cmd, const std::vector<BenchRow>& rows, const BackendDispatcher& dispatcher,
                unsigned hardwareThreads) {
-    nlohmann::ordered_json j;
-    j["command"] = {{"orbit", cmd.orbit},
-                    {"size", std::to_string(cmd.width) + "x" + std::to_string(cmd.height)},
-                    {"repeat", cmd.repeat},
-                    {"warmup", cmd.warmup},
-                    {"suite", toString(cmd.suite)}};
-    const gpu::Context* context = dispatcher.gpuContext();
-    j["machine"] = {{"cpu", cpuModelName()},
-                    {"simd_target", simd::activeTarget()},
-                    {"hardware_threads", hardwareThreads},
-                    {"gpu_device", context ? context->info().name : std::string()},
-                    {"gpu_driver", context ? context->info().driver : std::string()},
-                    {"lp_num_threads", std::getenv("LP_NUM_THREADS") ? std::getenv("LP_NUM_THREADS") : ""}};
+    nlohmann::ordered_json j = runJson(cmd, dispatcher, hardwareThreads);
     j["near_tie_tolerance_relative"] = kNearTieRelativeDepth;
     j["pareto_time_margin"] = kParetoTimeMargin;
-    j["validation_errors"] = dispatcher.validationErrors();
     j["rows"] = nlohmann::ordered_json::array();
     for (const BenchRow& r : rows) j["rows"].push_back(rowJson(r));
     writeFileAtomically(cmd.jsonPath, j.dump(2) + "\n");
@@ -355,6 +246,7 @@ int runBenchCommand(const BenchCommand& request) {
     const std::vector<Backend> backends = chooseBackends(cmd);
     BackendDispatcher dispatcher(cmd.devices, backends);
     const std::vector<BenchConfig> configs = chooseConfigs(cmd, backends, dispatcher, hardwareThreads);
+    if (cmd.suite == BenchSuite::Passes) return runPassesSuite(cmd, configs, dispatcher, hardwareThreads);
 
     std::vector<BenchRow> rows;
     for (const std::string& path : cmd.scenes) measureScene(path, cmd, configs, dispatcher, hardwareThreads, rows);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cmd/backend_dispatcher.hpp"
+#include "cmd/frame_passes.hpp"
 #include "core/enum_names.hpp"
 
 namespace dacrt {
@@ -12,14 +13,18 @@ namespace dacrt {
 // sweep: every backend's default, then each option value changed one at a time.
 // peers: each DACRT default against every mode of the peers (embree, rayquery).
 // table51: the source's Table 5.1 and Figure 5.3 (threads, regions per thread, axes).
-enum class BenchSuite { Sweep, Peers, Skips, Table51 };
+// passes: a lit frame's passes (primary, a shadow pass per light, occlusion) timed apart, for
+// each DACRT default and every build mode of the peers, each pass's visibility checked against
+// cpu-seq's.
+enum class BenchSuite { Sweep, Peers, Skips, Table51, Passes };
 
 template <>
 struct EnumNames<BenchSuite> {
-    static constexpr std::array<std::pair<BenchSuite, std::string_view>, 4> table{{{BenchSuite::Sweep, "sweep"},
+    static constexpr std::array<std::pair<BenchSuite, std::string_view>, 5> table{{{BenchSuite::Sweep, "sweep"},
                                                                                     {BenchSuite::Peers, "peers"},
                                                                                     {BenchSuite::Skips, "skips"},
-                                                                                    {BenchSuite::Table51, "table51"}}};
+                                                                                    {BenchSuite::Table51, "table51"},
+                                                                                    {BenchSuite::Passes, "passes"}}};
 };
 
 struct BenchCommand {
@@ -40,6 +45,8 @@ struct BenchCommand {
     std::string cacheDir;      // empty: $XDG_CACHE_HOME/dacrt or ~/.cache/dacrt
     bool useCache = true;
     DeviceChoice devices;      // gpu
+    // --suite passes: the lights (render's --light) and the occlusion rays per hit (--ao).
+    PassOptions passes{.lights = {}, .occlusionSamples = 4, .occlusionDistance = 0.0};
 };
 
 // Returns the process exit code; throws InputError on bad input.

@@ -153,6 +153,18 @@ std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads) {
     return {baseConfig(b, hardwareThreads)};
 }
 
+std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
+    std::vector<BenchConfig> out;
+    if (isPeer(b)) {
+        for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0))
+            if (c.name == "default") out.push_back(c);
+        return out;
+    }
+    out.push_back(baseConfig(b, hardwareThreads));
+    out.back().request.keepForPasses = true;
+    return out;
+}
+
 // The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
 std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads) {
     std::vector<BenchConfig> out;

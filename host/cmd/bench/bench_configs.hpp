@@ -26,6 +26,11 @@ std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads);
 // off; the peers' defaults beside them.
 std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads);
 
+// passes: each DACRT backend's default and each build mode of the peers (their defaults
+// otherwise), as the peers suite configures them; dacrt's keep the primary pass for the
+// secondary ones (gpu: on the device).
+std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads);
+
 // The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
 std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads);
 

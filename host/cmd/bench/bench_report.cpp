@@ -1,6 +1,7 @@
 #include "cmd/bench/bench_report.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -9,7 +10,9 @@
 #include "cmd/bench/bench_configs.hpp"
 #include "cmd/json_keys.hpp"
 #include "core/atomic_file.hpp"
+#include "core/cpu_model.hpp"
 #include "core/errors.hpp"
+#include "dacrt/simd_kernels.hpp"
 
 namespace dacrt {
 
@@ -26,6 +29,30 @@ void markPareto(std::vector<BenchRow>& rows) {
             }
         }
     }
+}
+
+nlohmann::ordered_json runJson(const BenchCommand& cmd, const BackendDispatcher& dispatcher, unsigned hardwareThreads) {
+    nlohmann::ordered_json j;
+    j["command"] = {{"orbit", cmd.orbit},
+                    {"size", std::to_string(cmd.width) + "x" + std::to_string(cmd.height)},
+                    {"repeat", cmd.repeat},
+                    {"warmup", cmd.warmup},
+                    {"suite", toString(cmd.suite)}};
+    if (cmd.suite == BenchSuite::Passes) {
+        j["command"]["ao"] = cmd.passes.occlusionSamples;
+        j["command"]["ao_distance"] = cmd.passes.occlusionDistance;
+        j["command"]["light"] = cmd.passes.lights;
+    }
+    const gpu::Context* context = dispatcher.gpuContext();
+    const char* lpThreads = std::getenv("LP_NUM_THREADS");
+    j["machine"] = {{"cpu", cpuModelName()},
+                    {"simd_target", simd::activeTarget()},
+                    {"hardware_threads", hardwareThreads},
+                    {"gpu_device", context ? context->info().name : std::string()},
+                    {"gpu_driver", context ? context->info().driver : std::string()},
+                    {"lp_num_threads", lpThreads ? lpThreads : ""}};
+    j["validation_errors"] = dispatcher.validationErrors();
+    return j;
 }
 
 nlohmann::ordered_json rowJson(const BenchRow& r) {
@@ -66,19 +93,14 @@ nlohmann::ordered_json rowJson(const BenchRow& r) {
     return j;
 }
 
-void writeCsv(const std::string& path, const std::vector<BenchRow>& rows) {
+void writeCsvOf(const std::string& path, const std::vector<std::string>& columns,
+                const std::vector<nlohmann::ordered_json>& rows) {
     std::ostringstream f;
-    const char* columns[] = {"scene", "triangles", "rays_per_frame", "cameras", "backend", "series", "config",
-                             "default", "options", "threads", "regions", "division_axis", "frame_ms_min",
-                             "frame_ms_median", "mrays_per_s", "speedup_over_cpu_seq", "pixels", "differing_prim",
-                             "near_ties", "real_errors", "real_error_fraction", "near_tie_fraction", "leaks",
-                             "real_leaks", "spurious_hits", "depth_rel_max", "depth_rel_rms", "psnr_db", "pareto"};
-    for (std::size_t i = 0; i < std::size(columns); ++i) f << (i ? "," : "") << columns[i];
+    for (std::size_t i = 0; i < columns.size(); ++i) f << (i ? "," : "") << columns[i];
     f << "\n";
-    for (const BenchRow& r : rows) {
-        const nlohmann::ordered_json j = rowJson(r);
-        for (std::size_t i = 0; i < std::size(columns); ++i) {
-            const nlohmann::ordered_json& v = j[columns[i]];
+    for (const nlohmann::ordered_json& j : rows) {
+        for (std::size_t i = 0; i < columns.size(); ++i) {
+            const nlohmann::ordered_json& v = j.at(columns[i]);
             f << (i ? "," : "");
             if (v.is_string()) {
                 std::string text = v.get<std::string>();
@@ -97,6 +119,18 @@ void writeCsv(const std::string& path, const std::vector<BenchRow>& rows) {
         f << "\n";
     }
     writeFileAtomically(path, f.str());
+}
+
+void writeCsv(const std::string& path, const std::vector<BenchRow>& rows) {
+    const std::vector<std::string> columns = {
+        "scene", "triangles", "rays_per_frame", "cameras", "backend", "series", "config",
+        "default", "options", "threads", "regions", "division_axis", "frame_ms_min",
+        "frame_ms_median", "mrays_per_s", "speedup_over_cpu_seq", "pixels", "differing_prim",
+        "near_ties", "real_errors", "real_error_fraction", "near_tie_fraction", "leaks",
+        "real_leaks", "spurious_hits", "depth_rel_max", "depth_rel_rms", "psnr_db", "pareto"};
+    std::vector<nlohmann::ordered_json> json;
+    for (const BenchRow& r : rows) json.push_back(rowJson(r));
+    writeCsvOf(path, columns, json);
 }
 
 void printSummary(const std::vector<BenchRow>& rows) {

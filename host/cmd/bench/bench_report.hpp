@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cmd/bench/bench.hpp"
 #include "cmd/bench/bench_rows.hpp"
 
 namespace dacrt {
@@ -16,8 +17,15 @@ namespace dacrt {
 constexpr double kParetoTimeMargin = 0.05;
 
 void markPareto(std::vector<BenchRow>& rows);
+// What every run's JSON opens with: the command, the machine (CPU, SIMD target, driver) and
+// the validation error count.
+nlohmann::ordered_json runJson(const BenchCommand& cmd, const BackendDispatcher& dispatcher, unsigned hardwareThreads);
 nlohmann::ordered_json rowJson(const BenchRow& r);
 void writeCsv(const std::string& path, const std::vector<BenchRow>& rows);
+// A header line of `columns`, then per row its value of each (strings quoted where they hold
+// a comma or a quote; null as nothing).
+void writeCsvOf(const std::string& path, const std::vector<std::string>& columns,
+                const std::vector<nlohmann::ordered_json>& rows);
 void printSummary(const std::vector<BenchRow>& rows);
 
 }  // namespace dacrt

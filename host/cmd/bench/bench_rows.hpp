@@ -2,6 +2,7 @@
 // What the bench command measures: a configuration (a backend request with a name) and the
 // row it yields per scene.
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <utility>
@@ -35,6 +36,31 @@ struct BenchRow {
     ErrorMetrics errors;
     bool pareto = false;
     std::optional<double> speedupOverSequential;
+};
+
+// --suite passes: one pass of a lit frame (or the whole frame) per scene and configuration.
+struct PassRow {
+    std::string scene;
+    std::size_t triangles = 0;
+    std::size_t pixels = 0;  // primary rays per frame
+    int cameras = 0;
+    BenchConfig config;
+    int passIndex = 0;        // 0: primary, then the secondary passes in the order they run
+    std::string pass;         // "primary", the secondary pass's name, or "frame" (every pass)
+    std::string kind;         // primary, shadow, occlusion, frame
+    std::uint32_t raysPerHit = 1;
+    double slotsPerFrame = 0.0;  // mean over the cameras
+    double raysPerFrame = 0.0;   // rays made, mean over the cameras
+    double msMin = 0.0;          // each camera's fastest frame, mean over the cameras
+    double msMedian = 0.0;       // each camera's median, mean over the cameras
+    double msMean = 0.0;         // every frame's, mean (what partsMs divide)
+    std::vector<std::pair<std::string, double>> partsMs;  // mean per frame
+    std::uint64_t checkedSlots = 0;  // summed over the cameras
+    // Slots whose answer differs from cpu-seq's: the visibility (no ray, open, blocked) of a
+    // secondary pass; the primitive of a primary ray, and for dacrt's backends its depth bit
+    // for bit too.
+    std::uint64_t mismatches = 0;
+    bool exactRequired = false;  // dacrt's backends: any mismatch fails the run
 };
 
 }  // namespace dacrt
