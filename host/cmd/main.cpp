@@ -1,3 +1,7 @@
 #include "cmd/cli.hpp"
+#include "core/system_memory.hpp"
 
-int main(int argc, char** argv) { return dacrt::runCli(argc, argv); }
+int main(int argc, char** argv) {
+    dacrt::reuseFreedMemory();
+    return dacrt::runCli(argc, argv);
+}
