@@ -47,36 +47,36 @@ uint firstRegion(Ray ray) {
     return kNoSlot;
 }
 
-// Step 0, one invocation per primary ray: its rays, their starting hits, and their slots
-// (region and ray group: the rays of the g-th band of the image go to group g), counted in
-// each slot's rayEnd, with the directions they move along the axis.
-void makeRays(uint source) {
+// Step 0, one invocation per slot (source ray s, sample k): its ray, its starting hit, and its
+// slot (region and ray group: the rays of the g-th band of the image go to group g), counted
+// in each slot's rayEnd, with the directions they move along the axis. One ray an invocation
+// keeps its loops (16 tries, two walks over at most 4096 regions) far below llvmpipe's 65535.
+void makeRay(uint slot) {
+    uint source = slot / push.raysPerHit;
+    uint k = slot - source * push.raysPerHit;
     Hit primaryHit = sourceHits[source];
     SurfaceSample surface = noSurface();
     if (primaryHit.prim != kMissPrim) surface = surfaceOfHit(sourceRays[source], primaryHit, triangles[primaryHit.prim]);
     uint band = (push.sourceCount + push.groups - 1u) / push.groups;
     uint group = min(source / band, push.groups - 1u);
-    for (uint k = 0u; k < push.raysPerHit; ++k) {
-        uint slot = source * push.raysPerHit + k;
-        uint stream = source * push.samplesPerHit + push.firstSample + k;
-        GeneratedRay g = push.kind == kPassShadow ? shadowRay(surface, push.light)
-                                                  : occlusionRay(surface, stream, push.sampleSeed, push.occlusionDistance);
-        rays[slot] = g.ray;
-        Hit start;
-        start.t = g.traced ? g.ray.tmax : 0.0;
-        start.prim = g.traced ? kMissPrim : kNotTracedPrim;
-        start.u = 0.0;
-        start.v = 0.0;
-        hits[slot] = start;
-        uint region = g.traced ? firstRegion(g.ray) : kNoSlot;
-        uint key = region == kNoSlot ? kNoSlot : region * push.groups + group;
-        rayIds[gRayScratchHalf + slot] = key;
-        if (key == kNoSlot) continue;
-        atomicAdd(regions[key].rayEnd, 1u);
-        float d = g.ray.dir[push.axis];
-        uint moving = (d < 0.0 ? kTowardLow : 0u) | (d > 0.0 ? kTowardHigh : 0u);
-        if (moving != 0u) atomicOr(regions[key].directions, moving);
-    }
+    uint stream = source * push.samplesPerHit + push.firstSample + k;
+    GeneratedRay g = push.kind == kPassShadow ? shadowRay(surface, push.light)
+                                              : occlusionRay(surface, stream, push.sampleSeed, push.occlusionDistance);
+    rays[slot] = g.ray;
+    Hit start;
+    start.t = g.traced ? g.ray.tmax : 0.0;
+    start.prim = g.traced ? kMissPrim : kNotTracedPrim;
+    start.u = 0.0;
+    start.v = 0.0;
+    hits[slot] = start;
+    uint region = g.traced ? firstRegion(g.ray) : kNoSlot;
+    uint key = region == kNoSlot ? kNoSlot : region * push.groups + group;
+    rayIds[gRayScratchHalf + slot] = key;
+    if (key == kNoSlot) return;
+    atomicAdd(regions[key].rayEnd, 1u);
+    float d = g.ray.dir[push.axis];
+    uint moving = (d < 0.0 ? kTowardLow : 0u) | (d > 0.0 ? kTowardHigh : 0u);
+    if (moving != 0u) atomicOr(regions[key].directions, moving);
 }
 
 // Step 1, one invocation: counts to consecutive ranges, slot by slot.
@@ -104,7 +104,7 @@ void writeRayId(uint slot) {
 void main() {
     gRayScratchHalf = push.sourceCount * push.raysPerHit;
     uint i = push.firstInvocation + gl_GlobalInvocationID.x;
-    if (push.step == 0u && i < push.sourceCount) makeRays(i);
+    if (push.step == 0u && i < gRayScratchHalf) makeRay(i);
     if (push.step == 1u && i == 0u) rangesFromCounts();
     if (push.step == 2u && i < gRayScratchHalf) writeRayId(i);
 }

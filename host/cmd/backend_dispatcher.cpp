@@ -171,6 +171,12 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
         for (const Hit& h : out.result.hits) out.rays += h.prim != kNotTracedPrim;
         return out;
     }
+    // The slot arrays are allocated before the tracer plans: checked first, as its plan is.
+    const std::uint64_t slots = secondarySlots(pass, primary.rays->size());
+    MemoryPlan making;
+    making.add("secondary rays and their slots (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
+    making.add("hits per slot", slots * sizeof(Hit));
+    if (onPlan && !onPlan(making)) return out;
     const auto start = Clock::now();
     const SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
     const double makeMs = msSince(start);

@@ -193,6 +193,8 @@ Subcommand addRenderCommand(CLI::App& app) {
                     "a light, repeatable: point:X,Y,Z[:CANDELA[:R,G,B]], directional:DX,DY,DZ[:LUX[:R,G,B]] (the way it "
                     "shines), or headlight (the unlit preview, no shadow rays); default: the scene's lights, else a key "
                     "light over the first camera's left shoulder")
+        ->expected(1)
+        ->allow_extra_args(false)
         ->take_all();
     cmd->add_option("--ao", render.passes.occlusionSamples,
                     "ambient occlusion: rays per primary hit, cosine-distributed (0: none)")
@@ -353,6 +355,8 @@ Subcommand addBenchCommand(CLI::App& app) {
     CLI::Option* light = cmd->add_option("--light", bench.passes.lights,
                                          "--suite passes: a light, repeatable, as render's --light (default: the "
                                          "scene's lights, else a key light over the first camera's left shoulder)")
+                             ->expected(1)
+                             ->allow_extra_args(false)
                              ->take_all();
     CLI::Option* ao = cmd->add_option("--ao", bench.passes.occlusionSamples,
                                       "--suite passes: occlusion rays per primary hit (0: no occlusion pass)")

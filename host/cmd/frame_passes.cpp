@@ -12,9 +12,10 @@ namespace dacrt {
 void checkPassOptions(const PassOptions& o) {
     for (const std::string& light : o.lights) parseLightSpec(light);
     if (o.occlusionSamples > 1024) throw InputError("--ao " + std::to_string(o.occlusionSamples) + ": at most 1024 rays per hit");
-    if (!std::isfinite(o.occlusionDistance) || o.occlusionDistance < 0.0 || o.occlusionDistance > kMaxCoordinate)
-        throw InputError("--ao-distance must be a positive length (0: a tenth of the scene's diagonal), at most " +
-                         std::to_string(kMaxCoordinate));
+    if (!std::isfinite(o.occlusionDistance) || o.occlusionDistance < 0.0 || o.occlusionDistance > kMaxCoordinate ||
+        (o.occlusionDistance > 0.0 && o.occlusionDistance < 1e-30))
+        throw InputError("--ao-distance must be a length from 1e-30 to " + std::to_string(kMaxCoordinate) +
+                         " (0: a tenth of the scene's diagonal)");
 }
 
 float occlusionDistance(const PassOptions& o, const Box& box) {

@@ -59,8 +59,9 @@ nlohmann::ordered_json passesJson(const RenderedFrame& frame, double primaryMs) 
     for (const TracedPass& t : *frame.passes) {
         double compile = 0.0;
         nlohmann::ordered_json phases;
-        for (const auto& [name, ms] : t.result.phaseMs) {
-            phases[jsonKey(name)] = ms;
+        for (const auto& [name, ms] : t.result.phaseMs) {  // a batched pass has each phase once per batch
+            const std::string key = jsonKey(name);
+            phases[key] = (phases.contains(key) ? phases[key].get<double>() : 0.0) + ms;
             if (name == kPipelinePhase) compile += ms;
         }
         const double ms = t.ms - compile;

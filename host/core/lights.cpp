@@ -1,5 +1,6 @@
 #include "core/lights.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -36,6 +37,22 @@ glm::dvec3 triple(const std::string& text, const std::string& spec, const char* 
     return {number(parts[0], spec), number(parts[1], spec), number(parts[2], spec)};
 }
 
+// Intensities and colours become float32: a value beyond this would be infinite there.
+constexpr double kLargestLightValue = 1e30;
+
+double lightValue(double v, const std::string& spec, const char* what) {
+    if (v < 0.0) throw InputError("--light " + spec + ": the " + std::string(what) + " is negative");
+    if (v > kLargestLightValue) throw InputError("--light " + spec + ": the " + std::string(what) + " exceeds 1e30");
+    return v;
+}
+
+// The unit direction of d, scaled by its largest component first so that no length
+// overflows or underflows; zero only for the zero vector.
+glm::dvec3 unitDirection(const glm::dvec3& d) {
+    const double largest = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+    return largest == 0.0 ? glm::dvec3(0.0) : glm::normalize(d / largest);
+}
+
 }  // namespace
 
 LightSpec parseLightSpec(const std::string& text) {
@@ -57,18 +74,14 @@ LightSpec parseLightSpec(const std::string& text) {
             throw InputError("--light " + text + ": the position lies beyond " + std::to_string(kMaxCoordinate));
     } else {
         light.type = LightType::Directional;
-        const glm::dvec3 d = triple(parts[1], text, "direction");
-        if (glm::length(d) == 0.0) throw InputError("--light " + text + ": the direction is zero");
-        light.direction = glm::normalize(d);
+        light.direction = unitDirection(triple(parts[1], text, "direction"));
+        if (light.direction == glm::dvec3(0.0)) throw InputError("--light " + text + ": the direction is zero");
     }
-    if (parts.size() >= 3) {
-        light.intensity = float(number(parts[2], text));
-        if (light.intensity < 0.0f) throw InputError("--light " + text + ": the intensity is negative");
-    }
+    if (parts.size() >= 3) light.intensity = float(lightValue(number(parts[2], text), text, "intensity"));
     if (parts.size() == 4) {
         const glm::dvec3 c = triple(parts[3], text, "colour");
-        if (glm::any(glm::lessThan(c, glm::dvec3(0.0)))) throw InputError("--light " + text + ": a colour component is negative");
-        light.color = glm::vec3(c);
+        light.color = glm::vec3(lightValue(c.r, text, "colour"), lightValue(c.g, text, "colour"),
+                                lightValue(c.b, text, "colour"));
     }
     return spec;
 }
@@ -107,6 +120,10 @@ std::vector<Light> frameLights(const Scene& scene, const Camera& camera, const B
         return {};
     }
     if (!specs.empty()) return lights;
+    for (const Light& l : scene.lights)
+        if (l.type != LightType::Directional && glm::any(glm::greaterThan(glm::abs(l.position), glm::dvec3(kMaxCoordinate))))
+            throw InputError("light '" + l.name + "' lies beyond " + std::to_string(kMaxCoordinate) +
+                             ", the largest coordinate dacrt traces (the scene's vertices obey the same limit)");
     if (!scene.lights.empty()) return scene.lights;
     return {defaultKeyLight(camera, sceneBox)};
 }

@@ -12,7 +12,11 @@ ShadowLight shadowLightOf(const Light& light) {
     s.type = light.type == LightType::Point ? shared::kLightPoint
                                             : (light.type == LightType::Spot ? shared::kLightSpot : shared::kLightDirectional);
     s.position = glm::vec3(light.position);
+    // Components below 2^-40 are flushed, as the surface normals' are: no product with one is
+    // subnormal, which a device may flush and the host would not.
     s.direction = glm::vec3(glm::normalize(light.direction));
+    for (int a = 0; a < 3; ++a)
+        if (std::abs(s.direction[a]) < 0x1p-40f) s.direction[a] = 0.0f;
     s.range = light.range;
     const double cosOuter = std::cos(light.outerConeAngle);
     s.cosOuterSquared = light.type == LightType::Spot ? float(cosOuter * cosOuter) : 0.0f;

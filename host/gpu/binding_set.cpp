@@ -25,9 +25,11 @@ DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& c) {
     return p;
 }
 
-void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, MemoryPlan& plan) {
-    for (const PlannedBuffer& b : buffers) {
-        plan.add(std::string("device: ") + b.name, b.bytes);
+void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, MemoryPlan& plan,
+                     const ResidentBuffers* reused) {
+    for (std::size_t k = 0; k < buffers.size(); ++k) {
+        const PlannedBuffer& b = buffers[k];
+        if (!reused || !(*reused)[k]) plan.add(std::string("device: ") + b.name, b.bytes);
         if (b.bytes > device.maxStorageBufferRange)
             throw InputError(std::string("the device buffer of ") + b.name + " needs " + std::to_string(b.bytes) +
                              " bytes, more than the device's maxStorageBufferRange of " +

@@ -36,11 +36,14 @@ using DacrtBufferPlan = std::array<PlannedBuffer, DACRT_BINDING_COUNT>;
 DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& counts);
 
 // Appends "device: NAME" entries to plan, and throws InputError naming the first buffer that
-// exceeds the device's maxStorageBufferRange, with the limit and the excess.
-void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, MemoryPlan& plan);
-
-// Buffers that outlive a binding set, for the bindings that name one (null: the set makes it).
+// exceeds the device's maxStorageBufferRange, with the limit and the excess. Bindings that
+// `reused` names (buffers that exist already) are checked but not added.
 using ResidentBuffers = std::array<Buffer*, DACRT_BINDING_COUNT>;
+void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, MemoryPlan& plan,
+                     const ResidentBuffers* reused = nullptr);
+
+// Buffers that outlive a binding set, for the bindings that name one (null: the set makes it):
+// ResidentBuffers, above.
 
 class DacrtBindingSet {
 public:

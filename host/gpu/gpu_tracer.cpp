@@ -381,8 +381,13 @@ void divideForSecondaryRays(GpuPassSource& source, const FrameGeometry& frame, c
     const std::uint32_t groups = tuning.rayGroups ? tuning.rayGroups : gpu::defaultRayGroups(device, regions);
     source.work = gpu::planWorkItems(source.division, transferSchedule(source.division, false), groups);
     const std::vector<std::uint32_t> ids = gpu::groupTriangleIds(source.division, groups);
-    source.triangleIds = std::make_unique<gpu::Buffer>(context, std::max<std::uint64_t>(ids.size(), 1) * 8,
-                                                       "triangle ids and scratch (secondary passes)");
+    const std::uint64_t idBytes = std::max<std::uint64_t>(ids.size(), 1) * 8;
+    if (idBytes > device.maxStorageBufferRange)
+        throw InputError("the device buffer of the secondary passes' triangle ids and scratch needs " +
+                         std::to_string(idBytes) + " bytes, more than the device's maxStorageBufferRange of " +
+                         std::to_string(device.maxStorageBufferRange) + " bytes (over by " +
+                         std::to_string(idBytes - device.maxStorageBufferRange) + "); use fewer regions or ray groups");
+    source.triangleIds = std::make_unique<gpu::Buffer>(context, idBytes, "triangle ids and scratch (secondary passes)");
     source.triangleIds->upload(ids.data(), ids.size() * sizeof(std::uint32_t));
     source.divided = true;
     result.phaseMs.emplace_back("divide", msSince(start));
@@ -414,7 +419,7 @@ Prelude makeRaysOnDevice(gpu::ComputePipeline& pipeline, const SecondaryPush& ba
         std::uint32_t step;
         std::uint64_t invocations;
     };
-    const std::vector<Step> steps = {{"make rays", 0, base.sourceCount}, {"ray ranges", 1, 1}, {"ray ids", 2, slots}};
+    const std::vector<Step> steps = {{"make rays", 0, slots}, {"ray ranges", 1, 1}, {"ray ids", 2, slots}};
     const std::uint64_t perGroupDispatch = std::uint64_t(perDispatch) * gpu::kSecondaryWorkgroup;
     Prelude prelude;
     for (const Step& s : steps) prelude.dispatches += std::uint32_t((s.invocations + perGroupDispatch - 1) / perGroupDispatch);
@@ -465,12 +470,7 @@ TraceResult traceGpuSecondary(GpuPassSource& source, const FrameGeometry& frame,
         .maxDepth = options.dacrt.maxDepth,
         .sourceRays = source.primaryRays,
     });
-    gpu::addToMemoryPlan(buffers, device, result.memory);
-    result.memory.addWork("rays made on the device", slots,
-                          std::to_string(pass.raysPerHit) + " per primary hit, where the surface can send one");
-    result.memory.addWork("gpu work items", source.work.items.size(), "Step 1 and every pair of regions, per ray group");
-    if (onPlan && !onPlan(result.memory)) return result;
-
+    // The buffers this pass shares with the primary pass: counted once, as kept.
     gpu::ResidentBuffers resident{};
     gpu::DacrtBindingSet& primary = *source.primary;
     resident[DACRT_BINDING_TRIANGLES] = &primary[DACRT_BINDING_TRIANGLES];
@@ -478,6 +478,15 @@ TraceResult traceGpuSecondary(GpuPassSource& source, const FrameGeometry& frame,
     resident[DACRT_BINDING_TRI_IDS] = source.triangleIds.get();
     resident[DACRT_BINDING_SOURCE_RAYS] = &primary[DACRT_BINDING_RAYS];
     resident[DACRT_BINDING_SOURCE_HITS] = &primary[DACRT_BINDING_HITS];
+    gpu::addToMemoryPlan(buffers, device, result.memory, &resident);
+    std::uint64_t kept = source.triangleIds->size();
+    for (std::uint32_t k = 0; k < DACRT_BINDING_COUNT; ++k) kept += primary[k].size();
+    result.memory.add("device: kept from the primary pass (its rays, hits, triangles and work buffers)", kept);
+    result.memory.addWork("rays made on the device", slots,
+                          std::to_string(pass.raysPerHit) + " per primary hit, where the surface can send one");
+    result.memory.addWork("gpu work items", source.work.items.size(), "Step 1 and every pair of regions, per ray group");
+    if (onPlan && !onPlan(result.memory)) return result;
+
     auto start = Clock::now();
     gpu::DacrtBindingSet set(context, buffers, resident);
     const GpuCounters zero{};

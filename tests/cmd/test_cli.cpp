@@ -152,6 +152,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCommand{"HeadlightAndALight",
                    "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light headlight --light point:0,1,2",
                    "headlight"},
+        BadCommand{"HugeIntensity", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light point:0,1,2:1e39",
+                   "exceeds 1e30"},
+        BadCommand{"TinyOcclusionDistance", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --ao 2 --ao-distance 1e-40",
+                   "--ao-distance"},
         BadCommand{"TooManyOcclusionRays", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --ao 5000", "--ao"},
         BadCommand{"NegativeOcclusionDistance", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --ao 2 --ao-distance -1",
                    "--ao-distance"}),
@@ -493,10 +497,14 @@ TEST(Cli, AnOrthographicCameraRendersAlikeOnEveryBackend) {
         EXPECT_EQ(aov.depth, brute.depth) << backend;
         // The quad's diagonal runs through the diagonal pixels' centres: a tie between its two
         // triangles, which brute force and DACRT give to the smaller id and Embree to either.
-        if (backend != "embree") EXPECT_EQ(aov.primId, brute.primId) << backend;
+        if (backend != "embree") {
+            EXPECT_EQ(aov.primId, brute.primId) << backend;
+        }
     }
     for (float z : brute.depth)
-        if (std::isfinite(z)) EXPECT_EQ(z, 3.0f);  // every ray travels 3 from the view plane z = 3
+        if (std::isfinite(z)) {
+            EXPECT_EQ(z, 3.0f);  // every ray travels 3 from the view plane z = 3
+        }
     const std::string side = temp("side.json");
     ASSERT_EQ(run("render " + scene + " --camera side --size 8x8 --stats " + side).code, 0);
     std::ifstream f(side);
@@ -595,6 +603,9 @@ TEST(Cli, LightsComeFromTheFileOrTheCommandLineAndHeadlightTracesNoPass) {
     EXPECT_EQ(named["lights"][0]["intensity"], 50.0);
     EXPECT_EQ(named["lights"][1]["type"], "directional");
     EXPECT_EQ(named["passes"].size(), 3u);
+    // A --light before the scene takes one value: the scene stays the positional argument.
+    const CommandResult before = run("render --light directional:0,0,-1 " + scene + " --size 8x6 --stats " + stats);
+    EXPECT_EQ(before.code, 0) << before.output;
     const nlohmann::json headlight = passes("--light headlight");
     EXPECT_EQ(headlight["lights"].size(), 0u);
     EXPECT_EQ(headlight["passes"].size(), 1u);

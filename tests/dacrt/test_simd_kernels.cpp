@@ -264,7 +264,9 @@ TEST(PacketFilter, NeverRejectsACellOneOfItsRaysMayCross) {
         bool anyRay = false;
         for (const Ray& r : rays) anyRay |= shared::rayMayCrossCell(r, cell.lo, cell.hi, kNoHitT);
         const bool packet = packetMayCrossCell(p, origin, tmin, cell);
-        if (anyRay) ASSERT_TRUE(packet) << "trial " << trial;
+        if (anyRay) {
+            ASSERT_TRUE(packet) << "trial " << trial;
+        }
         rejected += !packet;
         ++trials;
     }
