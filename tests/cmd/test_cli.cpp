@@ -331,13 +331,17 @@ TEST(Cli, RenderWithoutOutputsSaysHowToSave) {
 }
 
 TEST(Cli, TheLastLineNamesEveryFileWritten) {
-    const std::string png = temp("last.png"), exr = temp("last.exr");
+    // A folder of its own: other tests running beside it (ctest -j) leave temporaries in TempDir.
+    const std::filesystem::path folder = std::filesystem::path(::testing::TempDir()) / "cli_last_line";
+    std::filesystem::remove_all(folder);
+    std::filesystem::create_directories(folder);
+    const std::string png = (folder / "last.png").string(), exr = (folder / "last.exr").string();
     const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 8x6 -o " + png + " --aov " + exr);
     ASSERT_EQ(r.code, 0) << r.output;
     const std::string last = r.output.substr(r.output.rfind('\n', r.output.size() - 2) + 1);
     EXPECT_EQ(last, "dacrt: wrote " + png + ", " + exr + "\n");
     // No temporary file is left beside them.
-    for (const auto& e : std::filesystem::directory_iterator(::testing::TempDir()))
+    for (const auto& e : std::filesystem::directory_iterator(folder))
         EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
 }
 

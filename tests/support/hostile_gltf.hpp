@@ -3,6 +3,7 @@
 // change, with the part of the message that must name its problem. Used by the loader's
 // tests and, through `dacrt render`, by the command-line tests.
 #include <fstream>
+#include <unistd.h>
 #include <functional>
 #include <string>
 #include <vector>
@@ -165,9 +166,11 @@ inline std::vector<HostileGltf> hostileGltfFiles() {
     return files;
 }
 
-// Writes the file to the test's temporary folder and returns its path.
+// Writes the file to the test's temporary folder and returns its path; the process id keeps
+// the loader's and the CLI's tests, which write the same files, apart under `ctest -j`.
 inline std::string writeHostileGltf(const HostileGltf& h) {
-    const std::string path = ::testing::TempDir() + "/dacrt_hostile_" + h.name + ".gltf";
+    const std::string path =
+        ::testing::TempDir() + "/dacrt_hostile_" + h.name + "_" + std::to_string(getpid()) + ".gltf";
     std::ofstream(path) << h.contents();
     return path;
 }
