@@ -35,7 +35,7 @@ std::string join(const std::vector<std::string>& items) {
 }  // namespace
 
 int runInfo(const InfoOptions& options) {
-    const Scene scene = loadGltf(options.scenePath, {}, GltfSelection{options.sceneChoice});
+    const Scene scene = loadGltf(options.scenePath, {}, GltfSelection{.scene = options.sceneChoice});
     const GltfInventory& inv = scene.inventory;
     const Box box = sceneBounds(scene.triangles);
     std::cout << "file " << options.scenePath << "\n";

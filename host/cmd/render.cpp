@@ -60,7 +60,7 @@ struct PreparedScene {
 PreparedScene loadAndPrepare(const RenderOptions& o) {
     PreparedScene p;
     const auto start = Clock::now();
-    p.scene = loadGltf(o.scenePath, {}, GltfSelection{o.sceneChoice});
+    p.scene = loadGltf(o.scenePath, {}, GltfSelection{.scene = o.sceneChoice});
     selectCamera(p.scene, o.cameraChoice);
     for (const std::string& w : p.scene.warnings) std::cerr << "dacrt: warning: " << w << "\n";
     applyCullMode(p.scene, o.cull);

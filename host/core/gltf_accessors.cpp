@@ -187,6 +187,20 @@ std::vector<glm::dvec4> AccessorReader::readVectors(int index, std::initializer_
     return out;
 }
 
+std::vector<glm::dmat4> AccessorReader::readMatrices(int index, const std::string& where) const {
+    const Elements e = elements(index, {TINYGLTF_TYPE_MAT4}, where);
+    const std::string a = where + ": accessor " + std::to_string(index);
+    if (e.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) fail(a + ": matrices must be float32");
+    if (model_.accessors[std::size_t(index)].sparse.isSparse) fail(a + ": sparse matrices are not read");
+    const std::uint64_t bytes = mul(e.count, sizeof(glm::dmat4), a + " size");
+    if (byteLimit_ && bytes > byteLimit_) fail(a + " has " + str(e.count) + " matrices, more than the byte limit allows");
+    std::vector<glm::dmat4> out(e.count, glm::dmat4(0.0));
+    for (std::uint64_t i = 0; e.data && i < e.count; ++i)
+        for (int c = 0; c < 16; ++c)
+            out[i][c / 4][c % 4] = readComponent(e.data + i * e.stride + std::uint64_t(c) * 4, e.componentType, false);
+    return out;
+}
+
 std::vector<std::uint32_t> AccessorReader::readIndices(int index, const std::string& where) const {
     const tinygltf::Accessor& acc = accessor(index, {TINYGLTF_TYPE_SCALAR}, where);
     if (acc.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && acc.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&

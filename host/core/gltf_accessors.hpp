@@ -41,6 +41,8 @@ public:
     std::uint64_t checkedCount(int index, std::initializer_list<int> types, const std::string& where) const {
         return elements(index, types, where).count;
     }
+    // 4x4 float matrices, column-major as glTF stores them (a skin's inverse bind matrices).
+    std::vector<glm::dmat4> readMatrices(int index, const std::string& where) const;
     // Unsigned integer scalars (indices).
     std::vector<std::uint32_t> readIndices(int index, const std::string& where) const;
     // The bytes of a buffer view: the buffer's, or what EXT_meshopt_compression decoded.

@@ -20,6 +20,7 @@
 
 #include "core/errors.hpp"
 #include "core/gltf_accessors.hpp"
+#include "core/gltf_animation.hpp"
 #include "core/gltf_compression.hpp"
 #include "core/gltf_container.hpp"
 #include "core/gltf_materials.hpp"
@@ -290,17 +291,25 @@ private:
 
 // ---- planning: how many triangles, before anything is flattened --------------------------
 
-glm::dmat4 localTransform(const tinygltf::Node& node) {
+// The node's transform, its animated properties (pose) in place of its own. An animated node
+// has no matrix (readAnimations refuses one); properties neither set nor animated are skipped,
+// not multiplied as identities, so a still node's transform is what it always was.
+glm::dmat4 localTransform(const tinygltf::Node& node, const gltf::NodePose& pose) {
     if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());
     glm::dmat4 m(1.0);
-    if (node.translation.size() == 3) m = glm::translate(m, glm::make_vec3(node.translation.data()));
-    if (node.rotation.size() == 4) {
+    if (pose.translation) m = glm::translate(m, *pose.translation);
+    else if (node.translation.size() == 3) m = glm::translate(m, glm::make_vec3(node.translation.data()));
+    std::optional<glm::dquat> r = pose.rotation;
+    if (!r && node.rotation.size() == 4) {
         const std::vector<double>& q = node.rotation;  // glTF order: x, y, z, w
-        glm::dquat r(q[3], q[0], q[1], q[2]);
-        if (std::abs(glm::length(r) - 1.0) > 1e-12) r = glm::normalize(r);  // within 1% (checkNodes)
-        m = m * glm::mat4_cast(r);
+        r = glm::dquat(q[3], q[0], q[1], q[2]);
     }
-    if (node.scale.size() == 3) m = glm::scale(m, glm::make_vec3(node.scale.data()));
+    if (r) {
+        if (std::abs(glm::length(*r) - 1.0) > 1e-12) r = glm::normalize(*r);  // within 1% (checkNodes)
+        m = m * glm::mat4_cast(*r);
+    }
+    if (pose.scale) m = glm::scale(m, *pose.scale);
+    else if (node.scale.size() == 3) m = glm::scale(m, glm::make_vec3(node.scale.data()));
     return m;
 }
 
@@ -324,35 +333,55 @@ bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v
 const std::string kPosition = "POSITION", kNormal = "NORMAL", kColor = "COLOR_0";
 std::string texCoordName(std::uint32_t set) { return "TEXCOORD_" + std::to_string(set); }
 
+}  // namespace
+
+// What a file's every frame shares: the parsed model, its checks' results, the materials and
+// textures (decoded once), the animations and the primitives' data (read once, on first use).
+struct GltfDocument::Impl {
+    std::string name;
+    GltfLimits limits;
+    gltf::PreparedContainer prepared;
+    tinygltf::Model model;
+    std::unique_ptr<gltf::AccessorReader> reader;
+    std::vector<int> parent;                 // each node's, -1 for none
+    Scene shared;                            // materials (the default last), textures, the file's warnings
+    std::vector<gltf::Animation> animations;
+    std::vector<GltfAnimationInfo> animationInfo;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, gltf::PrimitiveData> primitives;  // by (mesh, primitive)
+
+    std::uint64_t memoryLimit() const { return limits.maxBytes ? limits.maxBytes : physicalMemoryBytes(); }
+};
+
+namespace {
+
 class GltfFlattener {
 public:
-    GltfFlattener(gltf::AccessorReader& reader, const GltfLimits& limits, const GltfSelection& selection,
-                  const gltf::ImageSource& images)
-        : reader_(reader), model_(reader.model()), limits_(limits), selection_(selection), images_(images), check_(reader) {
-        scene_.name = reader.name();
+    GltfFlattener(GltfDocument::Impl& document, const GltfSelection& selection)
+        : document_(document), reader_(*document.reader), model_(document.model), limits_(document.limits),
+          selection_(selection), check_(*document.reader) {
+        scene_.name = document.name;
     }
 
     Scene run() {
-        check_.checkExtensions(scene_.warnings);
-        check_.checkCameras();
-        const std::vector<int> parent = check_.checkNodes(scene_.warnings);
         const int sceneIndex = check_.chooseScene(selection_.scene);
-        const std::vector<NodeInstance> instances = walkHierarchy(check_.sceneRoots(parent, sceneIndex));
-        gltf::decodeMeshoptViews(reader_, memoryLimit());
+        const int animation = gltf::chooseAnimation(document_.animations, selection_.animation, reader_);
+        pose_ = gltf::poseAt(document_.animations, animation, selection_.time, model_.nodes.size());
+        const std::vector<NodeInstance> instances = walkHierarchy(check_.sceneRoots(document_.parent, sceneIndex));
         planTriangles(instances);
-        gltf::readMaterials(reader_, images_, scene_);
-        defaultMaterial_ = std::uint32_t(scene_.materials.size());
-        Material fallback;
-        fallback.name = "(default)";
-        scene_.materials.push_back(fallback);
+        scene_.materials = document_.shared.materials;
+        scene_.textures = document_.shared.textures;
+        scene_.warnings = document_.shared.warnings;
+        defaultMaterial_ = std::uint32_t(scene_.materials.size() - 1);
         for (const NodeInstance& i : instances) flattenNode(i);
         takeInventory(sceneIndex);
-        warnAboutMotion();
+        if (unweightedVertices_)
+            scene_.warnings.push_back(reader_.name() + ": " + str(unweightedVertices_) +
+                                      " skinned vertices have no joint weight; they follow their skin's first joint");
         return std::move(scene_);
     }
 
 private:
-    std::uint64_t memoryLimit() const { return limits_.maxBytes ? limits_.maxBytes : physicalMemoryBytes(); }
+    std::uint64_t memoryLimit() const { return document_.memoryLimit(); }
 
     // Every node of the scene with its world transform, depth first without recursion.
     std::vector<NodeInstance> walkHierarchy(const std::vector<int>& roots) const {
@@ -366,7 +395,8 @@ private:
                 check_.fail("the node hierarchy is deeper than " + str(limits_.maxHierarchyDepth) + " levels (at node " +
                             std::to_string(parentInstance.node) + ")");
             const tinygltf::Node& node = model_.nodes[std::size_t(parentInstance.node)];
-            const NodeInstance here{parentInstance.node, parentInstance.world * localTransform(node)};
+            const NodeInstance here{parentInstance.node,
+                                    parentInstance.world * localTransform(node, pose_[std::size_t(parentInstance.node)])};
             out.push_back(here);
             for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({{*c, here.world}, depth + 1});
         }
@@ -551,6 +581,127 @@ private:
         if (v.size() < n) v.resize(n, {value, value, value});
     }
 
+    // The primitive's indices and attributes, read once per document: the shading's, a skin's
+    // JOINTS_n and WEIGHTS_n, and each morph target's POSITION and NORMAL offsets (as
+    // "TARGET<i>:POSITION"). A Draco mesh placed by many nodes is decoded once too.
+    const gltf::PrimitiveData& primitiveData(std::uint32_t meshIndex, std::uint32_t primIndex, const tinygltf::Primitive& prim,
+                                             std::uint32_t material, const std::string& where) {
+        const auto key = std::make_pair(meshIndex, primIndex);
+        if (auto cached = document_.primitives.find(key); cached != document_.primitives.end()) return cached->second;
+        std::vector<std::string> wanted = wantedAttributes(material);
+        for (const auto& [name, accessor] : prim.attributes)
+            if (name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) wanted.push_back(name);
+        gltf::PrimitiveData data = readPrimitive(prim, wanted, where);
+        if (!prim.targets.empty() && gltf::usesDraco(prim))
+            check_.fail(where + ": morph targets of a Draco-compressed primitive are not read");
+        const std::size_t vertices = data.attributes.count(kPosition) ? data.attributes.at(kPosition).size() : 0;
+        for (std::size_t t = 0; t < prim.targets.size(); ++t)
+            for (const std::string& name : {kPosition, kNormal}) {
+                auto a = prim.targets[t].find(name);
+                if (a == prim.targets[t].end()) continue;
+                const std::string w = where + " morph target " + str(t) + " " + name;
+                std::vector<glm::dvec4> offsets = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3}, w);
+                if (offsets.size() != vertices)
+                    check_.fail(w + ": accessor " + std::to_string(a->second) + " has " + str(offsets.size()) +
+                                " elements, POSITION has " + str(vertices));
+                data.attributes["TARGET" + std::to_string(t) + ":" + name] = std::move(offsets);
+            }
+        return document_.primitives.emplace(key, std::move(data)).first->second;
+    }
+
+    // The morph-target weights of a node's mesh at this instant: animated, else the node's,
+    // else the mesh's, else zeros; as many as the mesh's primitives have targets.
+    std::vector<double> morphWeights(std::uint32_t nodeIndex, const tinygltf::Mesh& mesh, std::size_t targets,
+                                     const std::string& where) const {
+        const tinygltf::Node& node = model_.nodes[nodeIndex];
+        const std::optional<std::vector<double>>& animated = pose_[nodeIndex].weights;
+        const std::vector<double>& w = animated ? *animated : !node.weights.empty() ? node.weights : mesh.weights;
+        if (w.empty()) return std::vector<double>(targets, 0.0);
+        if (w.size() != targets)
+            check_.fail(where + ": " + str(w.size()) + " morph weights for " + str(targets) + " morph targets");
+        for (double x : w)
+            if (!std::isfinite(x)) check_.fail(where + ": a morph weight is not finite");
+        return w;
+    }
+
+    // A skin's joint matrices at this instant: each joint's world transform times its inverse
+    // bind matrix. (glTF ignores the skinned mesh node's own transform.)
+    std::vector<glm::dmat4> jointMatrices(int skinIndex, const std::string& where) {
+        if (skinIndex < 0 || std::size_t(skinIndex) >= model_.skins.size())
+            check_.fail(where + ": skin " + std::to_string(skinIndex) + " does not exist");
+        const tinygltf::Skin& skin = model_.skins[std::size_t(skinIndex)];
+        const std::string w = "skin " + std::to_string(skinIndex);
+        if (skin.joints.empty()) check_.fail(w + " has no joints");
+        std::vector<glm::dmat4> inverseBind(skin.joints.size(), glm::dmat4(1.0));
+        if (skin.inverseBindMatrices >= 0) {
+            inverseBind = reader_.readMatrices(skin.inverseBindMatrices, w + " inverseBindMatrices");
+            if (inverseBind.size() < skin.joints.size())
+                check_.fail(w + ": " + str(inverseBind.size()) + " inverse bind matrices for " + str(skin.joints.size()) + " joints");
+        }
+        std::vector<glm::dmat4> out(skin.joints.size());
+        for (std::size_t j = 0; j < skin.joints.size(); ++j) {
+            const int joint = skin.joints[j];
+            if (joint < 0 || std::size_t(joint) >= model_.nodes.size())
+                check_.fail(w + " names joint node " + std::to_string(joint) + ", which does not exist");
+            out[j] = nodeWorld(std::size_t(joint)) * inverseBind[j];
+            for (int c = 0; c < 4; ++c)
+                if (!finite3(glm::dvec3(out[j][c])) || !std::isfinite(out[j][c][3]))
+                    check_.fail(w + ": joint " + str(j) + " has a non-finite matrix");
+        }
+        return out;
+    }
+
+    // Any node's world transform at this instant (a joint may lie outside the loaded scene).
+    const glm::dmat4& nodeWorld(std::size_t node) {
+        if (worlds_.empty()) worlds_.resize(model_.nodes.size());
+        if (!worlds_[node]) {
+            const glm::dmat4 local = localTransform(model_.nodes[node], pose_[node]);
+            const int parent = document_.parent[node];
+            worlds_[node] = parent < 0 ? glm::dmat4(1.0) * local : nodeWorld(std::size_t(parent)) * local;
+        }
+        return *worlds_[node];
+    }
+
+    // Each vertex's skinning matrix: its joints' matrices weighted over every JOINTS_n/WEIGHTS_n
+    // set (weights normalized to sum 1; a vertex with none keeps the first joint's).
+    std::vector<glm::dmat4> vertexSkinning(const gltf::PrimitiveData& data, const std::vector<glm::dmat4>& joints,
+                                           std::size_t vertices, const std::string& where) {
+        std::vector<glm::dmat4> out(vertices, glm::dmat4(0.0));
+        std::vector<double> total(vertices, 0.0);
+        bool anySet = false;
+        for (int set = 0;; ++set) {
+            auto j = data.attributes.find("JOINTS_" + std::to_string(set));
+            auto w = data.attributes.find("WEIGHTS_" + std::to_string(set));
+            if (j == data.attributes.end() && w == data.attributes.end()) break;
+            if (j == data.attributes.end() || w == data.attributes.end())
+                check_.fail(where + ": JOINTS_" + std::to_string(set) + " and WEIGHTS_" + std::to_string(set) + " come in pairs");
+            anySet = true;
+            for (std::size_t v = 0; v < vertices; ++v)
+                for (int k = 0; k < 4; ++k) {
+                    const double weight = w->second[v][k];
+                    if (!(weight >= 0.0) || !std::isfinite(weight))
+                        check_.fail(where + ": vertex " + str(v) + " has a negative or non-finite skin weight");
+                    if (weight == 0.0) continue;
+                    const double joint = j->second[v][k];
+                    if (!(joint >= 0.0) || joint >= double(joints.size()) || joint != std::floor(joint))
+                        check_.fail(where + ": vertex " + str(v) + " names joint " + std::to_string(joint) + "; the skin has " +
+                                    str(joints.size()));
+                    out[v] += weight * joints[std::size_t(joint)];
+                    total[v] += weight;
+                }
+        }
+        if (!anySet) check_.fail(where + ": a skinned mesh's primitive has no JOINTS_0 and WEIGHTS_0");
+        for (std::size_t v = 0; v < vertices; ++v) {
+            if (total[v] > 0.0) {
+                if (total[v] != 1.0) out[v] /= total[v];
+            } else {
+                out[v] = joints.front();
+                ++unweightedVertices_;
+            }
+        }
+        return out;
+    }
+
     void addPrimitive(std::uint32_t node, std::uint32_t meshIndex, std::uint32_t primIndex,
                       const tinygltf::Primitive& prim, const glm::dmat4& world) {
         const std::string where = "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(primIndex);
@@ -562,19 +713,7 @@ private:
             material = std::uint32_t(prim.material);
         }
         checkPositionType(prim, where);
-        // A Draco mesh placed by many nodes is decoded once (the decoder is the costly reader).
-        gltf::PrimitiveData plain;
-        const gltf::PrimitiveData* read = &plain;
-        if (gltf::usesDraco(prim)) {
-            const auto key = std::make_pair(meshIndex, primIndex);
-            auto cached = dracoDecoded_.find(key);
-            if (cached == dracoDecoded_.end())
-                cached = dracoDecoded_.emplace(key, readPrimitive(prim, wantedAttributes(material), where)).first;
-            read = &cached->second;
-        } else {
-            plain = readPrimitive(prim, wantedAttributes(material), where);
-        }
-        const gltf::PrimitiveData& data = *read;
+        const gltf::PrimitiveData& data = primitiveData(meshIndex, primIndex, prim, material, where);
         if (data.trianglesListed) mode = TINYGLTF_MODE_TRIANGLES;
         if (!data.attributes.count(kPosition)) check_.fail(where + ": no POSITION data");
         const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
@@ -596,14 +735,6 @@ private:
         }
         if (corners.size() % 3 != 0) check_.fail(where + ": " + str(corners.size()) + " indices is not a multiple of 3");
 
-        std::vector<glm::vec3> worldPositions(positions.size());
-        for (std::size_t i = 0; i < positions.size(); ++i) {
-            const glm::dvec3 p(positions[i]);
-            if (!finite3(p))
-                check_.fail(where + ": vertex " + std::to_string(i) + " has a non-finite position (" + std::to_string(p.x) +
-                            ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
-            worldPositions[i] = glm::vec3(world * glm::dvec4(p, 1.0));
-        }
         auto attribute = [&](const std::string& name) -> const std::vector<glm::dvec4>* {
             auto it = data.attributes.find(name);
             if (it == data.attributes.end()) return nullptr;
@@ -617,24 +748,58 @@ private:
         const std::vector<glm::dvec4>* texCoords = texture.texture >= 0 ? attribute(texCoordName(texture.texCoord)) : nullptr;
         const bool colorHasAlpha = colors && prim.attributes.count(kColor) &&
                                    model_.accessors[std::size_t(prim.attributes.at(kColor))].type == TINYGLTF_TYPE_VEC4;
-        const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
 
-        // glTF: a node whose global transform mirrors (negative determinant) turns its
-        // triangles' winding clockwise; swapping two corners keeps counter-clockwise the front.
-        const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
-        const int order[3] = {0, mirrored ? 2 : 1, mirrored ? 1 : 2};
+        // Morph targets first (offsets weighted in the mesh's space), then the skin or the node.
+        std::vector<glm::dvec3> local(positions.size());
+        std::vector<glm::dvec3> localNormals(normals ? positions.size() : 0);
+        for (std::size_t i = 0; i < positions.size(); ++i) local[i] = glm::dvec3(positions[i]);
+        for (std::size_t i = 0; i < localNormals.size(); ++i) localNormals[i] = glm::dvec3((*normals)[i]);
+        if (!prim.targets.empty()) {
+            const std::vector<double> weights =
+                morphWeights(node, model_.meshes[meshIndex], prim.targets.size(), "node " + std::to_string(node) + " " + where);
+            for (std::size_t t = 0; t < weights.size(); ++t) {
+                if (weights[t] == 0.0) continue;
+                if (const auto* d = attribute("TARGET" + std::to_string(t) + ":" + kPosition))
+                    for (std::size_t i = 0; i < local.size(); ++i) local[i] += weights[t] * glm::dvec3((*d)[i]);
+                if (const auto* d = attribute("TARGET" + std::to_string(t) + ":" + kNormal); d && normals)
+                    for (std::size_t i = 0; i < localNormals.size(); ++i) localNormals[i] += weights[t] * glm::dvec3((*d)[i]);
+            }
+        }
+        const int skin = model_.nodes[node].skin;
+        std::vector<glm::dmat4> skinning;
+        if (skin >= 0) skinning = vertexSkinning(data, jointMatrices(skin, where), positions.size(), where);
+        auto transformOf = [&](std::uint32_t vertex) -> const glm::dmat4& { return skin >= 0 ? skinning[vertex] : world; };
+
+        std::vector<glm::vec3> worldPositions(positions.size());
+        for (std::size_t i = 0; i < positions.size(); ++i) {
+            const glm::dvec3& p = local[i];
+            if (!finite3(p))
+                check_.fail(where + ": vertex " + std::to_string(i) + " has a non-finite position (" + std::to_string(p.x) +
+                            ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
+            worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(p, 1.0));
+        }
+        const glm::dmat3 nodeNormalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+        const bool nodeMirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+
         const std::uint32_t cullBackFace = scene_.materials[material].doubleSided ? 0u : 1u;
         CornerAttributes& out = scene_.corners;
         for (std::size_t t = 0; t * 3 < corners.size(); ++t) {
+            for (int k = 0; k < 3; ++k)
+                if (corners[t * 3 + std::size_t(k)] >= positions.size())
+                    check_.fail(where + ": index " + std::to_string(corners[t * 3 + std::size_t(k)]) + " (triangle " +
+                                std::to_string(t) + ") is out of range for " + str(positions.size()) + " vertices");
+            // glTF: a transform that mirrors (negative determinant) turns the triangles' winding
+            // clockwise; swapping two corners keeps counter-clockwise the front. A skinned
+            // triangle mirrors with its first corner's skinning.
+            const bool mirrored =
+                skin >= 0 ? glm::determinant(glm::dmat3(skinning[corners[t * 3]])) < 0.0 : nodeMirrored;
+            const int order[3] = {0, mirrored ? 2 : 1, mirrored ? 1 : 2};
             Triangle tri{};
             tri.cullBackFace = cullBackFace;
             glm::vec3* v[3] = {&tri.v0, &tri.v1, &tri.v2};
             std::uint32_t index[3];
             for (int k = 0; k < 3; ++k) {
                 index[k] = corners[t * 3 + std::size_t(order[k])];
-                if (index[k] >= positions.size())
-                    check_.fail(where + ": index " + std::to_string(index[k]) + " (triangle " + std::to_string(t) +
-                                ") is out of range for " + str(positions.size()) + " vertices");
                 *v[k] = worldPositions[index[k]];
             }
             // Never hit, so never traced. (A non-finite vertex gives a non-zero cross product:
@@ -650,7 +815,9 @@ private:
             if (normals || !out.normals.empty()) {
                 fillTo(out.normals, at + 1, glm::vec3(0.0f));
                 for (int k = 0; normals && k < 3; ++k) {
-                    const glm::dvec3 n = normalMatrix * glm::dvec3((*normals)[index[k]]);
+                    const glm::dmat3 normalMatrix =
+                        skin >= 0 ? glm::transpose(glm::inverse(glm::dmat3(skinning[index[k]]))) : nodeNormalMatrix;
+                    const glm::dvec3 n = normalMatrix * localNormals[index[k]];
                     const double length = glm::length(n);
                     out.normals[at][std::size_t(k)] = length > 0.0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f);
                 }
@@ -672,20 +839,6 @@ private:
             }
         }
         touchTriangles(scene_);
-    }
-
-    // Animations, skins and morph targets are not applied: the meshes are traced at rest (their
-    // bind pose, morph weights 0). Said once, so that a still image is not mistaken for a frame.
-    void warnAboutMotion() {
-        std::size_t morphed = 0;
-        for (const tinygltf::Mesh& m : model_.meshes)
-            for (const tinygltf::Primitive& p : m.primitives) morphed += !p.targets.empty();
-        std::vector<std::string> parts;
-        if (!model_.animations.empty()) parts.push_back(str(model_.animations.size()) + " animation(s)");
-        if (!model_.skins.empty()) parts.push_back(str(model_.skins.size()) + " skin(s)");
-        if (morphed) parts.push_back(str(morphed) + " primitive(s) with morph targets");
-        if (!parts.empty())
-            scene_.warnings.push_back(reader_.name() + ": " + joined(parts) + " not applied; the meshes are traced at rest");
     }
 
     void takeInventory(int sceneIndex) {
@@ -725,34 +878,20 @@ private:
         inv.extensionsRequired = model_.extensionsRequired;
     }
 
+    GltfDocument::Impl& document_;
     gltf::AccessorReader& reader_;
     const tinygltf::Model& model_;
     GltfLimits limits_;
     GltfSelection selection_;
-    gltf::ImageSource images_;
     GltfChecker check_;
     Scene scene_;
     std::uint32_t defaultMaterial_ = 0;
-    std::map<std::pair<std::uint32_t, std::uint32_t>, gltf::PrimitiveData> dracoDecoded_;  // by (mesh, primitive)
+    std::vector<gltf::NodePose> pose_;                  // every node's animated properties at this instant
+    std::vector<std::optional<glm::dmat4>> worlds_;     // nodeWorld's, computed on demand
+    std::uint64_t unweightedVertices_ = 0;              // skinned vertices without a weight
 };
 
-Scene loadFromBytes(std::span<const unsigned char> bytes, const std::string& name, const std::string& baseDir,
-                    bool readFiles, const GltfLimits& limits, const GltfSelection& selection) {
-    if (bytes.empty()) throw InputError(name + ": the file is empty");
-    checkJsonNesting(bytes, name, limits);
-    const gltf::PreparedContainer prepared = gltf::prepareForParser(bytes);
-    const tinygltf::Model model = parseGltf(prepared.bytes.empty() ? bytes : std::span<const unsigned char>(prepared.bytes),
-                                            name, baseDir, readFiles);
-    gltf::AccessorReader reader(name, model, prepared.rewrites);
-    reader.setByteLimit(limits.maxBytes ? limits.maxBytes : physicalMemoryBytes());
-    Scene scene = GltfFlattener(reader, limits, selection, gltf::ImageSource{baseDir, readFiles}).run();
-    validateScene(scene);
-    return scene;
-}
-
-}  // namespace
-
-Scene loadGltf(const std::string& path, const GltfLimits& limits, const GltfSelection& selection) {
+std::vector<unsigned char> readWholeFile(const std::string& path, const GltfLimits& limits) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": no such file");
     const std::uint64_t size = std::filesystem::file_size(path, ec);
@@ -764,13 +903,75 @@ Scene loadGltf(const std::string& path, const GltfLimits& limits, const GltfSele
     std::ifstream in(path, std::ios::binary);
     if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
         throw InputError(path + ": cannot read the file");
+    return bytes;
+}
+
+}  // namespace
+
+// Parses and checks the file, and reads what every frame shares.
+std::unique_ptr<GltfDocument::Impl> openDocument(std::span<const unsigned char> bytes, const std::string& name,
+                                                 const std::string& baseDir, bool readFiles, const GltfLimits& limits) {
+    if (bytes.empty()) throw InputError(name + ": the file is empty");
+    checkJsonNesting(bytes, name, limits);
+    auto d = std::make_unique<GltfDocument::Impl>();
+    d->name = name;
+    d->limits = limits;
+    d->prepared = gltf::prepareForParser(bytes);
+    d->model = parseGltf(d->prepared.bytes.empty() ? bytes : std::span<const unsigned char>(d->prepared.bytes), name, baseDir,
+                         readFiles);
+    d->prepared.bytes = {};  // parsed: only the rewrites are read from here on
+    d->reader = std::make_unique<gltf::AccessorReader>(name, d->model, d->prepared.rewrites);
+    d->reader->setByteLimit(d->memoryLimit());
+    const GltfChecker check(*d->reader);
+    check.checkExtensions(d->shared.warnings);
+    check.checkCameras();
+    d->parent = check.checkNodes(d->shared.warnings);
+    gltf::decodeMeshoptViews(*d->reader, d->memoryLimit());
+    gltf::readMaterials(*d->reader, gltf::ImageSource{baseDir, readFiles}, d->shared);
+    Material fallback;
+    fallback.name = "(default)";
+    d->shared.materials.push_back(fallback);
+    d->animations = gltf::readAnimations(*d->reader, d->shared.warnings);
+    for (const gltf::Animation& a : d->animations)
+        d->animationInfo.push_back(GltfAnimationInfo{a.name, a.start, a.end, a.channels.size()});
+    return d;
+}
+
+GltfDocument::GltfDocument(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+GltfDocument::GltfDocument(GltfDocument&&) noexcept = default;
+GltfDocument& GltfDocument::operator=(GltfDocument&&) noexcept = default;
+GltfDocument::~GltfDocument() = default;
+
+GltfDocument GltfDocument::open(const std::string& path, const GltfLimits& limits) {
+    const std::vector<unsigned char> bytes = readWholeFile(path, limits);
     const std::string baseDir = std::filesystem::path(path).parent_path().string();
-    return loadFromBytes(bytes, path, baseDir.empty() ? "." : baseDir, true, limits, selection);
+    return GltfDocument(openDocument(bytes, path, baseDir.empty() ? "." : baseDir, true, limits));
+}
+
+GltfDocument GltfDocument::fromMemory(std::span<const unsigned char> bytes, const std::string& name, const GltfLimits& limits) {
+    return GltfDocument(openDocument(bytes, name, "", false, limits));
+}
+
+Scene GltfDocument::scene(const GltfSelection& selection) const {
+    if (!std::isfinite(selection.time)) throw InputError(impl_->name + ": the time " + std::to_string(selection.time) + " is not finite");
+    Scene scene = GltfFlattener(*impl_, selection).run();
+    validateScene(scene);
+    return scene;
+}
+
+const std::vector<GltfAnimationInfo>& GltfDocument::animations() const { return impl_->animationInfo; }
+
+void GltfDocument::checkAnimationChoice(const std::string& choice) const {
+    gltf::chooseAnimation(impl_->animations, choice, *impl_->reader);
+}
+
+Scene loadGltf(const std::string& path, const GltfLimits& limits, const GltfSelection& selection) {
+    return GltfDocument::open(path, limits).scene(selection);
 }
 
 Scene loadGltfFromMemory(std::span<const unsigned char> bytes, const std::string& name, const GltfLimits& limits,
                          const GltfSelection& selection) {
-    return loadFromBytes(bytes, name, "", false, limits, selection);
+    return GltfDocument::fromMemory(bytes, name, limits).scene(selection);
 }
 
 void selectCamera(Scene& scene, const std::string& choice) {

@@ -1,8 +1,11 @@
 #pragma once
-// The load stage: a glTF 2.0 file's default scene flattened into world-space triangles.
+// The load stage: a glTF 2.0 file's scene flattened into world-space triangles, at an instant of
+// its animations.
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "core/scene.hpp"
 
@@ -14,9 +17,49 @@ struct GltfLimits {
     std::uint32_t maxJsonNesting = 256;      // objects and arrays inside one another, checked before parsing
 };
 
-// Which of the file's scenes to load: an index or a name; empty: the file's default scene.
+// Which of the file's scenes to load, and when: an index or a name; empty: the file's default
+// scene. Animations (node translation, rotation, scale and morph-target weights) are sampled
+// at `time` seconds: every animation of the file together, or the one `animation` names (an
+// index or a name). Skins and morph targets always deform their meshes, animated or not.
 struct GltfSelection {
     std::string scene;
+    std::string animation;  // empty: every animation together
+    double time = 0.0;      // seconds; before an animation's first key it holds the first key's value
+};
+
+// An animation of the file: its name, its keys' time span (seconds) and its channels.
+struct GltfAnimationInfo {
+    std::string name;
+    double start = 0.0;
+    double end = 0.0;
+    std::size_t channels = 0;
+};
+
+// A glTF file parsed and checked once, its scenes flattened at any instant: what a frame range
+// loads once and evaluates per frame. The accessors' data are read once and kept.
+class GltfDocument {
+public:
+    static GltfDocument open(const std::string& path, const GltfLimits& limits = {});
+    static GltfDocument fromMemory(std::span<const unsigned char> bytes, const std::string& name, const GltfLimits& limits = {});
+    GltfDocument(GltfDocument&&) noexcept;
+    GltfDocument& operator=(GltfDocument&&) noexcept;
+    ~GltfDocument();
+
+    // The flattened scene (as loadGltf describes) at the selection's instant. Throws InputError
+    // for a scene or animation that does not exist, or an animation that cannot be sampled.
+    Scene scene(const GltfSelection& selection = {}) const;
+
+    const std::vector<GltfAnimationInfo>& animations() const;
+
+    // Throws InputError listing the animations when `choice` (an index or a name) names none;
+    // empty names every animation.
+    void checkAnimationChoice(const std::string& choice) const;
+
+    struct Impl;  // the loader's own (gltf_loader.cpp)
+    explicit GltfDocument(std::unique_ptr<Impl> impl);
+
+private:
+    std::unique_ptr<Impl> impl_;
 };
 
 // Loads the default scene of a glTF 2.0 file (.gltf or .glb) and flattens every triangle
