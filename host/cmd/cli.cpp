@@ -13,6 +13,7 @@
 
 #include "cmd/bench/bench.hpp"
 #include "cmd/exit_codes.hpp"
+#include "cmd/frame_range.hpp"
 #include "cmd/output_paths.hpp"
 #include "cmd/info.hpp"
 #include "cmd/render.hpp"
@@ -170,12 +171,52 @@ void addDeviceOptions(CLI::App* cmd, DeviceChoice& devices) {
     cmd->add_flag("--validate", devices.validate, "run under the Vulkan validation layers; errors fail the run with exit 3 (gpu, rayquery)");
 }
 
+// render's instants and their shards (docs/animation.md): the values as text, parsed by
+// applyFrameOptions when the command runs.
+template <typename State>
+void addFrameOptions(CLI::App* cmd, State& s) {
+    RenderOptions& render = s.render;
+    cmd->add_option("--time", s.time, "render the scene at this instant of its animations, in seconds (default 0)");
+    cmd->add_option("--frames", s.frames,
+                    "render frames FIRST to LAST (inclusive), every STEP-th: FIRST:LAST[:STEP]; frame n is at n / fps "
+                    "seconds; every output name needs a frame number pattern (out_%04d.png)");
+    cmd->add_option("--fps", s.fps, "frames per second of --frames")->default_str("24");
+    cmd->add_option("--animation", render.animationChoice,
+                    "which animation plays, by index or name (default: every animation of the file together; "
+                    "'dacrt info' lists them)");
+    cmd->add_option("--shard", render.shards.shard,
+                    "render the I-th of N shards of --frames, I/N with I from 0 (default: from SLURM_ARRAY_TASK_ID "
+                    "or JOB_COMPLETION_INDEX, else every frame)");
+    cmd->add_option("--shard-mode", s.shardMode,
+                    "how a range is split: interleaved (frame k of the range to shard k mod N) or blocked "
+                    "(contiguous runs)")
+        ->check(CLI::IsMember({"interleaved", "blocked"}))
+        ->default_str("interleaved");
+    cmd->add_option("--shard-count", render.shards.count,
+                    "the number of shards of a Kubernetes Indexed Job (its completions), whose JOB_COMPLETION_INDEX "
+                    "gives the shard")
+        ->check(CLI::Range(1, kMaxShards));
+    cmd->add_flag("--skip-existing", render.skipExisting,
+                  "do not render a frame whose every output exists (a re-run finishes the missing frames)");
+}
+
+template <typename State>
+void applyFrameOptions(const State& s, RenderOptions& r) {
+    if (!s.time.empty()) r.time = parseTime(s.time);
+    if (!s.frames.empty()) r.frames = parseFrameRange(s.frames);
+    r.fpsGiven = !s.fps.empty();
+    if (r.fpsGiven) r.fps = parseFps(s.fps);
+    r.shards.modeGiven = !s.shardMode.empty();
+    r.shards.mode = s.shardMode == "blocked" ? ShardMode::Blocked : ShardMode::Interleaved;
+}
+
 Subcommand addRenderCommand(CLI::App& app) {
     struct State {
         RenderOptions render;
         std::string size = "640x480";
         CameraText camera;
         bool embreeFast = false, embreeSingleRays = false;
+        std::string time, frames, fps, shardMode;  // parsed when the command runs, errors quoting the text
     };
     auto s = std::make_shared<State>();
     RenderOptions& render = s->render;
@@ -230,8 +271,10 @@ Subcommand addRenderCommand(CLI::App& app) {
                     "triangle ids (gpu; default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; "
                     "64 / regions on a GPU)")
         ->check(CLI::Range(1u, 64u));
+    addFrameOptions(cmd, *s);
     return {cmd, [s, cmd] {
                 RenderOptions& r = s->render;
+                applyFrameOptions(*s, r);
                 parseSize(s->size, r.width, r.height);
                 applyCameraOptions(*cmd, s->camera, r.camera);
                 r.request.embree.robust = !s->embreeFast;
@@ -340,6 +383,7 @@ Subcommand addBenchCommand(CLI::App& app) {
         std::string size = "640x480";
         CameraText camera;
         bool noCache = false;
+        std::string frames, fps;  // --suite animation, parsed as render parses them
     };
     auto s = std::make_shared<State>();
     BenchCommand& bench = s->bench;
@@ -350,8 +394,17 @@ Subcommand addBenchCommand(CLI::App& app) {
                          "rayquery with one that has ray query)", enumNameList<Backend>());
     addEnumOption(cmd, "--suite", bench.suite,
                   "sweep (every option value), peers (each DACRT default against every embree and rayquery mode), "
-                  "skips (each skip of the work plan off in turn), table51 (the source's Table 5.1 and Figure 5.3) or "
-                  "passes (a lit frame's primary, shadow and occlusion passes timed apart, checked against cpu-seq)");
+                  "skips (each skip of the work plan off in turn), table51 (the source's Table 5.1 and Figure 5.3), "
+                  "passes (a lit frame's primary, shadow and occlusion passes timed apart, checked against cpu-seq) or "
+                  "animation (an animated scene's frames: evaluation, each backend's rebuild or refit and trace)");
+    CLI::Option* frames = cmd->add_option("--frames", s->frames,
+                                          "--suite animation: frames FIRST to LAST (inclusive), every STEP-th: "
+                                          "FIRST:LAST[:STEP]; frame n is at n / fps seconds")
+                              ->default_str("0:11");
+    CLI::Option* fps = cmd->add_option("--fps", s->fps, "--suite animation: frames per second")->default_str("24");
+    CLI::Option* animation = cmd->add_option("--animation", bench.animation.animation,
+                                             "--suite animation: which animation plays, by index or name (default: "
+                                             "every animation of the file together)");
     CLI::Option* light = cmd->add_option("--light", bench.passes.lights,
                                          "--suite passes: a light, repeatable, as render's --light (default: the "
                                          "scene's lights, else a key light over the first camera's left shoulder)")
@@ -368,8 +421,8 @@ Subcommand addBenchCommand(CLI::App& app) {
     cmd->add_option("--orbit", bench.orbit, "K cameras on a circle about the vertical axis")->check(CLI::Range(1, 1000))->default_str("1");
     addCameraOptions(cmd, s->camera);
     cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
-    cmd->add_option("--repeat", bench.repeat, "timed frames per camera and configuration")->check(CLI::Range(1, 1000))->default_str("3");
-    cmd->add_option("--warmup", bench.warmup, "untimed frames first")->check(CLI::Range(0, 1000))->default_str("1");
+    cmd->add_option("--repeat", bench.repeat, "timed frames per camera (--suite animation: per frame) and configuration")->check(CLI::Range(1, 1000))->default_str("3");
+    cmd->add_option("--warmup", bench.warmup, "untimed frames first (of each camera or frame)")->check(CLI::Range(0, 1000))->default_str("1");
     cmd->add_option("--out", bench.outDir, "directory of the outputs not named below")->default_str("dacrt-bench");
     cmd->add_option("--csv", bench.csvPath, "one row per scene and configuration (default OUT/bench.csv)");
     cmd->add_option("--json", bench.jsonPath,
@@ -377,10 +430,15 @@ Subcommand addBenchCommand(CLI::App& app) {
     cmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
     cmd->add_flag("--no-cache", s->noCache, "always recompute the float64 reference");
     addDeviceOptions(cmd, bench.devices);
-    return {cmd, [s, cmd, light, ao, aoDistance] {
+    return {cmd, [s, cmd, light, ao, aoDistance, frames, fps, animation] {
                 if (s->bench.suite != BenchSuite::Passes && (light->count() || ao->count() || aoDistance->count()))
                     throw InputError("--light, --ao and --ao-distance light the frames of --suite passes; the other "
                                      "suites time primary rays alone");
+                if (s->bench.suite != BenchSuite::Animation && (frames->count() || fps->count() || animation->count()))
+                    throw InputError("--frames, --fps and --animation choose the frames of --suite animation; the "
+                                     "other suites trace the scene as loaded");
+                if (!s->frames.empty()) s->bench.animation.frames = parseFrameRange(s->frames);
+                if (!s->fps.empty()) s->bench.animation.fps = parseFps(s->fps);
                 parseSize(s->size, s->bench.width, s->bench.height);
                 applyCameraOptions(*cmd, s->camera, s->bench.camera);
                 s->bench.useCache = !s->noCache;

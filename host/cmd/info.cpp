@@ -35,7 +35,8 @@ std::string join(const std::vector<std::string>& items) {
 }  // namespace
 
 int runInfo(const InfoOptions& options) {
-    const Scene scene = loadGltf(options.scenePath, {}, GltfSelection{.scene = options.sceneChoice});
+    const GltfDocument file = GltfDocument::open(options.scenePath);
+    const Scene scene = file.scene(GltfSelection{.scene = options.sceneChoice, .animation = "", .time = 0.0});
     const GltfInventory& inv = scene.inventory;
     const Box box = sceneBounds(scene.triangles);
     std::cout << "file " << options.scenePath << "\n";
@@ -62,7 +63,15 @@ int runInfo(const InfoOptions& options) {
                          (l.type == LightType::Directional ? "" : ", at " + vec(l.position)) +
                          (l.type == LightType::Point ? "" : ", towards " + vec(l.direction)));
     section("lights placed by the scene (KHR_lights_punctual)", lights);
+    std::vector<std::string> animations;
+    for (std::size_t i = 0; i < file.animations().size(); ++i) {
+        const GltfAnimationInfo& a = file.animations()[i];
+        animations.push_back(std::to_string(i) + (a.name.empty() ? "" : " '" + a.name + "'") + ": " + number(a.start) + " s to " +
+                             number(a.end) + " s, " + std::to_string(a.channels) + " channel(s)");
+    }
+    section("animations (--animation; all play together by default; the scene above is at 0 s)", animations);
     section("meshes", inv.meshes);
+    section("skins", inv.skins);
     section("materials", inv.materials);
     section("textures decoded", inv.textures);
     std::cout << "extensions used: " << join(inv.extensionsUsed) << "\n"

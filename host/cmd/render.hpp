@@ -1,9 +1,13 @@
 #pragma once
-// The render command: scene in, one traced frame per camera, images and stats out.
+// The render command: scene in, one traced frame per camera and instant (one, or each frame of
+// a range, or of this process's shard of it), images and stats out.
+#include <optional>
 #include <string>
 
 #include "cmd/backend_dispatcher.hpp"
 #include "cmd/frame_passes.hpp"
+#include "cmd/frame_range.hpp"
+#include "cmd/frame_shards.hpp"
 #include "core/camera.hpp"
 
 namespace dacrt {
@@ -12,6 +16,14 @@ struct RenderOptions {
     std::string scenePath;
     std::string sceneChoice;   // --scene: an index or name among the file's scenes; empty: its default
     std::string cameraChoice;  // --camera: an index or name among the cameras the scene places; empty: the first
+    std::string animationChoice;  // --animation: an index or name; empty: every animation together
+    std::optional<double> time;   // --time: the one instant (seconds); none: 0 s, or the frames' times
+    std::optional<FrameRange> frames;  // --frames: a range of frame numbers
+    double fps = kDefaultFps;     // --fps: frame n is at n / fps seconds
+    bool fpsGiven = false;
+    ShardRequest shards;          // --shard, --shard-count, --shard-mode
+    bool skipExisting = false;    // --skip-existing: a frame whose every output exists is not rendered
+    // Every output name may hold a frame number pattern (frame_pattern.hpp).
     std::string outputPath;   // shaded image; empty: none
     std::string aovPath;      // EXR AOVs; empty: none
     std::string statsPath;    // JSON; empty: none

@@ -112,6 +112,9 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     nlohmann::ordered_json j;
     j["backend"] = toString(trace.backend);
     j["scene"] = o.scenePath;
+    j["frame"] = frame.instant.frame ? nlohmann::ordered_json(*frame.instant.frame) : nlohmann::ordered_json(nullptr);
+    j["time_s"] = frame.instant.time;
+    j["animation"] = o.animationChoice.empty() ? std::string("(all)") : o.animationChoice;
     j["triangles"] = scene.triangleCount();
     j["triangles_dropped_degenerate"] = scene.degenerateTrianglesDropped;
     j["rays"] = frame.rayCount;

@@ -1,5 +1,7 @@
 #pragma once
-// The --stats JSON of one rendered frame.
+// The --stats JSON of one rendered frame (one camera at one instant).
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,9 +17,12 @@ struct RenderedFrame {
     const Scene& scene;
     const Camera& camera;
     int cameraIndex = 0;
+    FrameInstant instant;                                   // the frame number (of a range) and its time
     std::size_t rayCount = 0;
     const TraceResult& result;
-    std::vector<std::pair<std::string, double>> timingsMs;  // load, prepare, trace, write, total
+    // load, evaluate_animation, prepare, shader_compile, trace, secondary_passes,
+    // antialiasing_samples, write, total
+    std::vector<std::pair<std::string, double>> timingsMs;
     const std::vector<TracedPass>* passes = nullptr;        // the secondary passes
     std::vector<Light> lights;                              // the lights shaded with (none: headlight)
     float exposure = 1.0f;

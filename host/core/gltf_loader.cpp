@@ -556,6 +556,8 @@ private:
             if (count != vertices)
                 check_.fail(w + ": accessor " + std::to_string(a->second) + " has " + str(count) + " elements, POSITION has " + str(vertices));
             if (name == kColor) data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, w);
+            else if (name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0)
+                data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC4}, w);
             else if (name.rfind("TEXCOORD_", 0) == 0) data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC2}, w);
             else data.attributes[name] = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3}, w);
         }
@@ -874,6 +876,13 @@ private:
         }
         for (const Texture& t : scene_.textures)
             inv.textures.push_back("'" + t.name + "': " + std::to_string(t.width) + " x " + std::to_string(t.height));
+        for (std::size_t k = 0; k < model_.skins.size(); ++k) {
+            std::string users;
+            for (std::size_t n = 0; n < model_.nodes.size(); ++n)
+                if (model_.nodes[n].skin == int(k)) users += (users.empty() ? "" : ", ") + str(n);
+            inv.skins.push_back(str(k) + named(model_.skins[k].name) + ": " + str(model_.skins[k].joints.size()) +
+                                " joint(s), deforms node(s) " + (users.empty() ? std::string("none") : users));
+        }
         inv.extensionsUsed = model_.extensionsUsed;
         inv.extensionsRequired = model_.extensionsRequired;
     }

@@ -67,6 +67,9 @@ void writeAov(const std::string& path, const Scene& scene, const HitImage& image
     spec.channelformats[4] = OIIO::TypeDesc::UINT32;
     spec.z_channel = 0;
     spec.attribute("compression", "zip");
+    // OpenImageIO stamps the write's wall-clock time (OpenEXR's capDate) when none is given;
+    // a fixed one keeps the same frame's file identical bit for bit across runs and shards.
+    spec.attribute("DateTime", "1970:01:01 00:00:00");
     writePixels(path, spec, OIIO::TypeDesc::UNKNOWN, packed.data());
 }
 

@@ -93,6 +93,7 @@ struct GltfInventory {
     std::vector<std::string> meshes;      // with primitives and triangles
     std::vector<std::string> materials;
     std::vector<std::string> textures;
+    std::vector<std::string> skins;       // with joints and the nodes they deform
     std::vector<std::string> extensionsUsed;
     std::vector<std::string> extensionsRequired;
     std::uint32_t loadedScene = 0;

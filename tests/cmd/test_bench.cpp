@@ -267,6 +267,206 @@ TEST(Bench, PassesSuiteOnTheDeviceMatchesCpuSeqUnderValidation) {
     }
 }
 
+// --suite animation's scene: a unit quad (two triangles) before a large one, seen by the
+// scene's camera. Animation "slide" moves the small quad across the view (LINEAR, 0..1 s);
+// "vanish" scales it to nothing at 0.5 s (STEP), where the loader drops its two triangles,
+// which no refit can follow.
+std::string base64(const std::string& bytes) {
+    static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (std::size_t i = 0; i < bytes.size(); i += 3) {
+        const auto byte = [&](std::size_t k) { return k < bytes.size() ? std::uint32_t(std::uint8_t(bytes[k])) : 0u; };
+        const std::uint32_t n = byte(i) << 16 | byte(i + 1) << 8 | byte(i + 2);
+        out += digits[n >> 18 & 63];
+        out += digits[n >> 12 & 63];
+        out += i + 1 < bytes.size() ? digits[n >> 6 & 63] : '=';
+        out += i + 2 < bytes.size() ? digits[n & 63] : '=';
+    }
+    return out;
+}
+
+std::string writeAnimatedQuads(const fs::path& dir) {
+    std::string data;
+    std::vector<std::pair<std::size_t, std::size_t>> views;  // offset, length
+    auto add = [&](const auto& values) {
+        views.emplace_back(data.size(), values.size() * sizeof(values[0]));
+        data.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(values[0]));
+    };
+    add(std::vector<float>{-0.5f, -0.5f, 0, 0.5f, -0.5f, 0, 0.5f, 0.5f, 0, -0.5f, 0.5f, 0});
+    add(std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3});
+    add(std::vector<float>{0, 1});                    // slide: times
+    add(std::vector<float>{-1, 0, 0, 1, 0, 0});       // slide: translations
+    add(std::vector<float>{0, 0.5f});                 // vanish: times
+    add(std::vector<float>{1, 1, 1, 0, 0, 0});        // vanish: scales
+    nlohmann::json doc = {
+        {"asset", {{"version", "2.0"}}},
+        {"buffers", {{{"byteLength", data.size()}, {"uri", "data:application/octet-stream;base64," + base64(data)}}}},
+        {"accessors",
+         {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}, {"min", {-0.5, -0.5, 0}}, {"max", {0.5, 0.5, 0}}},
+          {{"bufferView", 1}, {"componentType", 5125}, {"count", 6}, {"type", "SCALAR"}},
+          {{"bufferView", 2}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {1}}},
+          {{"bufferView", 3}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}},
+          {{"bufferView", 4}, {"componentType", 5126}, {"count", 2}, {"type", "SCALAR"}, {"min", {0}}, {"max", {0.5}}},
+          {{"bufferView", 5}, {"componentType", 5126}, {"count", 2}, {"type", "VEC3"}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
+        {"cameras", {{{"type", "perspective"}, {"perspective", {{"yfov", 0.9}, {"znear", 0.01}}}}}},
+        {"nodes",
+         {{{"mesh", 0}},
+          {{"mesh", 0}, {"translation", {0, 0, -1}}, {"scale", {4, 4, 1}}},
+          {{"camera", 0}, {"translation", {0, 0, 3}}}}},
+        {"scenes", {{{"nodes", {0, 1, 2}}}}},
+        {"animations",
+         {{{"name", "slide"},
+           {"samplers", {{{"input", 2}, {"output", 3}, {"interpolation", "LINEAR"}}}},
+           {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}},
+          {{"name", "vanish"},
+           {"samplers", {{{"input", 4}, {"output", 5}, {"interpolation", "STEP"}}}},
+           {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}}}}}}}};
+    for (const auto& [offset, length] : views)
+        doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}});
+    const fs::path path = dir / "quads.gltf";
+    std::ofstream(path) << doc.dump();
+    return path.string();
+}
+
+// What every frame row of an animation run holds: the frame's instant, every phase (a peer's
+// build or refit, none for dacrt), the work and total adding up, and dacrt's hits exact.
+void expectAnimationRows(const nlohmann::json& j, const std::vector<std::string>& series, std::size_t frames, double fps,
+                         std::size_t pixels) {
+    ASSERT_EQ(j["rows"].size(), frames * series.size());
+    for (std::size_t i = 0; i < j["rows"].size(); ++i) {
+        const nlohmann::json& r = j["rows"][i];
+        const std::string name = r["series"];
+        EXPECT_EQ(name, series[i % series.size()]);
+        EXPECT_EQ(r["frame"].get<std::size_t>(), i / series.size()) << name;
+        EXPECT_DOUBLE_EQ(r["time_s"].get<double>(), double(i / series.size()) / fps) << name;
+        EXPECT_EQ(r["rays_per_frame"].get<std::size_t>(), pixels);
+        // One evaluation per frame, reported beside every backend's work.
+        EXPECT_EQ(r["evaluate_ms"], j["rows"][i - i % series.size()]["evaluate_ms"]) << name;
+        for (const char* phase : {"evaluate_ms", "prepare_ms", "trace_ms", "work_ms", "total_ms", "mrays_per_s"})
+            EXPECT_GT(r[phase].get<double>(), 0.0) << name << " " << phase;
+        const bool peer = name.rfind("embree", 0) == 0 || name.rfind("rayquery", 0) == 0;
+        EXPECT_EQ(r["build_ms"].is_number(), peer) << name;
+        const double build = peer ? r["build_ms"].get<double>() : 0.0;
+        EXPECT_NEAR(r["work_ms"].get<double>(), r["prepare_ms"].get<double>() + build + r["trace_ms"].get<double>(), 1e-9) << name;
+        EXPECT_NEAR(r["total_ms"].get<double>(), r["evaluate_ms"].get<double>() + r["work_ms"].get<double>(), 1e-9) << name;
+        EXPECT_EQ(r["exact_required"].get<bool>(), !peer) << name;
+        if (!peer) {
+            EXPECT_EQ(r["differing"].get<std::uint64_t>(), 0u) << name << " frame " << r["frame"];
+        }
+        EXPECT_EQ(r["real_errors"].get<std::uint64_t>(), 0u) << name << " frame " << r["frame"];
+    }
+    ASSERT_EQ(j["summary"].size(), series.size());
+    for (const auto& s : j["summary"]) {
+        EXPECT_EQ(s["frames"].get<std::size_t>(), frames);
+        for (const char* phase : {"evaluate_ms", "prepare_ms", "trace_ms", "work_ms", "total_ms"}) {
+            EXPECT_LE(s[phase]["min"].get<double>(), s[phase]["mean"].get<double>() * (1 + 1e-12)) << s["series"] << phase;
+            EXPECT_LE(s[phase]["mean"].get<double>(), s[phase]["max"].get<double>() * (1 + 1e-12)) << s["series"] << phase;
+        }
+    }
+}
+
+TEST(Bench, AnimationSuiteTimesEachFrameAndDacrtMatchesCpuSeq) {
+    // cpu-seq, the reference, is not named and runs first all the same.
+    const BenchOutputs out("animation");
+    const std::string scene = writeAnimatedQuads(out.dir);
+    const test::CommandResult r =
+        test::runDacrt("bench " + scene + " --suite animation --backends cpu,embree --size 32x24 --frames 0:2 --fps 4 "
+                       "--animation slide --repeat 1 --warmup 0" + out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("cpu-seq runs too"), std::string::npos) << r.output;
+    const nlohmann::json j = out.json();
+    EXPECT_EQ(j["command"]["suite"], "animation");
+    EXPECT_EQ(j["command"]["frames"], "0:2");
+    EXPECT_EQ(j["command"]["animation"], "slide");
+    ASSERT_EQ(j["scenes"].size(), 1u);
+    EXPECT_TRUE(j["scenes"][0]["animated"].get<bool>());
+    EXPECT_TRUE(j["scenes"][0]["topology_changes"].empty());
+    const std::vector<std::string> series = {"cpu-seq", "cpu", "embree dynamic", "embree refit"};
+    expectAnimationRows(j, series, 3, 4.0, 32 * 24);
+    for (const auto& row : j["rows"]) {
+        EXPECT_EQ(row["triangles"].get<std::size_t>(), 4u);
+        EXPECT_FALSE(row["rebuilt"].get<bool>());
+    }
+    // The refit peer's structure was built once, from the first frame, before the timing.
+    EXPECT_TRUE(j["summary"][3]["initial_build_ms"].is_number());
+    EXPECT_TRUE(j["summary"][2]["initial_build_ms"].is_null());
+    // A CSV line per frame row and three (mean, min, max) per configuration.
+    EXPECT_EQ(lines(out.dir / "b.csv"), 1 + j["rows"].size() + 3 * j["summary"].size());
+    EXPECT_NE(r.output.find("embree refit"), std::string::npos) << r.output;
+
+    // A scene without animation is benchmarked all the same, and says so.
+    const test::CommandResult still = test::runDacrt("bench " + roomScene() +
+                                                     " --suite animation --backends cpu-seq --size 16x12 --frames 0:1 "
+                                                     "--repeat 1 --warmup 0" + out.args());
+    ASSERT_EQ(still.code, 0) << still.output;
+    EXPECT_NE(still.output.find("has no animation"), std::string::npos) << still.output;
+    EXPECT_FALSE(out.json()["scenes"][0]["animated"].get<bool>());
+}
+
+TEST(Bench, AnimationSuiteRebuildsTheRefitWhereTheTopologyChanges) {
+    const BenchOutputs out("animation_topology");
+    const std::string scene = writeAnimatedQuads(out.dir);
+    const test::CommandResult r =
+        test::runDacrt("bench " + scene + " --suite animation --backends cpu-seq,embree --size 24x18 --frames 0:3 --fps 4 "
+                       "--animation vanish --repeat 2 --warmup 0" + out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("a refit cannot follow a change of topology"), std::string::npos) << r.output;
+    const nlohmann::json j = out.json();
+    expectAnimationRows(j, {"cpu-seq", "embree dynamic", "embree refit"}, 4, 4.0, 24 * 18);
+    EXPECT_EQ(j["scenes"][0]["topology_changes"], nlohmann::json::array({2}));
+    for (const auto& row : j["rows"]) {
+        const std::size_t frame = row["frame"];
+        EXPECT_EQ(row["triangles"].get<std::size_t>(), frame < 2 ? 4u : 2u);
+        EXPECT_EQ(row["topology_changed"].get<bool>(), frame == 2);
+        EXPECT_EQ(row["rebuilt"].get<bool>(), frame == 2 && row["series"] == "embree refit") << row["series"];
+    }
+    EXPECT_EQ(j["summary"][2]["rebuilds"].get<int>(), 1);
+}
+
+TEST(Bench, AnimationSuiteOnTheDeviceMatchesCpuSeqUnderValidation) {
+    DACRT_REQUIRE_GPU(gpu);
+    const BenchOutputs out("animation_gpu");
+    const std::string scene = writeAnimatedQuads(out.dir);
+    // Where the device has ray query (tools/mesa25.sh here) both its modes run; elsewhere the
+    // default backends leave them out with a message.
+    const bool rayQuery = gpu->info().rayQuery;
+    const test::CommandResult r = test::runDacrt(
+        "bench " + scene + " --suite animation" + (rayQuery ? " --backends cpu-seq,gpu,rayquery" : "") +
+        " --size 32x24 --frames 0:1 --fps 4 --repeat 1 --warmup 0 --validate" + out.args());
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json j = out.json();
+    EXPECT_EQ(j["validation_errors"].get<int>(), 0);
+    const std::vector<std::string> series =
+        rayQuery ? std::vector<std::string>{"cpu-seq", "gpu", "rayquery dynamic", "rayquery refit"}
+                 : std::vector<std::string>{"cpu-seq", "cpu", "gpu", "embree dynamic", "embree refit"};
+    expectAnimationRows(j, series, 2, 4.0, 32 * 24);
+    if (!rayQuery) {
+        EXPECT_NE(r.output.find("no rayquery rows"), std::string::npos) << r.output;
+    }
+}
+
+TEST(Bench, AnimationSuiteRefusesBadOptions) {
+    const BenchOutputs out("animation_bad");
+    const std::string scene = writeAnimatedQuads(out.dir);
+    const std::string run = "bench " + scene + " --backends cpu-seq --size 8x6 --repeat 1 --warmup 0" + out.args();
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {" --suite animation --frames 3:1", "--frames"},
+        {" --suite animation --frames 0:x", "--frames"},
+        {" --suite animation --fps 0", "--fps"},
+        {" --suite animation --animation spin", "spin"},
+        {" --suite animation --orbit 2", "--orbit"},
+        {" --suite peers --frames 0:2", "--suite animation"},
+        {" --animation slide", "--suite animation"},
+    };
+    for (const auto& [options, named] : cases) {
+        const test::CommandResult r = test::runDacrt(run + options);
+        EXPECT_EQ(r.code, 2) << options << ": " << r.output;
+        EXPECT_NE(r.output.find(named), std::string::npos) << options << ": " << r.output;
+        EXPECT_EQ(r.output.find("evaluate"), std::string::npos) << options << ": it ran: " << r.output;
+    }
+}
+
 TEST(Bench, OutputsDefaultToOneDirectoryAndAreCheckedFirst) {
     const BenchOutputs out("defaults");
     const std::string cache = " --cache " + (out.dir / "cache").string();

@@ -388,13 +388,13 @@ TEST(GltfFeatures, ScenesCamerasAndLights) {
     EXPECT_EQ(s.lights[1].direction, glm::dvec3(0, 0, -1));
     EXPECT_EQ(s.warnings.size(), 1u);  // EXT_unheard_of_but_optional, used only
 
-    const Scene far = loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{.scene = "far"});
+    const Scene far = loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{.scene = "far", .animation = "", .time = 0.0});
     EXPECT_EQ(far.triangles[0].v0.z, -5.0f);
     EXPECT_EQ(far.lights.size(), 0u);
     EXPECT_EQ(far.cameras.size(), 1u);
-    EXPECT_EQ(loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{.scene = "1"}).triangles[0].v0.z, -5.0f);
+    EXPECT_EQ(loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{.scene = "1", .animation = "", .time = 0.0}).triangles[0].v0.z, -5.0f);
     try {
-        loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{.scene = "middle"});
+        loadGltf(fixture("quad_cameras_lights.gltf"), {}, GltfSelection{.scene = "middle", .animation = "", .time = 0.0});
         FAIL() << "loaded";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("0 'near', 1 'far'"), std::string::npos) << e.what();

@@ -1,6 +1,7 @@
 #include "cmd/bench/bench.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -10,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cmd/bench/bench_animation.hpp"
 #include "cmd/bench/bench_configs.hpp"
 #include "cmd/bench/bench_frame.hpp"
 #include "cmd/bench/bench_passes.hpp"
@@ -38,6 +40,14 @@ void checkBenchCommand(const BenchCommand& cmd) {
     if (cmd.width < 1 || cmd.height < 1 || cmd.width > 16384 || cmd.height > 16384)
         throw InputError("--size: width and height must lie in 1..16384");
     if (cmd.suite == BenchSuite::Passes) checkPassOptions(cmd.passes);
+    if (cmd.suite == BenchSuite::Animation) {
+        if (!(std::isfinite(cmd.animation.fps) && cmd.animation.fps > 0.0))
+            throw InputError("--fps: frames per second must be a finite number above 0");
+        parseFrameRange(cmd.animation.frames.text());  // the range's own checks, for a command made in code
+        if (cmd.orbit != 1)
+            throw InputError("bench: --suite animation traces each frame from one camera (the scene's, which may move, "
+                             "or --eye/--target); --orbit is for the still suites");
+    }
 }
 
 // Resolves the output paths and checks that they can be written before anything is timed:
@@ -59,12 +69,16 @@ BenchCommand withOutputs(BenchCommand cmd) {
     return cmd;
 }
 
-// --suite passes checks every pass against cpu-seq's, so cpu-seq runs first, named or not.
+// --suite passes checks every pass, --suite animation every frame, against cpu-seq's, so
+// cpu-seq runs first, named or not.
 std::vector<Backend> withReferenceFirst(const BenchCommand& cmd, std::vector<Backend> backends) {
-    if (cmd.suite != BenchSuite::Passes || (!backends.empty() && backends.front() == Backend::CpuSeq)) return backends;
+    const bool checked = cmd.suite == BenchSuite::Passes || cmd.suite == BenchSuite::Animation;
+    if (!checked || (!backends.empty() && backends.front() == Backend::CpuSeq)) return backends;
     const auto named = std::find(backends.begin(), backends.end(), Backend::CpuSeq);
     if (named != backends.end()) backends.erase(named);
-    else std::cerr << "dacrt bench: --suite passes checks every pass against cpu-seq's, so cpu-seq runs too\n";
+    else
+        std::cerr << "dacrt bench: --suite " << toString(cmd.suite) << " checks every "
+                  << (cmd.suite == BenchSuite::Passes ? "pass" : "frame") << " against cpu-seq's, so cpu-seq runs too\n";
     backends.insert(backends.begin(), Backend::CpuSeq);
     return backends;
 }
@@ -110,6 +124,7 @@ std::vector<BenchConfig> chooseConfigs(const BenchCommand& cmd, const std::vecto
             : cmd.suite == BenchSuite::Peers  ? peerConfigs(b, hardwareThreads)
             : cmd.suite == BenchSuite::Skips  ? skipConfigs(b, hardwareThreads)
             : cmd.suite == BenchSuite::Passes ? passesConfigs(b, hardwareThreads)
+            : cmd.suite == BenchSuite::Animation ? animationConfigs(b, hardwareThreads)
                                               : table51Configs(b, hardwareThreads);
         configs.insert(configs.end(), more.begin(), more.end());
     }
@@ -247,6 +262,7 @@ int runBenchCommand(const BenchCommand& request) {
     BackendDispatcher dispatcher(cmd.devices, backends);
     const std::vector<BenchConfig> configs = chooseConfigs(cmd, backends, dispatcher, hardwareThreads);
     if (cmd.suite == BenchSuite::Passes) return runPassesSuite(cmd, configs, dispatcher, hardwareThreads);
+    if (cmd.suite == BenchSuite::Animation) return runAnimationSuite(cmd, configs, dispatcher, hardwareThreads);
 
     std::vector<BenchRow> rows;
     for (const std::string& path : cmd.scenes) measureScene(path, cmd, configs, dispatcher, hardwareThreads, rows);

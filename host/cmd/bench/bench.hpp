@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cmd/backend_dispatcher.hpp"
+#include "cmd/frame_range.hpp"
 #include "cmd/frame_passes.hpp"
 #include "core/enum_names.hpp"
 
@@ -16,15 +17,19 @@ namespace dacrt {
 // passes: a lit frame's passes (primary, a shadow pass per light, occlusion) timed apart, for
 // each DACRT default and every build mode of the peers, each pass's visibility checked against
 // cpu-seq's.
-enum class BenchSuite { Sweep, Peers, Skips, Table51, Passes };
+// animation: the per-frame cost of an animated scene over a range of frames: the animation
+// evaluated, then each DACRT default's prepare and trace, each peer's rebuild or refit and
+// trace (bench_animation.hpp).
+enum class BenchSuite { Sweep, Peers, Skips, Table51, Passes, Animation };
 
 template <>
 struct EnumNames<BenchSuite> {
-    static constexpr std::array<std::pair<BenchSuite, std::string_view>, 5> table{{{BenchSuite::Sweep, "sweep"},
+    static constexpr std::array<std::pair<BenchSuite, std::string_view>, 6> table{{{BenchSuite::Sweep, "sweep"},
                                                                                     {BenchSuite::Peers, "peers"},
                                                                                     {BenchSuite::Skips, "skips"},
                                                                                     {BenchSuite::Table51, "table51"},
-                                                                                    {BenchSuite::Passes, "passes"}}};
+                                                                                    {BenchSuite::Passes, "passes"},
+                                                                                    {BenchSuite::Animation, "animation"}}};
 };
 
 struct BenchCommand {
@@ -47,6 +52,13 @@ struct BenchCommand {
     DeviceChoice devices;      // gpu
     // --suite passes: the lights (render's --light) and the occlusion rays per hit (--ao).
     PassOptions passes{.lights = {}, .occlusionSamples = 4, .occlusionDistance = 0.0};
+    // --suite animation: frames first..last (--frames, render's syntax), frame n at n / fps
+    // seconds, of one animation or (empty) every one together (--animation).
+    struct Animation {
+        FrameRange frames{.first = 0, .last = 11, .step = 1};
+        double fps = kDefaultFps;
+        std::string animation;
+    } animation;
 };
 
 // Returns the process exit code; throws InputError on bad input.

@@ -165,6 +165,17 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
     return out;
 }
 
+std::vector<BenchConfig> animationConfigs(Backend b, unsigned hardwareThreads) {
+    std::vector<BenchConfig> out;
+    if (!isPeer(b)) return {baseConfig(b, hardwareThreads)};
+    for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0)) {
+        const bool staticBuild = b == Backend::Embree ? c.request.embree.build == EmbreeBuild::Static
+                                                      : c.request.rayQueryBuild == RayQueryBuild::Static;
+        if (c.name == "default" && !staticBuild) out.push_back(c);
+    }
+    return out;
+}
+
 // The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
 std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads) {
     std::vector<BenchConfig> out;

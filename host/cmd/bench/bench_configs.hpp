@@ -31,6 +31,12 @@ std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads);
 // secondary ones (gpu: on the device).
 std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads);
 
+// animation: each DACRT backend's default, and each peer's per-frame modes with their defaults
+// otherwise: embree dynamic (a new BVH each frame) and refit, rayquery dynamic (rebuilt) and
+// refit (updated). No static structure: it cannot follow moving vertices, and building one
+// each frame would be the dynamic row at a slower build quality.
+std::vector<BenchConfig> animationConfigs(Backend b, unsigned hardwareThreads);
+
 // The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
 std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads);
 

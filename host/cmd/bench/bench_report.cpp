@@ -43,6 +43,12 @@ nlohmann::ordered_json runJson(const BenchCommand& cmd, const BackendDispatcher&
         j["command"]["ao_distance"] = cmd.passes.occlusionDistance;
         j["command"]["light"] = cmd.passes.lights;
     }
+    if (cmd.suite == BenchSuite::Animation) {
+        j["command"]["frames"] = cmd.animation.frames.text();
+        j["command"]["fps"] = cmd.animation.fps;
+        j["command"]["animation"] = cmd.animation.animation;
+        j["command"].erase("orbit");
+    }
     const gpu::Context* context = dispatcher.gpuContext();
     const char* lpThreads = std::getenv("LP_NUM_THREADS");
     j["machine"] = {{"cpu", cpuModelName()},

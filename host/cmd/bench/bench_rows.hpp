@@ -63,4 +63,43 @@ struct PassRow {
     bool exactRequired = false;  // dacrt's backends: any mismatch fails the run
 };
 
+// --suite animation: one configuration's work for one frame, from the run of the frame (of its
+// --repeat timed runs) whose work time is the median, so that its phases add up.
+struct AnimationFrameRow {
+    std::string scene;
+    std::int64_t frame = 0;
+    double timeS = 0.0;
+    std::size_t triangles = 0;
+    bool topologyChanged = false;  // the triangle count differs from the previous frame's
+    BenchConfig config;
+    std::size_t rays = 0;
+    double evaluateMs = 0.0;        // the animation evaluated into the frame's scene, the same for every configuration (median run)
+    double prepareMs = 0.0;
+    std::optional<double> buildMs;  // a peer's build or refit
+    double traceMs = 0.0;
+    double workMs = 0.0;            // prepare + build + trace: the backend's frame
+    double copyMs = 0.0;            // a peer's vertex copy, not counted
+    bool rebuilt = false;           // a refit peer rebuilt (the triangle count changed)
+    std::vector<std::pair<std::string, double>> partsMs;
+    // Pixels whose primitive differs from cpu-seq's (dacrt's backends: or whose depth differs
+    // in any bit); for the peers, how many of them are near ties (error_metrics.hpp, with
+    // cpu-seq's hits as the reference) and how many real.
+    std::uint64_t differing = 0;
+    std::uint64_t nearTies = 0;
+    std::uint64_t realErrors = 0;
+    bool exactRequired = false;     // dacrt's backends: any difference fails the run
+    double initialBuildMs = 0.0;    // a peer's structure built from the first frame, before the frames
+
+    double totalMs() const { return evaluateMs + workMs; }
+};
+
+// A scene of an animation run: what holds for all its rows.
+struct AnimationScene {
+    std::string name;
+    std::string path;
+    std::vector<std::string> animations;  // the file's, "name (start-end s)"
+    bool animated = false;
+    std::vector<std::int64_t> topologyChanges;  // frames whose triangle count differs from the previous frame's
+};
+
 }  // namespace dacrt
