@@ -8,12 +8,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/data_uri.hpp"
 #include "support/cli_support.hpp"
 #include "support/gpu_support.hpp"
 #include "support/frames.hpp"
 
 namespace dacrt {
 namespace {
+
+using dacrt::test::base64;
 
 namespace fs = std::filesystem;
 
@@ -271,20 +274,6 @@ TEST(Bench, PassesSuiteOnTheDeviceMatchesCpuSeqUnderValidation) {
 // scene's camera. Animation "slide" moves the small quad across the view (LINEAR, 0..1 s);
 // "vanish" scales it to nothing at 0.5 s (STEP), where the loader drops its two triangles,
 // which no refit can follow.
-std::string base64(const std::string& bytes) {
-    static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (std::size_t i = 0; i < bytes.size(); i += 3) {
-        const auto byte = [&](std::size_t k) { return k < bytes.size() ? std::uint32_t(std::uint8_t(bytes[k])) : 0u; };
-        const std::uint32_t n = byte(i) << 16 | byte(i + 1) << 8 | byte(i + 2);
-        out += digits[n >> 18 & 63];
-        out += digits[n >> 12 & 63];
-        out += i + 1 < bytes.size() ? digits[n >> 6 & 63] : '=';
-        out += i + 2 < bytes.size() ? digits[n & 63] : '=';
-    }
-    return out;
-}
-
 std::string writeAnimatedQuads(const fs::path& dir) {
     std::string data;
     std::vector<std::pair<std::size_t, std::size_t>> views;  // offset, length

@@ -20,11 +20,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/data_uri.hpp"
 #include "core/image_io.hpp"
 #include "support/cli_support.hpp"
 #include "support/fixtures.hpp"
 
 namespace {
+
+using dacrt::test::base64;
 
 namespace fs = std::filesystem;
 using dacrt::test::CommandResult;
@@ -47,20 +50,6 @@ fs::path freshFolder(const std::string& name) {
     fs::remove_all(folder);
     fs::create_directories(folder);
     return folder;
-}
-
-std::string base64(const std::string& bytes) {
-    static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (std::size_t i = 0; i < bytes.size(); i += 3) {
-        const auto byte = [&](std::size_t k) { return k < bytes.size() ? std::uint32_t(std::uint8_t(bytes[k])) : 0u; };
-        const std::uint32_t n = byte(i) << 16 | byte(i + 1) << 8 | byte(i + 2);
-        out += digits[n >> 18 & 63];
-        out += digits[n >> 12 & 63];
-        out += i + 1 < bytes.size() ? digits[n >> 6 & 63] : '=';
-        out += i + 2 < bytes.size() ? digits[n & 63] : '=';
-    }
-    return out;
 }
 
 template <typename T>

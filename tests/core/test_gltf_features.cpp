@@ -12,6 +12,7 @@
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 
+#include "support/data_uri.hpp"
 #include "core/camera.hpp"
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
@@ -23,6 +24,9 @@ using namespace dacrt;
 using dacrt::test::fixture;
 
 namespace {
+
+using dacrt::test::base64;
+using dacrt::test::dataUri;
 
 // The hit of the point p on triangle `prim` (barycentrics solved in double).
 Hit hitAt(const Scene& s, std::uint32_t prim, glm::dvec3 p) {
@@ -70,21 +74,6 @@ std::vector<std::array<float, 9>> canonical(const std::vector<Triangle>& triangl
     return out;
 }
 
-std::string base64(const std::vector<unsigned char>& bytes) {
-    static const char* digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (std::size_t i = 0; i < bytes.size(); i += 3) {
-        const std::uint32_t n = std::uint32_t(bytes[i]) << 16 | (i + 1 < bytes.size() ? std::uint32_t(bytes[i + 1]) << 8 : 0) |
-                                (i + 2 < bytes.size() ? bytes[i + 2] : 0);
-        out += digits[n >> 18 & 63];
-        out += digits[n >> 12 & 63];
-        out += i + 1 < bytes.size() ? digits[n >> 6 & 63] : '=';
-        out += i + 2 < bytes.size() ? digits[n & 63] : '=';
-    }
-    return out;
-}
-
-std::string dataUri(const std::vector<unsigned char>& bytes) { return "data:application/octet-stream;base64," + base64(bytes); }
 
 template <typename T>
 std::vector<unsigned char> bytesOf(const std::vector<T>& v) {
@@ -145,7 +134,7 @@ TEST(GltfFeatures, ATexturedQuadShowsItsTexelsThroughTexcoordAndSampler) {
 TEST(GltfFeatures, AnImageThatDoesNotDecodeIsAWarningAndTheFactorShades) {
     std::ifstream in(fixture("quad_texture_data_uri.gltf"));
     nlohmann::json doc = nlohmann::json::parse(in);
-    doc["images"][0]["uri"] = "data:image/png;base64," + base64({'n', 'o', 't', ' ', 'a', ' ', 'p', 'n', 'g'});
+    doc["images"][0]["uri"] = "data:image/png;base64," + base64("not a png");
     doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {0.5, 0.25, 1, 1};
     const Scene s = loadJson(doc, "broken_image.gltf");
     ASSERT_EQ(s.warnings.size(), 1u);

@@ -1,5 +1,6 @@
 #include "cmd/bench/animated_frame.hpp"
 
+#include "cmd/bench/bench_frame.hpp"
 #include "core/errors.hpp"
 #include "core/timing.hpp"
 #include "gpu/gpu_tracer.hpp"
@@ -20,13 +21,6 @@ double structureMs(const std::vector<std::pair<std::string, double>>& phases) {
     for (const auto& [name, t] : phases)
         if (name == "build" || name == "refit") ms += t;
     return ms;
-}
-
-void addGpuTimestamps(const TraceResult& r, std::vector<std::pair<std::string, double>>& parts) {
-    if (!r.gpu) return;
-    double gpuMs = 0.0;
-    for (const auto& [name, ms] : r.gpu->dispatchMs) gpuMs += ms;
-    parts.emplace_back("gpu timestamps", gpuMs);
 }
 
 // A peer's structure over `a.shared` as it stands; returns the milliseconds the making took

@@ -46,12 +46,7 @@ Json frameRowJson(const AnimationFrameRow& r) {
     j["time_s"] = r.timeS;
     j["triangles"] = r.triangles;
     j["topology_changed"] = r.topologyChanged;
-    j["backend"] = toString(r.config.backend());
-    j["series"] = r.config.series;
-    j["config"] = r.config.name;
-    j["default"] = r.config.isDefault;
-    j["options"] = optionText(r.config);
-    j["threads"] = r.config.threads();
+    recordConfig(j, r.config);
     j["rays_per_frame"] = r.rays;
     j["evaluate_ms"] = r.evaluateMs;
     j["prepare_ms"] = r.prepareMs;
@@ -75,12 +70,7 @@ Json frameRowJson(const AnimationFrameRow& r) {
 Json summaryJson(const AnimationSummary& s) {
     Json j;
     j["scene"] = s.scene;
-    j["backend"] = toString(s.config.backend());
-    j["series"] = s.config.series;
-    j["config"] = s.config.name;
-    j["default"] = s.config.isDefault;
-    j["options"] = optionText(s.config);
-    j["threads"] = s.config.threads();
+    recordConfig(j, s.config);
     j["frames"] = s.frames;
     j["rays_per_frame"] = s.rays;
     j["triangles"] = statsJson(s.triangles);
@@ -121,12 +111,7 @@ std::vector<Json> summaryCsvRows(const AnimationSummary& s) {
         j["time_s"] = nullptr;
         j["triangles"] = pick(s.triangles);
         j["topology_changed"] = nullptr;
-        j["backend"] = toString(s.config.backend());
-        j["series"] = s.config.series;
-        j["config"] = s.config.name;
-        j["default"] = s.config.isDefault;
-        j["options"] = optionText(s.config);
-        j["threads"] = s.config.threads();
+        recordConfig(j, s.config);
         j["rays_per_frame"] = s.rays;
         j["evaluate_ms"] = pick(s.evaluate);
         j["prepare_ms"] = pick(s.prepare);

@@ -6,6 +6,15 @@
 
 namespace dacrt {
 
+void recordConfig(nlohmann::ordered_json& row, const BenchConfig& c) {
+    row["backend"] = toString(c.backend());
+    row["series"] = c.series;
+    row["config"] = c.name;
+    row["default"] = c.isDefault;
+    row["options"] = optionText(c);
+    row["threads"] = c.threads();
+}
+
 std::string optionText(const BenchConfig& c) {
     std::ostringstream s;
     if (c.backend() == Backend::RayQuery) return "build=" + toString(c.request.rayQueryBuild);

@@ -4,12 +4,18 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "cmd/bench/bench_rows.hpp"
 
 namespace dacrt {
 
 // The options of a configuration in full, as the CSV and JSON record them.
 std::string optionText(const BenchConfig& c);
+
+// The configuration's fields of a JSON row, in every suite's order: backend, series, config,
+// default, options, threads.
+void recordConfig(nlohmann::ordered_json& row, const BenchConfig& c);
 
 // A backend's default configuration on hardwareThreads threads (cpu-seq: one).
 BenchConfig baseConfig(Backend b, unsigned hardwareThreads);

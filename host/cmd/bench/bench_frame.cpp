@@ -11,6 +11,13 @@
 
 namespace dacrt {
 
+void addGpuTimestamps(const TraceResult& r, std::vector<std::pair<std::string, double>>& parts) {
+    if (!r.gpu) return;
+    double gpuMs = 0.0;
+    for (const auto& [name, ms] : r.gpu->dispatchMs) gpuMs += ms;
+    parts.emplace_back("gpu timestamps", gpuMs);
+}
+
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const std::size_t n = v.size();

@@ -16,6 +16,10 @@ namespace dacrt {
 
 double median(std::vector<double> v);
 
+// The device's own time of a gpu trace (its dispatches' timestamps summed) as one more part of
+// a row's phases; nothing for a trace without timestamps.
+void addGpuTimestamps(const TraceResult& r, std::vector<std::pair<std::string, double>>& parts);
+
 struct BenchScene {
     std::string name;  // unique among the run's scenes: rows key on it
     Scene scene;

@@ -42,13 +42,6 @@ double compiledMs(const std::vector<std::pair<std::string, double>>& phases) {
     return ms;
 }
 
-void addGpuTimestamps(const TraceResult& r, std::vector<std::pair<std::string, double>>& parts) {
-    if (!r.gpu) return;
-    double gpuMs = 0.0;
-    for (const auto& [name, ms] : r.gpu->dispatchMs) gpuMs += ms;
-    parts.emplace_back("gpu timestamps", gpuMs);
-}
-
 // A dacrt backend's secondary pass: the dispatcher makes the rays from the primary hits (gpu:
 // on the device, from the primary pass it kept there) and traces them.
 PassFrame dacrtPass(const BenchConfig& c, const FrameOutcome& primary, const SecondaryPass& pass,
@@ -294,12 +287,7 @@ nlohmann::ordered_json passRowJson(const PassRow& r) {
     j["triangles"] = r.triangles;
     j["pixels_per_frame"] = r.pixels;
     j["cameras"] = r.cameras;
-    j["backend"] = toString(r.config.backend());
-    j["series"] = r.config.series;
-    j["config"] = r.config.name;
-    j["default"] = r.config.isDefault;
-    j["options"] = optionText(r.config);
-    j["threads"] = r.config.threads();
+    recordConfig(j, r.config);
     j["pass_index"] = r.passIndex;
     j["pass"] = r.pass;
     j["pass_kind"] = r.kind;

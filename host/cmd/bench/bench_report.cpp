@@ -68,12 +68,7 @@ nlohmann::ordered_json rowJson(const BenchRow& r) {
     j["triangles"] = r.triangles;
     j["rays_per_frame"] = r.raysPerFrame;
     j["cameras"] = r.cameras;
-    j["backend"] = toString(r.config.backend());
-    j["series"] = r.config.series;
-    j["config"] = r.config.name;
-    j["default"] = r.config.isDefault;
-    j["options"] = optionText(r.config);
-    j["threads"] = r.config.threads();
+    recordConfig(j, r.config);
     j["regions"] = r.regions;
     j["division_axis"] = r.divisionAxis < 0 ? std::string("-") : std::string(1, "xyz"[r.divisionAxis]);
     j["frame_ms_min"] = r.frameMsMin;
