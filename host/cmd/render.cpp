@@ -17,6 +17,7 @@
 #include "cmd/progress.hpp"
 #include "cmd/render_stats.hpp"
 #include "cmd/stale_temporaries.hpp"
+#include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
 #include "core/image_io.hpp"
@@ -337,13 +338,13 @@ std::vector<AovChannel> visibilityChannels(const Lighting& lighting, std::size_t
 void writeImages(const FrameFiles& files, const PreparedScene& p, const HitImage& image, const Lighting& lighting,
                  const std::vector<std::uint8_t>& shaded, std::vector<std::string>& written) {
     auto writeRgb = [&](const std::string& path, const std::vector<std::uint8_t>& rgb) {
-        writeOutput(path, [&](const std::string& to) { writeRgb8(to, image.width, image.height, rgb); });
+        writeThrough(path, [&](const std::string& to) { writeRgb8(to, image.width, image.height, rgb); });
         written.push_back(path);
     };
     if (!files.output.empty()) writeRgb(files.output, shaded);
     if (!files.aov.empty()) {
         const std::vector<AovChannel> extra = visibilityChannels(lighting, image.hits->size());
-        writeOutput(files.aov, [&](const std::string& to) { writeAov(to, p.scene, image, extra); });
+        writeThrough(files.aov, [&](const std::string& to) { writeAov(to, p.scene, image, extra); });
         written.push_back(files.aov);
     }
     if (!files.depthPng.empty()) writeRgb(files.depthPng, depthPreview(image));
@@ -353,12 +354,7 @@ void writeImages(const FrameFiles& files, const PreparedScene& p, const HitImage
 void writeStats(const RenderOptions& o, const std::string& path, const RenderedFrame& frame,
                 std::vector<std::string>& written) {
     if (path.empty()) return;
-    const std::string text = renderStatsJson(o, frame).dump(2) + "\n";
-    writeOutput(path, [&](const std::string& to) {
-        std::ofstream out(to, std::ios::binary);
-        out << text;
-        if (!out.flush()) throw InputError("the stream failed");
-    });
+    writeFileAtomically(path, renderStatsJson(o, frame).dump(2) + "\n");
     written.push_back(path);
 }
 

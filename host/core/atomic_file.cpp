@@ -3,6 +3,8 @@
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
+#include <mutex>
+#include <set>
 #include <system_error>
 
 #include <unistd.h>
@@ -10,6 +12,26 @@
 #include "core/errors.hpp"
 
 namespace dacrt {
+namespace {
+
+// The temporaries of this process's live AtomicFiles. The lock also orders a commit's rename
+// against the signal thread's removal: a file is either renamed into place or removed.
+std::mutex& unfinishedMutex() {
+    static std::mutex m;
+    return m;
+}
+
+std::multiset<std::string>& unfinished() {
+    static std::multiset<std::string> files;
+    return files;
+}
+
+void forget(const std::string& temporary) {
+    auto& files = unfinished();
+    if (auto it = files.find(temporary); it != files.end()) files.erase(it);
+}
+
+}  // namespace
 
 AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
     static std::atomic<unsigned> counter{0};
@@ -22,19 +44,33 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
     name += std::to_string(counter++);
     name += p.extension().string();
     temporary_ = (p.parent_path() / name).string();
+    const std::lock_guard<std::mutex> lock(unfinishedMutex());
+    unfinished().insert(temporary_);
 }
 
 AtomicFile::~AtomicFile() {
     if (committed_) return;
+    const std::lock_guard<std::mutex> lock(unfinishedMutex());
+    forget(temporary_);
     std::error_code ec;
     std::filesystem::remove(temporary_, ec);
 }
 
 void AtomicFile::commit() {
+    const std::lock_guard<std::mutex> lock(unfinishedMutex());
     std::error_code ec;
     std::filesystem::rename(temporary_, path_, ec);
     if (ec) throw InputError(path_ + ": cannot write the file (" + ec.message() + ")");
+    forget(temporary_);
     committed_ = true;
+}
+
+std::vector<std::string> removeUnfinishedTemporariesForExit() {
+    unfinishedMutex().lock();  // never unlocked: the caller ends the process
+    std::vector<std::string> removed;
+    for (const std::string& path : unfinished())
+        if (::unlink(path.c_str()) == 0) removed.push_back(path);
+    return removed;
 }
 
 }  // namespace dacrt

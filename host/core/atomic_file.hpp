@@ -1,8 +1,11 @@
 #pragma once
 // A file written under a temporary name beside its destination and renamed into place when
-// complete, so that a failed or interrupted write never leaves a partial file.
+// complete, so that a failed or interrupted write never leaves a partial file. Every
+// AtomicFile's temporary is known to the process while it exists, so that a run stopped by a
+// signal can remove them (removeUnfinishedTemporariesForExit).
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/errors.hpp"
 
@@ -30,6 +33,11 @@ private:
 }  // namespace dacrt
 
 namespace dacrt {
+
+// Removes the temporary of every AtomicFile this process has not committed or dropped, and keeps
+// any other from being made, committed or dropped until the process ends: for the one thread
+// that ends the process on a signal (cmd/interrupt_cleanup). Returns the paths removed.
+std::vector<std::string> removeUnfinishedTemporariesForExit();
 
 // Writes `contents` to path through an AtomicFile; throws InputError naming the path.
 void writeFileAtomically(const std::string& path, const std::string& contents);
