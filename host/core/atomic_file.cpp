@@ -16,14 +16,16 @@ namespace {
 
 // The temporaries of this process's live AtomicFiles. The lock also orders a commit's rename
 // against the signal thread's removal: a file is either renamed into place or removed.
+// Never destroyed: a file may be written from a destructor that runs after static destruction
+// began (a pipeline store kept by some static owner).
 std::mutex& unfinishedMutex() {
-    static std::mutex m;
-    return m;
+    static auto* m = new std::mutex;
+    return *m;
 }
 
 std::multiset<std::string>& unfinished() {
-    static std::multiset<std::string> files;
-    return files;
+    static auto* files = new std::multiset<std::string>;
+    return *files;
 }
 
 void forget(const std::string& temporary) {
