@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "cmd/exit_codes.hpp"
+#include "app/exit_codes.hpp"
 #include "core/gltf_loader.hpp"
 
 namespace dacrt {

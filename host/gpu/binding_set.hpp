@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/shader_layout.hpp"
-#include "dacrt/memory_plan.hpp"
+#include "cpu/memory_plan.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/compute_pipeline.hpp"
 

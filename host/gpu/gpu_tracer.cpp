@@ -6,7 +6,7 @@
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
-#include "dacrt/scene_division.hpp"
+#include "cpu/scene_division.hpp"
 #include "gpu/binding_set.hpp"
 #include "gpu/device_defaults.hpp"
 #include "gpu/dispatch_recorder.hpp"

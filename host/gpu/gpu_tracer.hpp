@@ -5,11 +5,11 @@
 #include <memory>
 
 #include "core/thread_pool.hpp"
-#include "dacrt/frame_geometry.hpp"
-#include "dacrt/memory_plan.hpp"
-#include "dacrt/options.hpp"
-#include "dacrt/secondary_rays.hpp"
-#include "dacrt/trace_result.hpp"
+#include "cpu/frame_geometry.hpp"
+#include "cpu/memory_plan.hpp"
+#include "cpu/options.hpp"
+#include "cpu/secondary_rays.hpp"
+#include "cpu/trace_result.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
 #include "gpu/resident_triangles.hpp"

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "dacrt/frame_geometry.hpp"
+#include "cpu/frame_geometry.hpp"
 #include "gpu/buffer.hpp"
 
 namespace dacrt::gpu {

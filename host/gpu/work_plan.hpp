@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/shader_layout.hpp"
-#include "dacrt/scene_division.hpp"
+#include "cpu/scene_division.hpp"
 
 namespace dacrt::gpu {
 

@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "core/errors.hpp"
-#include "dacrt/option_predicates.hpp"
+#include "cpu/option_predicates.hpp"
 
 namespace dacrt {
 namespace {

@@ -20,9 +20,9 @@
 #include "support/reference_support.hpp"
 #include "support/gpu_support.hpp"
 #include "core/procedural.hpp"
-#include "cmd/stress/stress.hpp"
+#include "stress/stress.hpp"
 #include "support/frames.hpp"
-#include "dacrt/secondary_rays.hpp"
+#include "cpu/secondary_rays.hpp"
 
 using namespace dacrt;
 

@@ -4,7 +4,7 @@
 
 #include "core/camera.hpp"
 #include "core/thread_pool.hpp"
-#include "dacrt/cpu_tracers.hpp"
+#include "cpu/cpu_tracers.hpp"
 
 int main() {
     using namespace dacrt;

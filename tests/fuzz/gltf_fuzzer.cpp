@@ -25,7 +25,7 @@
 #include "core/gltf_loader.hpp"
 #include "core/scene.hpp"
 #include "core/thread_pool.hpp"
-#include "dacrt/cpu_tracers.hpp"
+#include "cpu/cpu_tracers.hpp"
 
 namespace {
 

@@ -8,7 +8,7 @@
 
 #include "core/camera.hpp"
 #include "core/random.hpp"
-#include "dacrt/traversal.hpp"
+#include "cpu/traversal.hpp"
 #include "support/gpu_support.hpp"
 #include "gpu/gpu_tracer.hpp"
 #include "core/procedural.hpp"

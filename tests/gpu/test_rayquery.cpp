@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
-#include "dacrt/predicates.hpp"
+#include "cpu/predicates.hpp"
 #include "gpu/pipeline_cache.hpp"
-#include "gpu/rayquery_tracer.hpp"
+#include "peers/rayquery_tracer.hpp"
 #include "support/frames.hpp"
 #include "support/gpu_support.hpp"
 

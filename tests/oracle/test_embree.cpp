@@ -9,7 +9,7 @@
 #include <iostream>
 #include <string>
 
-#include "oracle/embree_tracer.hpp"
+#include "peers/embree_tracer.hpp"
 #include "core/procedural.hpp"
 #include "support/frames.hpp"
 

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "dacrt/traversal.hpp"
+#include "cpu/traversal.hpp"
 #include "oracle/error_metrics.hpp"
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "cmd/backend_dispatcher.hpp"
+#include "library/backend_dispatcher.hpp"
 
 namespace dacrt::test {
 

@@ -9,8 +9,8 @@
 
 #include "core/camera.hpp"
 #include "core/scene.hpp"
-#include "dacrt/cpu_tracers.hpp"
-#include "dacrt/secondary_rays.hpp"
+#include "cpu/cpu_tracers.hpp"
+#include "cpu/secondary_rays.hpp"
 #include "support/fixtures.hpp"
 
 namespace dacrt::test {

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "core/camera.hpp"
-#include "dacrt/traversal.hpp"
+#include "cpu/traversal.hpp"
 #include "gpu/buffer.hpp"
 #include "workgroup_test.spv.h"
 

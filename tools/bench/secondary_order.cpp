@@ -12,8 +12,8 @@
 #include "core/camera.hpp"
 #include "core/gltf_loader.hpp"
 #include "core/timing.hpp"
-#include "dacrt/cpu_tracers.hpp"
-#include "dacrt/secondary_rays.hpp"
+#include "cpu/cpu_tracers.hpp"
+#include "cpu/secondary_rays.hpp"
 
 using namespace dacrt;
 

@@ -1,0 +1,220 @@
+#include "bench/bench_configs.hpp"
+
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace dacrt {
+
+void recordConfig(nlohmann::ordered_json& row, const BenchConfig& c) {
+    row["backend"] = toString(c.backend());
+    row["series"] = c.series;
+    row["config"] = c.name;
+    row["default"] = c.isDefault;
+    row["options"] = optionText(c);
+    row["threads"] = c.threads();
+}
+
+std::string optionText(const BenchConfig& c) {
+    std::ostringstream s;
+    if (c.backend() == Backend::RayQuery) return "build=" + toString(c.request.rayQueryBuild);
+    if (c.backend() == Backend::Embree) {
+        s << "build=" << toString(c.request.embree.build) << " robust=" << (c.request.embree.robust ? "on" : "off")
+          << " rays=" << (c.request.embree.packets ? "rtcIntersect16_4x4" : "rtcIntersect1") << " threads=" << c.threads()
+          << " face_filter=" << (c.request.embree.faceFilter ? "on" : "off");
+        return s.str();
+    }
+    const DacrtOptions d = c.request.trace.dacrt.resolvedFor(c.backend());
+    s << "intersector=" << toString(d.intersector) << " triangle_filter=" << toString(d.triangleFilter)
+      << " precision=" << toString(d.precision) << " split=" << toString(d.split) << " ray_limit=" << d.rayLimit
+      << " tri_limit=" << d.triLimit << " axis=" << toString(c.request.trace.axis) << " regions=" << c.request.trace.regions
+      << " threads=" << c.threads();
+    if (c.backend() == Backend::Gpu)
+        s << " ray_groups=" << (c.request.gpuTuning.rayGroups ? std::to_string(c.request.gpuTuning.rayGroups) : "auto");
+    const SkipSwitches& k = c.request.trace.skips;
+    if (!(k == SkipSwitches{}))
+        s << " no_skip=" << (k.backFaces ? "" : "backfaces,") << (k.frustum ? "" : "frustum,") << (k.uploads ? "" : "uploads,") << (k.subScenes ? "" : "subscenes,");
+    return s.str();
+}
+
+BenchConfig baseConfig(Backend b, unsigned hardwareThreads) {
+    BenchConfig c;
+    c.series = toString(b);
+    c.name = "default";
+    c.request.trace.backend = b;
+    c.request.trace.threads = b == Backend::CpuSeq ? 1u : hardwareThreads;
+    c.isDefault = true;
+    return c;
+}
+
+std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions,
+                                      std::uint32_t gpuDefaultRayGroups) {
+    std::vector<BenchConfig> out;
+    const BenchConfig base = baseConfig(b, hardwareThreads);
+    auto variant = [&](const std::string& name, auto&& change) {
+        BenchConfig c = base;
+        c.name = name;
+        c.isDefault = false;
+        change(c);
+        out.push_back(c);
+    };
+    if (b == Backend::RayQuery) {
+        // As a Vulkan user builds for each case (the device's own ray tracing).
+        for (RayQueryBuild build : {RayQueryBuild::Dynamic, RayQueryBuild::Refit, RayQueryBuild::Static}) {
+            BenchConfig c = base;
+            c.series = "rayquery " + toString(build);
+            c.request.rayQueryBuild = build;
+            c.isDefault = build == RayQueryBuild::Dynamic;
+            out.push_back(c);
+        }
+        return out;
+    }
+    if (b == Backend::Embree) {
+        // As Embree's users run each case: a series per build mode, robust mode on (the
+        // default, exact on the models) and off, and single rays against packets once.
+        for (EmbreeBuild build : {EmbreeBuild::Dynamic, EmbreeBuild::Refit, EmbreeBuild::Static}) {
+            BenchConfig c = base;
+            c.series = "embree " + toString(build);
+            c.request.embree.build = build;
+            c.isDefault = build == EmbreeBuild::Dynamic;
+            out.push_back(c);
+            c.isDefault = false;
+            c.name = "robust=off";
+            c.request.embree.robust = false;
+            out.push_back(c);
+        }
+        variant("rtcIntersect1", [](BenchConfig& c) { c.request.embree.packets = false; });
+        out.back().series = "embree dynamic";
+        // Without the face rule's filter: what a user whose meshes show no back face runs.
+        variant("face-filter=off", [](BenchConfig& c) { c.request.embree.faceFilter = false; });
+        out.back().series = "embree dynamic";
+        return out;
+    }
+    out.push_back(base);
+    if (b == Backend::Brute) return out;
+    const bool cpu = b == Backend::Cpu || b == Backend::CpuSeq;
+    if (cpu) {
+        variant("intersector=moller-trumbore", [](BenchConfig& c) { c.request.trace.dacrt.intersector = Intersector::MollerTrumbore; });
+        variant("triangle-filter=sat", [](BenchConfig& c) { c.request.trace.dacrt.triangleFilter = TriangleFilter::Sat; });
+        variant("triangle-filter=mora", [](BenchConfig& c) { c.request.trace.dacrt.triangleFilter = TriangleFilter::Mora; });
+        variant("precision=f64", [](BenchConfig& c) { c.request.trace.dacrt.precision = Precision::F64; });
+        variant("split=centroid-mean", [](BenchConfig& c) { c.request.trace.dacrt.split = SplitMethod::CentroidMean; });
+        variant("split=sampled-mean", [](BenchConfig& c) { c.request.trace.dacrt.split = SplitMethod::SampledMean; });
+    }
+    const DacrtOptions defaults = base.request.trace.dacrt.resolvedFor(b);
+    if (cpu) {
+        variant("packets=off", [](BenchConfig& c) { c.request.trace.dacrt.packets = false; });
+        for (std::uint32_t f : {4u, 64u, 256u})
+            if (f != defaults.packetFlush)
+                variant("packet-flush=" + std::to_string(f), [f](BenchConfig& c) { c.request.trace.dacrt.packetFlush = f; });
+        for (std::uint32_t l : {4u, 8u, 16u, 32u, 64u})
+            if (l != defaults.rayLimit)
+                variant("ray-limit=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = l; });
+        for (std::uint32_t l : {8u, 16u, 32u, 64u, 128u})
+            if (l != defaults.triLimit)
+                variant("tri-limit=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.triLimit = l; });
+    } else {
+        for (std::uint32_t l : {8u, 16u, 32u, 64u, 128u})
+            if (l != defaults.rayLimit)
+                variant("leaf-limits=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = c.request.trace.dacrt.triLimit = l; });
+    }
+    if (b == Backend::CpuSeq) return out;
+    const unsigned defaultRegions = b == Backend::Cpu ? hardwareThreads : gpuDefaultRegions;
+    for (unsigned r : {1u, 2u, 4u, 8u, 16u, 64u})
+        if (r != defaultRegions)
+            variant("regions=" + std::to_string(r), [r](BenchConfig& c) { c.request.trace.regions = r; });
+    for (DivisionAxis a : {DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z})
+        variant("axis=" + toString(a), [a](BenchConfig& c) { c.request.trace.axis = a; });
+    if (b == Backend::Gpu)
+        for (std::uint32_t groups : {1u, 2u, 4u})
+            if (groups != gpuDefaultRayGroups)
+                variant("ray-groups=" + std::to_string(groups), [groups](BenchConfig& c) { c.request.gpuTuning.rayGroups = groups; });
+    return out;
+}
+
+std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads) {
+    if (b == Backend::Embree) {
+        BenchConfig noFilter = baseConfig(b, hardwareThreads);
+        noFilter.name = "face-filter=off";
+        noFilter.isDefault = false;
+        noFilter.request.embree.faceFilter = false;
+        return {baseConfig(b, hardwareThreads), noFilter};
+    }
+    if (isPeer(b)) return {baseConfig(b, hardwareThreads)};
+    std::vector<BenchConfig> out = {baseConfig(b, hardwareThreads)};
+    auto off = [&](const std::string& name, auto&& change) {
+        BenchConfig c = out.front();
+        c.name = "no-skip=" + name;
+        c.isDefault = false;
+        change(c.request.trace.skips);
+        out.push_back(c);
+    };
+    off("backfaces", [](SkipSwitches& s) { s.backFaces = false; });
+    off("frustum", [](SkipSwitches& s) { s.frustum = false; });
+    if (b == Backend::Gpu) off("uploads", [](SkipSwitches& s) { s.uploads = false; });
+    if (b == Backend::Cpu) off("subscenes", [](SkipSwitches& s) { s.subScenes = false; });
+    off("all", [](SkipSwitches& s) { s = SkipSwitches{false, false, false, false}; });
+    return out;
+}
+
+std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads) {
+    if (isPeer(b)) return sweepConfigs(b, hardwareThreads, 0, 0);
+    return {baseConfig(b, hardwareThreads)};
+}
+
+std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
+    std::vector<BenchConfig> out;
+    if (isPeer(b)) {
+        for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0))
+            if (c.name == "default") out.push_back(c);
+        return out;
+    }
+    out.push_back(baseConfig(b, hardwareThreads));
+    out.back().request.keepForPasses = true;
+    return out;
+}
+
+std::vector<BenchConfig> animationConfigs(Backend b, unsigned hardwareThreads) {
+    std::vector<BenchConfig> out;
+    if (!isPeer(b)) return {baseConfig(b, hardwareThreads)};
+    for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0)) {
+        const bool staticBuild = b == Backend::Embree ? c.request.embree.build == EmbreeBuild::Static
+                                                      : c.request.rayQueryBuild == RayQueryBuild::Static;
+        if (c.name == "default" && !staticBuild) out.push_back(c);
+    }
+    return out;
+}
+
+// The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
+std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads) {
+    std::vector<BenchConfig> out;
+    if (b == Backend::CpuSeq) {
+        out.push_back(baseConfig(b, hardwareThreads));
+        return out;
+    }
+    auto config = [&](unsigned threads, unsigned regions, DivisionAxis axis) {
+        BenchConfig c = baseConfig(b, hardwareThreads);
+        c.isDefault = false;
+        c.request.trace.threads = b == Backend::Cpu ? threads : hardwareThreads;
+        c.request.trace.regions = regions;
+        c.request.trace.axis = axis;
+        c.name = (b == Backend::Cpu ? "threads=" + std::to_string(threads) + " " : std::string()) +
+                 "regions=" + std::to_string(regions) + " axis=" + toString(axis);
+        out.push_back(c);
+    };
+    const DivisionAxis axes[] = {DivisionAxis::Best, DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z};
+    if (b == Backend::Cpu) {
+        const std::pair<unsigned, unsigned> setups[] = {{1, 1}, {2, 2}, {4, 4}, {1, 2}, {2, 4}, {4, 8}};
+        for (const auto& [threads, regions] : setups)
+            for (DivisionAxis a : axes) config(threads, regions, a);
+    } else if (b == Backend::Gpu) {
+        for (unsigned regions : {1u, 2u, 4u, 8u, 16u})
+            for (DivisionAxis a : axes)
+                if (a == DivisionAxis::Best || regions == 2 || regions == 4) config(0, regions, a);
+    } else {
+        throw InputError("--suite table51 compares the DACRT backends (cpu-seq, cpu, gpu), not " + toString(b));
+    }
+    return out;
+}
+
+}  // namespace dacrt

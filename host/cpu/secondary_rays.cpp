@@ -1,0 +1,107 @@
+#include "cpu/secondary_rays.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+
+namespace dacrt {
+
+ShadowLight shadowLightOf(const Light& light) {
+    ShadowLight s{};
+    s.type = light.type == LightType::Point ? shared::kLightPoint
+                                            : (light.type == LightType::Spot ? shared::kLightSpot : shared::kLightDirectional);
+    s.position = glm::vec3(light.position);
+    // Components below 2^-40 are flushed, as the surface normals' are: no product with one is
+    // subnormal, which a device may flush and the host would not.
+    s.direction = glm::vec3(glm::normalize(light.direction));
+    for (int a = 0; a < 3; ++a)
+        if (std::abs(s.direction[a]) < 0x1p-40f) s.direction[a] = 0.0f;
+    s.range = light.range;
+    const double cosOuter = std::cos(light.outerConeAngle);
+    s.cosOuterSquared = light.type == LightType::Spot ? float(cosOuter * cosOuter) : 0.0f;
+    return s;
+}
+
+std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, std::uint32_t k) {
+    const std::uint32_t perHit = pass.samplesPerHit ? pass.samplesPerHit : pass.raysPerHit;
+    return primary * perHit + pass.firstSample + k;
+}
+
+std::uint64_t secondarySlots(const SecondaryPass& pass, std::uint64_t primaryRays) {
+    const std::uint64_t slots = primaryRays * pass.raysPerHit;
+    const std::uint64_t streams = primaryRays * std::max(pass.raysPerHit, pass.samplesPerHit);
+    if (pass.raysPerHit == 0 || slots > kMaxSecondarySlots || streams > kMaxSecondarySlots)
+        throw InputError(pass.name + ": " + std::to_string(primaryRays) + " pixels x " + std::to_string(pass.raysPerHit) +
+                         " rays per hit is more than the " + std::to_string(kMaxSecondarySlots) +
+                         " rays a pass can hold (32-bit slots); lower --size or --ao");
+    return slots;
+}
+
+SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray>& primary,
+                                const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
+                                ThreadPool& pool) {
+    SecondaryRays out;
+    out.slotCount = secondarySlots(pass, primary.size());
+    const std::uint32_t perHit = pass.raysPerHit;
+    // Chunks of primary rays made in parallel, each into the front of its own slots, then moved
+    // down in slot order: one allocation (fresh pages cost a fault each on a VM), no copies.
+    out.rays.resize(out.slotCount);
+    out.slots.resize(out.slotCount);
+    const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(256, primary.size() / 1024 + 1));
+    std::vector<std::size_t> made(chunks, 0);
+    auto firstSlot = [&](std::size_t c) { return primary.size() * c / chunks * perHit; };
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        const std::size_t begin = primary.size() * c / chunks, end = primary.size() * (c + 1) / chunks;
+        std::size_t next = firstSlot(c);
+        for (std::size_t i = begin; i < end; ++i) {
+            const Hit& hit = primaryHits[i];
+            if (hit.prim == kMissPrim || hit.prim == kNotTracedPrim) continue;
+            const shared::SurfaceSample surface = shared::surfaceOfHit(primary[i], hit, triangles[hit.prim]);
+            for (std::uint32_t k = 0; k < perHit; ++k) {
+                const std::uint32_t slot = std::uint32_t(i) * perHit + k;
+                const shared::GeneratedRay g =
+                    pass.kind == shared::kPassShadow
+                        ? shared::shadowRay(surface, pass.light)
+                        : shared::occlusionRay(surface, occlusionStream(pass, std::uint32_t(i), k), pass.sampleSeed,
+                                               pass.occlusionDistance);
+                if (!g.traced) continue;
+                out.rays[next] = g.ray;
+                out.slots[next++] = slot;
+            }
+        }
+        made[c] = next - firstSlot(c);
+    });
+    std::size_t total = 0;
+    for (std::size_t c = 0; c < chunks; ++c) {
+        const std::size_t from = firstSlot(c);
+        if (from != total) {
+            std::copy(out.rays.begin() + std::ptrdiff_t(from), out.rays.begin() + std::ptrdiff_t(from + made[c]),
+                      out.rays.begin() + std::ptrdiff_t(total));
+            std::copy(out.slots.begin() + std::ptrdiff_t(from), out.slots.begin() + std::ptrdiff_t(from + made[c]),
+                      out.slots.begin() + std::ptrdiff_t(total));
+        }
+        total += made[c];
+    }
+    out.rays.resize(total);
+    out.slots.resize(total);
+    return out;
+}
+
+std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced) {
+    if (traced.size() != rays.rays.size())
+        throw InternalError("a secondary pass traced " + std::to_string(traced.size()) + " rays of " +
+                            std::to_string(rays.rays.size()));
+    std::vector<Hit> slots(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f});
+    for (std::size_t i = 0; i < traced.size(); ++i) slots[rays.slots[i]] = traced[i];
+    return slots;
+}
+
+FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles,
+                             const std::vector<Bounds>& bounds, const std::vector<Ray>& rays, const Box& sceneBox) {
+    FrameGeometry g = frameGeometry(triangles, bounds, rays, sceneBox);
+    g.query = HitQuery::Any;
+    return g;
+}
+
+}  // namespace dacrt

@@ -1,0 +1,85 @@
+#pragma once
+// Secondary passes made on the host: shadow and occlusion rays from the primary hits, by
+// shaders/secondary_rays.glsl compiled as C++ (the gpu backend runs the same file on the
+// device, so both make the same rays bit for bit), and the pass's results slot by slot.
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/scene.hpp"
+#include "core/thread_pool.hpp"
+#include "cpu/frame_geometry.hpp"
+#include "cpu/predicates.hpp"
+
+namespace dacrt::shared {
+inline uint floatBitsToUint(float x) { return std::bit_cast<uint>(x); }
+inline float uintBitsToFloat(uint x) { return std::bit_cast<float>(x); }
+inline float sqrt(float x) { return std::sqrt(x); }
+#define precise
+#define IN(T) const T&
+#define DACRT_UNROLL
+#define DACRT_HOST_IEEE_ARITHMETIC
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+namespace {  // GLSL has no `inline`: internal linkage keeps one copy per translation unit legal
+#include "secondary_rays.glsl"
+}
+#pragma GCC diagnostic pop
+#undef DACRT_HOST_IEEE_ARITHMETIC
+#undef DACRT_UNROLL
+#undef IN
+#undef precise
+}  // namespace dacrt::shared
+
+namespace dacrt {
+
+using shared::ShadowLight;
+
+// One secondary pass of a frame: what it makes from each primary hit.
+struct SecondaryPass {
+    std::string name;                        // "shadow (key light)", "occlusion"
+    std::uint32_t kind = shared::kPassShadow;  // shared::kPassShadow or kPassOcclusion
+    ShadowLight light{};                     // kPassShadow
+    std::uint32_t raysPerHit = 1;            // kPassOcclusion: samples per hit in this pass...
+    std::uint32_t firstSample = 0;           // ... [firstSample, + raysPerHit) of samplesPerHit
+    std::uint32_t samplesPerHit = 0;         // 0: raysPerHit (the pass holds every sample)
+    float occlusionDistance = 0.0f;          // kPassOcclusion: the rays' length
+    std::uint32_t sampleSeed = 0;            // kPassOcclusion: the sample sequence
+};
+
+// The light as the shadow pass traces it, in float32.
+ShadowLight shadowLightOf(const Light& light);
+
+// Sample k of primary ray i draws occlusion stream i * samplesPerHit + firstSample + k, so
+// that a pass split into batches of samples makes the rays the whole pass would.
+std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, std::uint32_t k);
+
+// The rays of a pass: one slot per primary ray and sample (slot = primary index * raysPerHit
+// + sample); slots without a ray (a miss, a surface the light cannot reach) are left out.
+struct SecondaryRays {
+    std::vector<Ray> rays;                 // the rays made, in slot order
+    std::vector<std::uint32_t> slots;      // rays[i] fills slots[i]
+    std::uint64_t slotCount = 0;
+};
+
+// Largest slot count of a pass (slots are 32-bit on the device, kNotTracedPrim reserved).
+constexpr std::uint64_t kMaxSecondarySlots = 0xFFFFFFF0ull;
+// Throws InputError when the pass has more slots than kMaxSecondarySlots.
+std::uint64_t secondarySlots(const SecondaryPass& pass, std::uint64_t primaryRays);
+
+SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray>& primary,
+                                const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
+                                ThreadPool& pool);
+
+// The pass's result per slot: the traced hit (any hit: the visibility is exact), or
+// Hit{0, kNotTracedPrim} where no ray was made.
+std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced);
+
+// The frame a pass's rays are traced as: any hit (frameGeometry finds their child order:
+// shadow rays to a directional light share a direction, the others go every way).
+FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles,
+                             const std::vector<Bounds>& bounds, const std::vector<Ray>& rays, const Box& sceneBox);
+
+}  // namespace dacrt

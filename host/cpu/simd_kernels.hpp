@@ -1,0 +1,77 @@
+#pragma once
+// The data-parallel kernels of the default DACRT path (docs/cpu-reference.md, "SIMD"): the
+// ray/cell filter, the triangle-bounds/cell filter and the leaf's watertight test, 4 to 16
+// lanes at a time through Google Highway, whose instruction set is chosen at run time
+// (AVX-512, AVX2, SSE4, ... down to portable scalar code), so one binary serves every x86-64.
+//
+// Each kernel computes, lane by lane, the same IEEE operations in the same order as the
+// scalar predicate it replaces (shaders/predicates.glsl), with the same min/max operand
+// order and no contraction, so its answers are the scalar ones bit for bit
+// (tests/cpu/test_simd_kernels.cpp runs both side by side on every compiled target).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/scene.hpp"
+
+namespace dacrt::simd {
+
+// Ids move through 32-bit gather offsets: the kernels take at most this many rays
+// (16 floats each) or triangles (12 floats each); larger frames use the scalar path.
+constexpr std::uint64_t kMaxRays = (std::uint64_t(1) << 31) / 16;
+constexpr std::uint64_t kMaxTriangles = (std::uint64_t(1) << 31) / 16;
+
+// Room past the ids a partition may park in scratch, for whole-vector stores.
+constexpr std::uint32_t kScratchSlack = 64;
+
+// Stable partition of ids[0, count): the ids whose ray may cross the (already widened) cell
+// before its best hit so far (shared::rayMayCrossCell with hits[id].t) first, in their order;
+// the others after them, in theirs. Returns how many pass. scratch holds count +
+// kScratchSlack ids. raysShareStart: every ray has rays[0]'s origin and tmin bit for bit
+// (raysShareStart() in frame_geometry.hpp).
+std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
+                                        const Box& cell, bool raysShareStart, std::uint32_t* scratch);
+
+// The same partition for triangles whose bounds are known to overlap a cell that differs
+// from this one only in one face, on `axis`: what shared::boundsOverlap with this cell
+// answers then is the one comparison that face adds, lo[axis] <= bound for a new high face
+// (lowSide) or hi[axis] >= bound for a new low face. One gather per id instead of six.
+std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
+                                       bool lowSide, float bound, std::uint32_t* scratch);
+
+// Up to kLeafBatch triangles of a leaf in structure-of-arrays form: coordinate c of vertex k
+// of triangle j is vertex[k][c][j]. Lanes past `count` are padding and never hit.
+constexpr std::uint32_t kLeafBatch = 64;
+struct LeafTriangles {
+    alignas(64) float vertex[3][3][kLeafBatch];
+    alignas(64) std::uint32_t prim[kLeafBatch];
+    alignas(64) std::uint32_t cullBackFace[kLeafBatch];  // Triangle::cullBackFace
+    std::uint32_t count = 0;
+};
+
+// Copies triIds[0, count) (count <= kLeafBatch) of triangles into batch.
+void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds, std::uint32_t count,
+                         LeafTriangles& batch);
+
+// The watertight test of each ray rays[rayIds[r]], r < rayCount, against every triangle of
+// batch; its hit becomes the first under the tie rule (smaller t, then smaller id) of the
+// hit it had and the batch's hits with t > tmin: what testTriangle over the batch gives, in
+// any order, since the rule is a total order on distinct ids.
+void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                    const LeafTriangles& batch);
+
+// The back-face skip's verdict on triangles[0, count) seen from origin, certified in float32
+// lanes: kKeep where facesAwayFrom (triangle_skips.hpp, float64) is false (front-facing, or not
+// single-sided), kDrop where it is true, kUndecided where float32 cannot tell within its
+// error bound (the caller then asks facesAwayFrom). Never kKeep or kDrop against it.
+enum FacingVerdict : std::uint8_t { kKeep = 0, kDrop = 1, kUndecided = 2 };
+void classifyFacing(const Triangle* triangles, std::uint32_t count, const glm::vec3& origin, std::uint8_t* verdict);
+
+// The instruction set the kernels run on now ("AVX3" is AVX-512), and every one this
+// binary holds that the machine supports, best first.
+std::string activeTarget();
+std::vector<std::string> availableTargets();
+// Restricts the dispatch to one of availableTargets() (tests); "" restores the best.
+void forceTarget(const std::string& name);
+
+}  // namespace dacrt::simd

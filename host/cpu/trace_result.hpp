@@ -1,0 +1,69 @@
+#pragma once
+// What every tracer returns: hits, counters, the memory plan and timings.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/shader_layout.hpp"
+#include "cpu/memory_plan.hpp"
+
+namespace dacrt {
+
+struct Counters {
+    std::uint64_t rayBoxTests = 0;
+    std::uint64_t packetBoxTests = 0;    // packets of rays tested at once against a box
+    std::uint64_t rayTriangleTests = 0;
+    std::uint64_t leaves = 0;
+    std::uint64_t raysRetired = 0;       // finished by the parallel scheme without a further hit
+    std::uint64_t raysCulled = 0;        // missed the scene box
+    std::uint64_t terminatedStep1 = 0;   // for cpu-seq: every terminated ray
+    std::vector<std::uint64_t> terminatedPerRound;  // transfer rounds in execution order
+    std::vector<std::string> roundNames;
+    std::uint64_t transferWorkItems = 0;
+    std::uint64_t transferWorkItemsSkipped = 0;
+
+    void add(const Counters& o) {
+        rayBoxTests += o.rayBoxTests;
+        packetBoxTests += o.packetBoxTests;
+        rayTriangleTests += o.rayTriangleTests;
+        leaves += o.leaves;
+        raysRetired += o.raysRetired;
+    }
+};
+
+// What only a device backend reports (plain data: the layer that fills it is above this one).
+struct GpuReport {
+    std::string device;
+    std::string driver;
+    std::uint32_t workgroupSize = 0;
+    std::uint32_t subgroupSize = 0;
+    std::uint32_t rayGroups = 0;       // work items per region and round (groupRegions)
+    std::vector<std::pair<std::string, double>> dispatchMs;  // GPU timestamps, per dispatch
+    std::uint32_t dispatches = 0;
+    std::uint32_t workItemsRun = 0;
+    std::uint32_t workItemsEmpty = 0;
+    std::uint32_t slices = 0;          // work item slices (more than work items: continuations)
+    std::uint64_t raysFinished = 0;    // rays ended by a hit or retired, over all steps
+    std::uint32_t validationErrors = 0;
+};
+
+struct TraceResult {
+    std::vector<Hit> hits;   // one per ray
+    Counters counters;
+    MemoryPlan memory;
+    std::vector<std::pair<std::string, double>> phaseMs;  // backend-specific parts of the trace
+    std::vector<double> step1RegionMs;   // cpu: each region's Step 1 work item, for load balance
+    unsigned threads = 1;
+    unsigned regions = 1;
+    int axis = -1;           // division axis used (cpu, gpu), -1 if none
+    std::optional<GpuReport> gpu;
+};
+
+// A hit record meaning "nothing yet" on a whole ray...
+inline Hit missHit() { return Hit{kNoHitT, kMissPrim, 0.0f, 0.0f}; }
+// ... and on this ray: its segment's end bounds every later test like a hit would.
+inline Hit missHit(const Ray& ray) { return Hit{ray.tmax, kMissPrim, 0.0f, 0.0f}; }
+
+}  // namespace dacrt

@@ -1,0 +1,455 @@
+#include "cpu/traversal.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+#include "cpu/option_predicates.hpp"
+
+namespace dacrt {
+namespace {
+
+Box widen(const Box& b, float margin) {
+    Box w;
+    w.lo = b.lo - glm::vec3(margin);
+    w.hi = b.hi + glm::vec3(margin);
+    return w;
+}
+
+int longestAxis(const Box& b) {
+    const glm::vec3 e = b.extent();
+    return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+}
+
+}  // namespace
+
+std::uint64_t packetTiles(const FrameGeometry& g) {
+    if (!g.imageWidth || !g.raysShareStart) return 0;
+    const std::uint64_t height = g.rays->size() / g.imageWidth;
+    return ((g.imageWidth + kPacketTile - 1) / kPacketTile) * ((height + kPacketTile - 1) / kPacketTile);
+}
+
+bool usesSimd(const FrameGeometry& g, const DacrtOptions& options) {
+    return options.exactDefaults() && g.rays->size() <= simd::kMaxRays && g.triangles->size() <= simd::kMaxTriangles;
+}
+
+bool usesPackets(const FrameGeometry& g, const DacrtOptions& options) {
+    return options.packets && usesSimd(g, options) && packetTiles(g) > 0;
+}
+
+namespace {
+
+// One worker's packet arrays, element by element: what the plan counts and the storage
+// allocates (plus one finished flag per ray of the frame, shared).
+struct PacketArrayCounts {
+    std::uint64_t rayIds = 0;      // packetRays, and flushRays as many
+    std::uint64_t packets = 0;     // packets, and packetIds as many
+    std::uint64_t tileStarts = 0;  // tileCounts
+};
+
+PacketArrayCounts packetArrayCounts(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t scratchIds) {
+    if (!usesPackets(g, options)) return {};
+    const std::uint64_t tiles = packetTiles(g);
+    return {scratchIds, tiles, tiles + 1};
+}
+
+}  // namespace
+
+void planPacketBuffers(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t scratchIds, unsigned workers,
+                       MemoryPlan& plan) {
+    const PacketArrayCounts c = packetArrayCounts(g, options, scratchIds);
+    if (!c.packets) return;
+    plan.add("packet rays and flushed rays (per thread)", 2 * c.rayIds * sizeof(std::uint32_t) * workers);
+    plan.add("packets (per thread)",
+             (c.packets * (sizeof(RayPacket) + sizeof(std::uint32_t)) + c.tileStarts * sizeof(std::uint32_t)) * workers);
+    plan.add("ray finished flags", g.rays->size() * sizeof(std::uint8_t));
+}
+
+PacketStorage::PacketStorage(const FrameGeometry& g, const DacrtOptions& options, std::uint64_t ids, unsigned workers)
+    : scratchIds(ids), tiles(packetArrayCounts(g, options, ids).packets) {
+    if (!tiles) return;
+    const PacketArrayCounts c = packetArrayCounts(g, options, ids);
+    packetRays.resize(c.rayIds * workers);
+    flushRays.resize(c.rayIds * workers);
+    packets.resize(c.packets * workers);
+    packetIds.resize(c.packets * workers);
+    tileCounts.resize(c.tileStarts * workers);
+    rayDone.assign(g.rays->size(), 0);
+}
+
+PacketBuffers PacketStorage::forWorker(unsigned w) {
+    if (!tiles) return {};
+    return {packetRays.data() + w * scratchIds, flushRays.data() + w * scratchIds, packets.data() + w * tiles,
+            packetIds.data() + w * tiles, tileCounts.data() + w * (tiles + 1), rayDone.data()};
+}
+
+std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange) {
+    return std::max(rayRange, triRange) + simd::kScratchSlack;
+}
+
+DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& options, const TraversalBuffers& buffers,
+                               Counters& counters)
+    : rays_(g.rays->data()),
+      triangles_(g.triangles->data()),
+      triangleBounds_(g.triangleBounds->data()),
+      order_(g.order),
+      orderPoint_(g.nearSide),
+      anyHit_(g.query == HitQuery::Any),
+      margin_(g.margin),
+      options_(options.resolvedFor(Backend::Cpu)),
+      hits_(buffers.hits),
+      rayIds_(buffers.rayIds),
+      triIds_(buffers.triIds),
+      scratch_(buffers.scratch),
+      raysShareStart_(g.raysShareStart),
+      simd_(scratch_ && usesSimd(g, options_)),
+      packets_(simd_ && buffers.packets.packetRays && usesPackets(g, options_)),
+      packet_(buffers.packets),
+      imageWidth_(g.imageWidth),
+      tiles_(std::uint32_t(packetTiles(g))),
+      counters_(counters) {}
+
+std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
+                                    std::uint32_t triBegin, std::uint32_t triEnd, const RetireRule& retire) {
+    const std::uint32_t crossing = filterRays(widen(box, margin_), terminated, rayEnd);
+    if (packets_)
+        tracePackets(box, terminated, crossing, triBegin, triEnd);
+    else if (order_ == ChildOrder::PerRay && options_.rayOrder == RayOrder::Octants)
+        traceOctants(box, terminated, crossing, triBegin, triEnd);
+    else
+        node(box, terminated, crossing, triBegin, triEnd, 0, 0);
+    if (retire.axis < 0) return crossing;
+    const Box cell = widen(box, margin_);
+    for (std::uint32_t k = terminated; k < rayEnd; ++k) {
+        const std::uint32_t id = rayIds_[k];
+        const float d = rays_[id].dir[retire.axis];
+        const bool done = retire.direction == 0
+                              ? d == 0.0f
+                              : (retire.direction > 0 ? d > 0.0f : d < 0.0f) &&
+                                    !shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
+        if (done) {
+            std::swap(rayIds_[k], rayIds_[terminated]);
+            ++terminated;
+            ++counters_.raysRetired;
+        }
+    }
+    return crossing;
+}
+
+// RayOrder::Octants: the live rays of each direction octant in turn, moved to the front of the
+// live range and traced with the near side their signs share (ChildOrder::NearSide); rays of
+// earlier octants that stay live wait behind them, as any unfinished ray does.
+void DacrtTraversal::traceOctants(const Box& box, std::uint32_t& terminated, std::uint32_t crossing,
+                                  std::uint32_t triBegin, std::uint32_t triEnd) {
+    auto octantOf = [&](std::uint32_t id) {
+        const glm::vec3& d = rays_[id].dir;
+        return (d.x < 0.0f ? 1u : 0u) | (d.y < 0.0f ? 2u : 0u) | (d.z < 0.0f ? 4u : 0u);
+    };
+    const ChildOrder order = order_;
+    const glm::vec3 point = orderPoint_;
+    order_ = ChildOrder::NearSide;
+    for (std::uint32_t octant = 0; octant < 8; ++octant) {
+        std::uint32_t* groupEnd = std::partition(rayIds_ + terminated, rayIds_ + crossing,
+                                                 [&](std::uint32_t id) { return octantOf(id) == octant; });
+        if (groupEnd == rayIds_ + terminated) continue;
+        for (int a = 0; a < 3; ++a)
+            orderPoint_[a] = (octant >> a) & 1u ? std::numeric_limits<float>::max() : -std::numeric_limits<float>::max();
+        node(box, terminated, std::uint32_t(groupEnd - rayIds_), triBegin, triEnd, 0, 0);
+    }
+    order_ = order;
+    orderPoint_ = point;
+}
+
+[[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
+    counters_.rayBoxTests += end - begin;
+    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, hits_, rayIds_ + begin, end - begin, cell, raysShareStart_,
+                                                            scratch_);
+    std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
+        return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);
+    });
+    return std::uint32_t(first - rayIds_);
+}
+
+std::uint32_t DacrtTraversal::filterRaysMoving(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
+                                               int moving) {
+    if (moving == 0) return filterRays(cell, begin, end);
+    std::uint32_t* moved = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
+        return (rays_[id].dir[axis] < 0.0f) == (moving < 0);
+    });
+    return filterRays(cell, begin, std::uint32_t(moved - rayIds_));
+}
+
+std::uint32_t DacrtTraversal::filterTriangles(const Box& child, const Box& cell, std::uint32_t begin,
+                                              std::uint32_t end, int axis, bool lowChild) {
+    std::uint32_t* first = triIds_ + begin;
+    switch (options_.triangleFilter) {
+        case TriangleFilter::Bounds:
+            if (simd_)
+                return begin + simd::partitionTrianglesOnFace(triangleBounds_, triIds_ + begin, end - begin, axis,
+                                                              lowChild, lowChild ? cell.hi[axis] : cell.lo[axis],
+                                                              scratch_);
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                const Bounds& b = triangleBounds_[id];
+                return shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
+            });
+            break;
+        case TriangleFilter::Sat:
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                return triangleOverlapsBoxSat(triangles_[id], triangleBounds_[id], cell.lo, cell.hi);
+            });
+            break;
+        case TriangleFilter::Mora:
+            // The unwidened child: Mora's test has no rounding margin (that is its price).
+            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
+                return triangleOverlapsBoxMora(triangles_[id], triangleBounds_[id], child.lo, child.hi, end - begin);
+            });
+            break;
+    }
+    return std::uint32_t(first - triIds_);
+}
+
+float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const {
+    const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
+    if (options_.split == SplitMethod::SpatialMedian) return mid;
+    // Mora's sampled mean: every 50th triangle centre once the set is large, all of them below.
+    const std::uint32_t count = triEnd - triBegin;
+    const std::uint32_t stride = options_.split == SplitMethod::SampledMean && count > 500 ? 50 : 1;
+    double sum = 0.0;
+    std::uint32_t samples = 0;
+    for (std::uint32_t i = triBegin; i < triEnd; i += stride, ++samples) {
+        const Bounds& b = triangleBounds_[triIds_[i]];
+        sum += 0.5 * (double(b.lo[axis]) + double(b.hi[axis]));
+    }
+    const float s = float(sum / double(std::max(samples, 1u)));
+    return s > box.lo[axis] && s < box.hi[axis] ? s : mid;
+}
+
+// The split both recursions share (node over rays, nodePackets over packets): the longest
+// axis at the split position, then the children front to back, each with its items and
+// triangles filtered from the node's. With a common order (ChildOrder::NearSide) or
+// for any hit (where order changes no result) every item visits the near child, then the far
+// one; with ChildOrder::PerRay the rays moving up visit the low child, then all rays the high
+// one, then the rays moving down the low one, so that each ray meets its children in the
+// order it crosses them. itemBegin is read again for each visit: a ray recursion moves the
+// rays an earlier visit finished before it. False (nothing done) where the node must end here
+// instead: fewItems, too few triangles, too deep, stalled, or no split inside.
+template <typename FilterItems, typename Descend>
+bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, std::uint32_t itemEnd,
+                               std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
+                               std::uint32_t stalls, bool fewItems, FilterItems filterItems, Descend descend) {
+    const int axis = longestAxis(box);
+    const float split = splitPosition(box, axis, triBegin, triEnd);
+    if (fewItems || triEnd - triBegin < options_.triLimit || depth >= options_.maxDepth ||
+        stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis]))
+        return false;
+    Box low = box, high = box;
+    low.hi[axis] = split;
+    high.lo[axis] = split;
+    struct Visit {
+        const Box* child;
+        int moving;  // the rays that visit it: +1 moving up (or not at all along axis), -1 down, 0 all
+    };
+    const bool lowFirst = order_ == ChildOrder::PerRay || orderPoint_[axis] <= split;
+    Visit visits[3] = {{lowFirst ? &low : &high, 0}, {lowFirst ? &high : &low, 0}, {nullptr, 0}};
+    if (order_ == ChildOrder::PerRay) {
+        visits[0] = {&low, anyHit_ ? 0 : 1};
+        visits[1] = {&high, 0};
+        visits[2] = {anyHit_ ? nullptr : &low, -1};
+    }
+    for (const Visit& visit : visits) {
+        if (!visit.child) break;
+        const Box cell = widen(*visit.child, margin_);
+        const std::uint32_t childItems = filterItems(cell, itemBegin, itemEnd, axis, visit.moving);
+        if (childItems == itemBegin) continue;
+        const std::uint32_t childTris = filterTriangles(*visit.child, cell, triBegin, triEnd, axis, visit.child == &low);
+        const bool stalled = childItems == itemEnd && childTris == triEnd;
+        descend(*visit.child, childItems, childTris, depth + 1, stalled ? stalls + 1 : 0);
+    }
+    return true;
+}
+
+void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
+    if (terminated >= rayEnd || triBegin >= triEnd) return;
+    const bool split = splitNode(
+        box, terminated, rayEnd, triBegin, triEnd, depth, stalls, rayEnd - terminated < options_.rayLimit,
+        [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving) {
+            return filterRaysMoving(cell, begin, end, axis, moving);
+        },
+        [&](const Box& child, std::uint32_t childRays, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
+            node(child, terminated, childRays, triBegin, childTris, d, s);
+        });
+    if (!split) leaf(box, terminated, rayEnd, triBegin, triEnd);
+}
+
+// The rays of [terminated, crossing) in packets: traced down as packets to nodes with fewer
+// than packetFlush of them, one by one below. Finished rays are flagged, and moved before
+// `terminated` at the end as node() would have moved them.
+void DacrtTraversal::tracePackets(const Box& box, std::uint32_t& terminated, std::uint32_t crossing,
+                                  std::uint32_t triBegin, std::uint32_t triEnd) {
+    const std::uint32_t packetCount = buildPackets(terminated, crossing);
+    nodePackets(box, 0, packetCount, triBegin, triEnd, 0, 0);
+    for (std::uint32_t k = terminated; k < crossing; ++k)
+        if (packet_.rayDone[rayIds_[k]]) std::swap(rayIds_[k], rayIds_[terminated++]);
+}
+
+// A counting sort of the rays by 8x8 tile into packetRays, then each packet's bounds.
+std::uint32_t DacrtTraversal::buildPackets(std::uint32_t begin, std::uint32_t end) {
+    const std::uint32_t tilesX = (imageWidth_ + kPacketTile - 1) / kPacketTile;
+    auto tileOf = [&](std::uint32_t id) { return (id / imageWidth_ / kPacketTile) * tilesX + (id % imageWidth_) / kPacketTile; };
+    std::uint32_t* start = packet_.tileCounts;  // start[t]: where tile t's rays begin
+    std::fill(start, start + tiles_ + 1, 0u);
+    for (std::uint32_t k = begin; k < end; ++k) ++start[tileOf(rayIds_[k]) + 1];
+    for (std::uint32_t t = 0; t < tiles_; ++t) start[t + 1] += start[t];
+    for (std::uint32_t k = begin; k < end; ++k) packet_.packetRays[start[tileOf(rayIds_[k])]++] = rayIds_[k];
+    // start[t] is now where tile t's rays end.
+    std::uint32_t packets = 0, tileBegin = 0;
+    for (std::uint32_t t = 0; t < tiles_; tileBegin = start[t], ++t) {
+        if (start[t] == tileBegin) continue;
+        RayPacket& p = packet_.packets[packets];
+        p.begin = tileBegin;
+        p.end = start[t];
+        p.invLo = glm::vec3(kNoHitT);
+        p.invHi = glm::vec3(-kNoHitT);
+        p.unboundedAxes = 0;
+        for (std::uint32_t k = p.begin; k < p.end; ++k) {
+            const glm::vec3& inv = rays_[packet_.packetRays[k]].invDir;
+            for (int a = 0; a < 3; ++a) {
+                if (inv[a] == 0.0f) p.unboundedAxes |= 1u << a;
+                p.invLo[a] = std::min(p.invLo[a], inv[a]);
+                p.invHi[a] = std::max(p.invHi[a], inv[a]);
+            }
+        }
+        packet_.packetIds[packets] = packets;
+        ++packets;
+    }
+    return packets;
+}
+
+// Conservative for every ray of the packet (see RayPacket): false only where the ray filter
+// would reject each of them.
+bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin, const Box& cell) {
+    float tNear = -kNoHitT, tFar = kNoHitT;
+    for (int a = 0; a < 3; ++a) {
+        if ((p.unboundedAxes >> a) & 1u) continue;
+        const float d0 = cell.lo[a] - origin[a], d1 = cell.hi[a] - origin[a];  // the ray filter's own first factors
+        const float q0 = d0 * p.invLo[a], q1 = d0 * p.invHi[a], q2 = d1 * p.invLo[a], q3 = d1 * p.invHi[a];
+        tNear = std::max(tNear, std::min(std::min(q0, q1), std::min(q2, q3)));
+        tFar = std::min(tFar, std::max(std::max(q0, q1), std::max(q2, q3)));
+    }
+    return tNear <= tFar && tFar >= tmin;
+}
+
+std::uint32_t DacrtTraversal::filterPackets(const Box& cell, std::uint32_t begin, std::uint32_t end) {
+    counters_.packetBoxTests += end - begin;
+    const glm::vec3 origin = rays_[0].origin;  // every ray's (packets need raysShareStart)
+    const float tmin = rays_[0].tmin;
+    std::uint32_t* first = std::partition(packet_.packetIds + begin, packet_.packetIds + end, [&](std::uint32_t p) {
+        return packetMayCrossCell(packet_.packets[p], origin, tmin, cell);
+    });
+    return std::uint32_t(first - packet_.packetIds);
+}
+
+void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd,
+                                 std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
+                                 std::uint32_t stalls) {
+    if (packetBegin >= packetEnd || triBegin >= triEnd) return;
+    const bool split = splitNode(
+        box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls, packetEnd - packetBegin < options_.packetFlush,
+        [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int) { return filterPackets(cell, begin, end); },
+        [&](const Box& child, std::uint32_t childPackets, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
+            nodePackets(child, packetBegin, childPackets, triBegin, childTris, d, s);
+        });
+    if (!split) flushPackets(box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls);
+}
+
+// The node's unfinished rays go on one by one, from its own ray filter down.
+void DacrtTraversal::flushPackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd,
+                                  std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
+                                  std::uint32_t stalls) {
+    std::uint32_t count = 0;
+    for (std::uint32_t i = packetBegin; i < packetEnd; ++i) {
+        const RayPacket& p = packet_.packets[packet_.packetIds[i]];
+        for (std::uint32_t k = p.begin; k < p.end; ++k) {
+            const std::uint32_t id = packet_.packetRays[k];
+            if (!packet_.rayDone[id]) packet_.flushRays[count++] = id;
+        }
+    }
+    if (count == 0) return;
+    std::uint32_t* const regionRays = rayIds_;
+    rayIds_ = packet_.flushRays;
+    std::uint32_t terminated = 0;
+    const std::uint32_t crossing = filterRays(widen(box, margin_), 0, count);
+    node(box, terminated, crossing, triBegin, triEnd, depth, stalls);
+    for (std::uint32_t k = 0; k < terminated; ++k) packet_.rayDone[rayIds_[k]] = 1;
+    rayIds_ = regionRays;
+}
+
+void DacrtTraversal::leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd) {
+    ++counters_.leaves;
+    counters_.rayTriangleTests += std::uint64_t(rayEnd - terminated) * (triEnd - triBegin);
+    auto same = [](const Ray& ray) -> const Ray& { return ray; };
+    if (simd_)
+        leafSimd(box, terminated, rayEnd, triBegin, triEnd);
+    else if (options_.precision == Precision::F64)
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, toF64, testTriangleF64);
+    else if (options_.intersector == Intersector::MollerTrumbore)
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, same, testTriangleMollerTrumbore);
+    else
+        leafWith(box, terminated, rayEnd, triBegin, triEnd, same, testTriangle);
+}
+
+template <typename PrepareRay, typename TestTriangle>
+[[gnu::flatten]] void DacrtTraversal::leafWith(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
+                                               std::uint32_t triBegin, std::uint32_t triEnd, PrepareRay prepare,
+                                               TestTriangle test) {
+    for (std::uint32_t k = terminated; k < rayEnd; ++k) {
+        const std::uint32_t rayId = rayIds_[k];
+        const Ray& ray = rays_[rayId];
+        const auto& prepared = prepare(ray);
+        Hit best = hits_[rayId];
+        for (std::uint32_t j = triBegin; j < triEnd; ++j) {
+            const std::uint32_t prim = triIds_[j];
+            test(prepared, triangles_[prim], prim, best);
+        }
+        hits_[rayId] = best;
+    }
+    endRaysHitInBox(box, terminated, rayEnd);
+}
+
+void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
+                              std::uint32_t triBegin, std::uint32_t triEnd) {
+    for (std::uint32_t j = triBegin; j < triEnd; j += simd::kLeafBatch) {
+        simd::gatherLeafTriangles(triangles_, triIds_ + j, std::min(triEnd - j, simd::kLeafBatch), batch_);
+        simd::intersectBatch(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_);
+    }
+    endRaysHitInBox(box, terminated, rayEnd);
+}
+
+void DacrtTraversal::endRaysHitInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd) {
+    for (std::uint32_t k = terminated; k < rayEnd; ++k) {
+        const std::uint32_t rayId = rayIds_[k];
+        if (hits_[rayId].prim != kMissPrim &&
+            (anyHit_ || shared::hitEndsInBox(rays_[rayId], box.lo, box.hi, hits_[rayId].t))) {
+            std::swap(rayIds_[k], rayIds_[terminated]);
+            ++terminated;
+        }
+    }
+}
+
+void testTriangleMollerTrumbore(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
+    const shared::TriangleHit h = intersectMollerTrumbore(ray, tri.v0, tri.v1, tri.v2, tri.cullBackFace != 0u);
+    if (h.hit && h.t > ray.tmin && shared::hitPrecedes(h.t, prim, best.t, best.prim)) best = Hit{h.t, prim, h.u, h.v};
+}
+
+void testTriangleF64(const RayF64& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
+    // The float64 hit is rounded to float32 for the tie rule and the result: hits closer than
+    // half a float32 ulp in depth become ties (lowest id), which the benchmark counts as near ties.
+    const TriangleHitF64 h = intersectWatertightF64(ray, tri.v0, tri.v1, tri.v2, tri.cullBackFace != 0u);
+    if (!h.hit || !(h.t > ray.tmin)) return;
+    const float t = float(h.t);
+    if (shared::hitPrecedes(t, prim, best.t, best.prim)) best = Hit{t, prim, float(h.u), float(h.v)};
+}
+
+}  // namespace dacrt

@@ -1,0 +1,171 @@
+#pragma once
+// Sequential divide-and-conquer ray tracing (Mora 2011) over in-place id arrays: the
+// building block of both the cpu-seq backend and every work item of the parallel scheme.
+#include <cstdint>
+#include <vector>
+
+#include "cpu/predicates.hpp"
+#include "cpu/frame_geometry.hpp"
+#include "cpu/memory_plan.hpp"
+#include "cpu/simd_kernels.hpp"
+#include "cpu/options.hpp"
+#include "cpu/trace_result.hpp"
+
+namespace dacrt {
+
+// Which live rays a work item of the parallel scheme may finish, because no later work item
+// can change their result: along `axis`, rays that do not move (direction 0, after Step 1),
+// or rays moving `direction` that cannot reach the region traced now before their best hit
+// (regions are consecutive slabs, so they cannot reach any further one either). The gpu
+// kernel applies the same rule (kKeepStill, kKeepStuckHigh, kKeepStuckLow).
+struct RetireRule {
+    int axis = -1;      // -1: retire nothing
+    int direction = 0;  // 0: rays with dir[axis] == 0; +1 / -1: non-crossing rays moving that way
+};
+
+// Ids a traversal's stable partitions park the rejected ids in: at least as many as the
+// longest ray or triangle id range it is given.
+std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange);
+
+// A packet: the live rays of one 8x8 pixel tile, and bounds of their direction reciprocals
+// per axis. Rays that share their start compute (lo - origin) * invDir with the same first
+// factor, and rounding is monotone, so the packet's four corner products bound every ray's
+// rounded slab values: a packet the bounds reject holds no ray the ray filter would keep.
+// An axis where some ray has invDir 0 (the filter's branch) is left unbounded.
+struct RayPacket {
+    std::uint32_t begin = 0, end = 0;  // its rays: packetRays[begin, end)
+    glm::vec3 invLo{0.0f}, invHi{0.0f};
+    std::uint32_t unboundedAxes = 0;   // bit per axis
+};
+constexpr std::uint32_t kPacketTile = 8;
+
+// Packets' working arrays, one set per worker: rays grouped by tile, the rays of a node's
+// packets when it goes on ray by ray, the packets and their ids (partitioned like ray ids),
+// and per-ray "finished" flags shared by all workers (each ray belongs to one work item).
+struct PacketBuffers {
+    std::uint32_t* packetRays = nullptr;  // partitionScratchIds ids
+    std::uint32_t* flushRays = nullptr;   // partitionScratchIds ids
+    RayPacket* packets = nullptr;         // packetTiles()
+    std::uint32_t* packetIds = nullptr;   // packetTiles()
+    std::uint32_t* tileCounts = nullptr;  // packetTiles() + 1
+    std::uint8_t* rayDone = nullptr;      // one per ray of the frame, zeroed
+};
+// The packet filter: false only where shared::rayMayCrossCell(ray, cell, tmax) is false for
+// every ray of p (origin and tmin: the rays' shared start).
+bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin, const Box& cell);
+// Whether a traversal of these (resolved) options on this frame runs the SIMD kernels: the
+// default tests, and counts whose ids fit the kernels' 32-bit gather offsets.
+bool usesSimd(const FrameGeometry& geometry, const DacrtOptions& options);
+// Tiles of the frame's image, 0 when the frame has no packets.
+std::uint64_t packetTiles(const FrameGeometry& geometry);
+// Whether a traversal of these options on this frame uses packets.
+bool usesPackets(const FrameGeometry& geometry, const DacrtOptions& options);
+// The memory one worker's packet buffers take (0 without packets), and the frame's flags.
+void planPacketBuffers(const FrameGeometry& geometry, const DacrtOptions& options, std::uint64_t scratchIds,
+                       unsigned workers, MemoryPlan& plan);
+
+// Owns what planPacketBuffers planned.
+struct PacketStorage {
+    std::vector<std::uint32_t> packetRays, flushRays, packetIds, tileCounts;
+    std::vector<RayPacket> packets;
+    std::vector<std::uint8_t> rayDone;
+    std::uint64_t scratchIds = 0, tiles = 0;
+    PacketStorage(const FrameGeometry& geometry, const DacrtOptions& options, std::uint64_t scratchIds, unsigned workers);
+    PacketBuffers forWorker(unsigned worker);
+};
+
+// The arrays a traversal permutes and updates. The last two serve the SIMD path of the
+// default options (without scratch the scalar path runs): scratch holds partitionScratchIds
+// of the ranges traced.
+struct TraversalBuffers {
+    Hit* hits = nullptr;
+    std::uint32_t* rayIds = nullptr;
+    std::uint32_t* triIds = nullptr;
+    std::uint32_t* scratch = nullptr;
+    PacketBuffers packets;  // used when usesPackets()
+};
+
+class DacrtTraversal {
+public:
+    DacrtTraversal(const FrameGeometry& geometry, const DacrtOptions& options, const TraversalBuffers& buffers,
+                   Counters& counters);
+
+    // Traces the live rays rayIds[terminated, rayEnd) against triIds[triBegin, triEnd)
+    // inside box. Rays whose final hit is found are swapped to position `terminated`, which
+    // advances past them; the others keep their best hit so far (it bounds later work).
+    // Returns the end of the rays that cross the box (the others are moved behind them).
+    // Rays that `retire` selects are finished too (moved before `terminated`).
+    std::uint32_t trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                        std::uint32_t triEnd, const RetireRule& retire = {});
+
+private:
+    template <typename FilterItems, typename Descend>
+    bool splitNode(const Box& box, const std::uint32_t& itemBegin, std::uint32_t itemEnd, std::uint32_t triBegin,
+                   std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool fewItems,
+                   FilterItems filterItems, Descend descend);
+    void node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+              std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
+    void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+              std::uint32_t triEnd);
+    std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);
+    // filterRays over the rays moving `moving` along axis (+1: up or not at all, -1: down, 0: all).
+    std::uint32_t filterRaysMoving(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving);
+    void tracePackets(const Box& box, std::uint32_t& terminated, std::uint32_t crossing, std::uint32_t triBegin,
+                      std::uint32_t triEnd);
+    void traceOctants(const Box& box, std::uint32_t& terminated, std::uint32_t crossing, std::uint32_t triBegin,
+                      std::uint32_t triEnd);
+    std::uint32_t buildPackets(std::uint32_t begin, std::uint32_t end);
+    void nodePackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,
+                     std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
+    std::uint32_t filterPackets(const Box& cell, std::uint32_t begin, std::uint32_t end);
+    void flushPackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,
+                      std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
+    void leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                  std::uint32_t triEnd);
+    void endRaysHitInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd);
+    template <typename PrepareRay, typename TestTriangle>
+    void leafWith(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                  std::uint32_t triEnd, PrepareRay prepare, TestTriangle test);
+    // cell is child widened by the filter margin; the Mora filter reads child itself. cell
+    // differs from the parent's widened cell in one face, on axis (the high face when child is
+    // the low one), and the SIMD path tests that face alone: never "no" where the full test
+    // says "maybe", and the same answer wherever the node's triangles overlap the node's
+    // widened cell, which the roots' do (scene bounds; region binning) and so every child's.
+    std::uint32_t filterTriangles(const Box& child, const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
+                                  bool lowChild);
+    float splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const;
+
+    const Ray* rays_;
+    const Triangle* triangles_;
+    const Bounds* triangleBounds_;
+    ChildOrder order_;
+    glm::vec3 orderPoint_;  // FrameGeometry::nearSide
+    bool anyHit_;           // HitQuery::Any: a ray ends at its first hit
+    float margin_;
+    DacrtOptions options_;
+    Hit* hits_;
+    std::uint32_t* rayIds_;
+    std::uint32_t* triIds_;
+    std::uint32_t* scratch_;
+    bool raysShareStart_;
+    bool simd_;
+    bool packets_;
+    PacketBuffers packet_;
+    std::uint32_t imageWidth_;
+    std::uint32_t tiles_;  // the default options (bounds filter, watertight float32 test) on SIMD kernels
+    simd::LeafTriangles batch_;
+    Counters& counters_;
+};
+
+// Tests one ray against one triangle and keeps the better hit under the tie rule.
+inline void testTriangle(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best) {
+    const shared::TriangleHit h = shared::intersectWatertight(ray, tri.v0, tri.v1, tri.v2, tri.cullBackFace != 0u);
+    if (h.hit && h.t > ray.tmin && shared::hitPrecedes(h.t, prim, best.t, best.prim)) best = Hit{h.t, prim, h.u, h.v};
+}
+
+// The leaf tests of the non-default options (docs/benchmarks.md prices them).
+void testTriangleMollerTrumbore(const Ray& ray, const Triangle& tri, std::uint32_t prim, Hit& best);
+struct RayF64;
+void testTriangleF64(const RayF64& ray, const Triangle& tri, std::uint32_t prim, Hit& best);
+
+}  // namespace dacrt

@@ -1,0 +1,164 @@
+#include "cpu/triangle_skips.hpp"
+
+#include "cpu/simd_kernels.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dacrt {
+namespace {
+
+constexpr double kFloatUnit = 0x1p-24;  // u: float32's unit roundoff
+
+// 2^-12 of the triangle's distance: far beyond how far from a triangle the watertight test
+// can place a hit (a few units in the last place of that distance, docs/correctness.md).
+constexpr double kFrustumSlack = 0x1p-12;
+
+// facesAwayFrom's bound: side / R^2 > kFacingL L + kFacingR R.
+constexpr double kFacingL = 480.0 * kFloatUnit, kFacingR = 200.0 * kFloatUnit * kFloatUnit;
+
+enum class Verdict : std::uint8_t { Traced, BackFacing, OutsideFrustum };
+
+}  // namespace
+
+bool facesAwayFrom(const Triangle& t, const glm::dvec3& origin) {
+    const glm::dvec3 p0(t.v0), p1(t.v1), p2(t.v2);
+    const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0, e3 = p2 - p1;
+    const glm::dvec3 a = p0 - origin, b = p1 - origin, c = p2 - origin;
+    const double side = glm::dot(glm::cross(e1, e2), a);  // > 0: the origin sees the back
+    if (!(side > 0.0)) return false;
+    // With R the largest distance from the origin to a vertex and L the longest edge, the
+    // test's determinant for a ray from the origin that it accepts is at least side / R in
+    // magnitude (exact arithmetic) and carries a rounding error below
+    // 96 u L R + 72 u L^2 + 100 u^2 R^2 (docs/correctness.md, "Skips"); its sign is the exact
+    // one, "back", where side / R^2 > 240 u L + 100 u^2 R (L <= 2R), required twice over.
+    const double r2 = std::max({glm::dot(a, a), glm::dot(b, b), glm::dot(c, c)});
+    const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
+    return side / r2 > kFacingL * std::sqrt(l2) + kFacingR * std::sqrt(r2);
+}
+
+bool outsideFrustum(const Triangle& t, const ViewFrustum& f) {
+    const glm::dvec3 p[3] = {glm::dvec3(t.v0) - f.apex, glm::dvec3(t.v1) - f.apex, glm::dvec3(t.v2) - f.apex};
+    // Outside a plane by more than kFrustumSlack R, R the largest vertex distance, in squares.
+    const double r2 = std::max({glm::dot(p[0], p[0]), glm::dot(p[1], p[1]), glm::dot(p[2], p[2])});
+    const double slack2 = kFrustumSlack * kFrustumSlack * r2;
+    auto beyond = [&](const glm::dvec3& n, const glm::dvec3& v) {
+        const double d = glm::dot(n, v);
+        return d < 0.0 && d * d > slack2;
+    };
+    for (const glm::dvec3& n : f.inward)
+        if (beyond(n, p[0]) && beyond(n, p[1]) && beyond(n, p[2])) return true;
+    return false;
+}
+
+namespace {
+
+// Whether the whole box lies inside the frustum with room to spare: then no triangle in it is
+// outside, and the per-triangle test is skipped.
+bool frustumHolds(const ViewFrustum& f, const Box& box) {
+    for (int k = 0; k < 8; ++k) {
+        const glm::dvec3 corner((k & 1) ? box.hi.x : box.lo.x, (k & 2) ? box.hi.y : box.lo.y, (k & 4) ? box.hi.z : box.lo.z);
+        const glm::dvec3 v = corner - f.apex;
+        for (const glm::dvec3& n : f.inward)
+            if (!(glm::dot(n, v) > 0.0)) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+TriangleSkips skipTriangles(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool) {
+    TriangleSkips s;
+    const std::vector<Triangle>& tris = *g.triangles;
+    const bool backFaces = switches.backFaces && g.raysShareStart;
+    const bool frustum = switches.frustum && g.frustum && g.raysShareStart && !frustumHolds(*g.frustum, g.sceneBox);
+    s.frustumTested = frustum;
+    if (!backFaces && !frustum) return s;  // not even counted: a frame with the skips off pays nothing
+
+    const glm::dvec3 origin(g.rayOrigin);
+    const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(64, tris.size() / 4096 + 1));
+    std::vector<Verdict> verdict(tris.size());
+    std::vector<std::uint64_t> kept(chunks, 0), away(chunks, 0), outside(chunks, 0), single(chunks, 0);
+    std::vector<Box> boxes(chunks);
+    auto range = [&](std::size_t c) {
+        return std::pair<std::size_t, std::size_t>(tris.size() * c / chunks, tris.size() * (c + 1) / chunks);
+    };
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        const auto [begin, end] = range(c);
+        // Counted locally: neighbouring chunks' counters share cache lines.
+        std::uint64_t keptHere = 0, awayHere = 0, outsideHere = 0, singleHere = 0;
+        Box box;
+        // The facing of the chunk's triangles in SIMD lanes first; facesAwayFrom where they
+        // cannot tell.
+        std::vector<std::uint8_t> facing(end - begin, backFaces ? simd::kUndecided : simd::kKeep);
+        if (backFaces && end - begin <= simd::kMaxTriangles)
+            simd::classifyFacing(tris.data() + begin, std::uint32_t(end - begin), g.rayOrigin, facing.data());
+        for (std::size_t i = begin; i < end; ++i) {
+            const Triangle& t = tris[i];
+            Verdict v = Verdict::Traced;
+            singleHere += t.cullBackFace != 0u;
+            const std::uint8_t f = facing[i - begin];
+            if (f == simd::kDrop || (f == simd::kUndecided && t.cullBackFace && facesAwayFrom(t, origin)))
+                v = Verdict::BackFacing, ++awayHere;
+            else if (frustum && outsideFrustum(t, *g.frustum))
+                v = Verdict::OutsideFrustum, ++outsideHere;
+            else {
+                ++keptHere;
+                box.extend(t.v0);  // the triangle's bounds, without reading them
+                box.extend(t.v1);
+                box.extend(t.v2);
+            }
+            verdict[i] = v;
+        }
+        kept[c] = keptHere, away[c] = awayHere, outside[c] = outsideHere, single[c] = singleHere;
+        boxes[c] = box;
+    });
+    std::vector<std::uint64_t> offset(chunks, 0);
+    std::uint64_t total = 0;
+    for (std::size_t c = 0; c < chunks; ++c) {
+        offset[c] = total;
+        total += kept[c];
+        s.backFacing += away[c];
+        s.outsideFrustum += outside[c];
+        s.singleSided += single[c];
+        if (!boxes[c].empty()) s.tracedBox.extend(boxes[c].lo), s.tracedBox.extend(boxes[c].hi);
+    }
+    s.applied = true;
+    s.traced.resize(total);
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        const auto [begin, end] = range(c);
+        std::uint64_t k = offset[c];
+        for (std::size_t i = begin; i < end; ++i)
+            if (verdict[i] == Verdict::Traced) s.traced[k++] = std::uint32_t(i);
+    });
+    return s;
+}
+
+FrameGeometry withSkips(const FrameGeometry& g, const TriangleSkips& skips) {
+    if (!skips.applied || skips.traced.empty()) return g;
+    FrameGeometry r = g;
+    r.tracedTriangles = &skips.traced;
+    r.sceneBox = skips.tracedBox;
+    r.margin = filterMargin(r.sceneBox, r.farthestOrigin);
+    return r;
+}
+
+void planSkips(const FrameGeometry& g, const SkipSwitches& switches, const TriangleSkips& skips, MemoryPlan& plan) {
+    plan.addWork("triangles", g.triangles->size(), "after the loader dropped those with no area");
+    if (skips.applied) plan.addWork("single-sided triangles", skips.singleSided, "back faces culled (--cull)");
+    auto reason = [&](bool on, bool possible, const char* needs) {
+        return std::string(!on ? "skip off (--no-skip)" : !possible ? needs : "");
+    };
+    plan.addWork("skipped: back-facing", skips.backFacing,
+                 skips.applied && switches.backFaces && g.raysShareStart
+                     ? "single-sided, facing away from the rays' shared origin"
+                     : reason(switches.backFaces, g.raysShareStart && skips.singleSided, "needs rays with one origin and single-sided triangles"));
+    plan.addWork("skipped: outside the view frustum", skips.outsideFrustum,
+                 skips.frustumTested ? "no primary ray of the camera can reach them"
+                 : switches.frustum && g.frustum ? "none tested: the scene box lies inside the view"
+                                                 : reason(switches.frustum, bool(g.frustum), "needs a pinhole camera's primary rays (an orthographic view has no apex)"));
+    plan.addWork("triangles traced", skips.applied ? skips.traced.size() : g.triangles->size());
+    plan.addWork("rays", g.rays->size());
+}
+
+}  // namespace dacrt

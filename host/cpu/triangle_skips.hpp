@@ -1,0 +1,45 @@
+#pragma once
+// The triangle skips of a frame, decided before anything is traced: triangles that no ray of
+// the frame can hit, dropped so that no backend divides, filters or tests them. Each is exact
+// by construction (docs/correctness.md, "Skips"): a triangle is dropped only where the
+// intersection test provably never reports it for these rays.
+#include <cstdint>
+#include <vector>
+
+#include "core/thread_pool.hpp"
+#include "cpu/frame_geometry.hpp"
+#include "cpu/memory_plan.hpp"
+#include "cpu/options.hpp"
+
+namespace dacrt {
+
+struct TriangleSkips {
+    bool applied = false;                // false: nothing dropped, every triangle traced
+    std::vector<std::uint32_t> traced;   // the kept ids, ascending (when applied)
+    Box tracedBox;                       // their exact bounds (when applied)
+    std::uint64_t singleSided = 0;       // triangles whose back face is culled (counted when applied)
+    std::uint64_t backFacing = 0;        // dropped: single-sided, facing away from the shared origin
+    std::uint64_t outsideFrustum = 0;    // dropped: outside the view frustum (and not back-facing)
+    bool frustumTested = false;          // false where the scene box lies inside the view
+};
+
+// Whether a single-sided triangle faces away from `origin` by a margin that no rounding of the
+// watertight test (or Moller-Trumbore's, or float64's) can overcome: every ray from origin
+// then meets its back, and the face rule rejects it.
+bool facesAwayFrom(const Triangle& triangle, const glm::dvec3& origin);
+// Whether the triangle lies outside one side plane of the frustum by more than the test's
+// rounding can bridge: no ray inside the frustum can hit it.
+bool outsideFrustum(const Triangle& triangle, const ViewFrustum& frustum);
+
+// The skips `switches` allow for frame g (back faces need rays that share their start; the
+// frustum needs g.frustum), on every thread of pool.
+TriangleSkips skipTriangles(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool);
+
+// g restricted to the kept triangles: tracedTriangles, the kept triangles' box and its margin.
+// skips must outlive the result.
+FrameGeometry withSkips(const FrameGeometry& g, const TriangleSkips& skips);
+
+// The skips' lines of the work plan.
+void planSkips(const FrameGeometry& g, const SkipSwitches& switches, const TriangleSkips& skips, MemoryPlan& plan);
+
+}  // namespace dacrt

@@ -1,0 +1,205 @@
+#include "library/backend_dispatcher.hpp"
+
+#include <algorithm>
+#include <ostream>
+#include <thread>
+
+#include "core/errors.hpp"
+#include "core/timing.hpp"
+#include "cpu/cpu_tracers.hpp"
+#include "cpu/triangle_skips.hpp"
+#include "peers/embree_tracer.hpp"
+
+namespace dacrt {
+
+namespace {
+
+// The options given, as the command line names them, that `takes` says the backend ignores.
+std::vector<std::string> ignoredOptions(const BackendRequest& r) {
+    const Backend b = r.trace.backend;
+    const bool dacrt = b == Backend::CpuSeq || b == Backend::Cpu || b == Backend::Gpu;
+    const bool parallel = b == Backend::Cpu || b == Backend::Gpu;
+    const DacrtOptions defaults;
+    const DacrtOptions& d = r.trace.dacrt;
+    std::vector<std::string> out;
+    auto given = [&](bool set, bool taken, const char* flag) {
+        if (set && !taken) out.push_back(flag);
+    };
+    given(r.trace.regions != 0, parallel, "--regions");
+    given(r.trace.axis != DivisionAxis::Best, parallel, "--axis");
+    given(r.trace.threads > 1, b != Backend::CpuSeq && b != Backend::RayQuery, "--threads");
+    given(d.rayLimit != 0, dacrt, "--ray-limit");
+    given(d.triLimit != 0, dacrt, "--tri-limit");
+    given(d.split != defaults.split, b == Backend::CpuSeq || b == Backend::Cpu, "--split");
+    given(d.intersector != defaults.intersector, b == Backend::CpuSeq || b == Backend::Cpu, "--intersector");
+    given(d.triangleFilter != defaults.triangleFilter, b == Backend::CpuSeq || b == Backend::Cpu, "--triangle-filter");
+    given(d.precision != defaults.precision, b == Backend::CpuSeq || b == Backend::Cpu, "--precision");
+    given(d.packets != defaults.packets, b == Backend::CpuSeq || b == Backend::Cpu, "--packets");
+    given(d.packetFlush != 0, b == Backend::CpuSeq || b == Backend::Cpu, "--packet-flush");
+    given(r.gpuTuning.workgroupSize != 0, b == Backend::Gpu, "--workgroup-size");
+    given(r.gpuTuning.rayGroups != 0, b == Backend::Gpu, "--ray-groups");
+    given(!(r.trace.skips == SkipSwitches{}), !isPeer(b), "--no-skip");
+    given(!r.embree.robust, b == Backend::Embree, "--embree-fast");
+    given(!r.embree.packets, b == Backend::Embree, "--embree-single-rays");
+    return out;
+}
+
+// Whether any of `backends` opens the Vulkan device.
+bool usesVulkan(const std::vector<Backend>& backends) {
+    return std::any_of(backends.begin(), backends.end(), runsOnVulkan);
+}
+
+}  // namespace
+
+void checkBackendRequest(const BackendRequest& r) {
+    const std::vector<std::string> ignored = ignoredOptions(r);
+    if (!ignored.empty()) {
+        std::string list;
+        for (std::size_t i = 0; i < ignored.size(); ++i)
+            list += (i == 0 ? "" : i + 1 == ignored.size() ? " and " : ", ") + ignored[i];
+        throw InputError(list + (ignored.size() == 1 ? " is not an option of --backend " : " are not options of --backend ") +
+                         toString(r.trace.backend) + " (see dacrt render --help: each option names its backends)");
+    }
+    if (r.trace.backend == Backend::Gpu) checkGpuOptions(r.trace);
+    if (r.trace.backend != Backend::Gpu && !isPeer(r.trace.backend)) checkCpuOptions(r.trace);
+}
+
+void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends) {
+    if (usesVulkan(backends)) return;
+    if (!devices.device.empty()) throw InputError("--device chooses the Vulkan device of the gpu and rayquery backends; neither runs here");
+    if (devices.validate) throw InputError("--validate runs the gpu and rayquery backends under the Vulkan validation layers; neither runs here");
+}
+
+BackendDispatcher::BackendDispatcher(const DeviceChoice& devices, const std::vector<Backend>& backends)
+    : devices_(devices) {
+    if (usesVulkan(backends)) {
+        gpu_ = std::make_unique<gpu::Context>(gpu::ContextOptions{devices.device, devices.validate});
+        pipelines_ = std::make_unique<gpu::PipelineCache>(*gpu_);
+        resident_ = std::make_unique<gpu::ResidentTriangles>();
+    }
+}
+
+BackendDispatcher::~BackendDispatcher() = default;
+
+unsigned BackendDispatcher::threadsOf(const TraceOptions& options) {
+    if (options.backend == Backend::CpuSeq) return 1;
+    return options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+}
+
+ThreadPool& BackendDispatcher::pool(unsigned threads) {
+    std::unique_ptr<ThreadPool>& p = pools_[threads];
+    if (!p) p = std::make_unique<ThreadPool>(threads);
+    return *p;
+}
+
+TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const BackendRequest& request,
+                                     const PlanHook& onPlan, const ProgressHook& onProgress) {
+    checkBackendRequest(request);
+    passSource_.reset();  // a later traceSecondary must not find an earlier frame's buffers
+    ThreadPool& threadPool = pool(threadsOf(request.trace));
+    if (isPeer(request.trace.backend)) return traceOnBackend(geometry, request, onPlan, onProgress);
+
+    // dacrt's backends trace the triangles no skip dropped; the plan starts with the skips.
+    const auto start = Clock::now();
+    const TriangleSkips skips = skipTriangles(geometry, request.trace.skips, threadPool);
+    MemoryPlan skipPlan;
+    planSkips(geometry, request.trace.skips, skips, skipPlan);
+    const double skipMs = msSince(start);
+    auto withSkipLines = [&](TraceResult r) {
+        r.memory.work.insert(r.memory.work.begin(), skipPlan.work.begin(), skipPlan.work.end());
+        r.phaseMs.insert(r.phaseMs.begin(), {"skips", skipMs});
+        return r;
+    };
+    const PlanHook planWithSkips = withWorkLines(onPlan, skipPlan.work, true);
+    if (skips.applied && skips.traced.empty()) {
+        // No triangle can be hit: every ray misses, with nothing to divide or upload.
+        TraceResult r;
+        r.threads = threadPool.size();
+        r.memory.add("hits", std::uint64_t(geometry.rays->size()) * sizeof(Hit));
+        if (!planWithSkips || planWithSkips(r.memory)) {
+            r.hits.reserve(geometry.rays->size());
+            for (const Ray& ray : *geometry.rays) r.hits.push_back(missHit(ray));
+            r.counters.raysCulled = geometry.rays->size();
+        }
+        return withSkipLines(std::move(r));
+    }
+    const FrameGeometry traced = withSkips(geometry, skips);
+    return withSkipLines(traceOnBackend(traced, request, planWithSkips, onProgress));
+}
+
+TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request,
+                                              const PlanHook& onPlan, const ProgressHook& onProgress) {
+    const unsigned threads = threadsOf(request.trace);
+    ThreadPool& threadPool = pool(threads);
+    switch (request.trace.backend) {
+        case Backend::Gpu:
+            if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
+            return traceGpu(geometry, request.trace, request.gpuTuning, *gpu_, threadPool, onPlan, pipelines_.get(),
+                            resident_.get(), request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
+        case Backend::Embree:
+            // Embree allocates its BVH itself: there is no plan to show or check.
+        {
+            // A single frame's trace: the BVH is built for it (the bench times refit and static
+            // scenes across frames).
+            EmbreeOptions embree = request.embree;
+            embree.threads = threads;
+            return traceEmbree(geometry, embree, threadPool);
+        }
+        case Backend::RayQuery:
+            if (!gpu_) throw InternalError("the rayquery backend was asked for a trace without a device being opened");
+            return traceRayQuery(geometry, *gpu_, *pipelines_, onPlan);
+        case Backend::Brute:
+        case Backend::CpuSeq:
+        case Backend::Cpu: return traceCpu(geometry, request.trace, threadPool, onPlan, onProgress);
+    }
+    throw InternalError("unknown backend");
+}
+
+BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeometry& primary,
+                                                               const std::vector<Hit>& primaryHits,
+                                                               const SecondaryPass& pass, const BackendRequest& request,
+                                                               const PlanHook& onPlan) {
+    checkBackendRequest(request);
+    ThreadPool& threadPool = pool(threadsOf(request.trace));
+    PassTrace out;
+    // On gpu the rays are made where the primary pass left its hits; a frame the skips left
+    // empty (no triangle: every primary ray misses) kept nothing there, and makes no ray.
+    if (request.trace.backend == Backend::Gpu && passSource_) {
+        out.result = traceGpuSecondary(*passSource_, primary, pass, request.trace, request.gpuTuning, *gpu_, threadPool,
+                                       onPlan, pipelines_.get());
+        for (const Hit& h : out.result.hits) out.rays += h.prim != kNotTracedPrim;
+        return out;
+    }
+    // The slot arrays are allocated before the tracer plans: checked first, as its plan is.
+    const std::uint64_t slots = secondarySlots(pass, primary.rays->size());
+    MemoryPlan making;
+    making.add("secondary rays and their slots (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
+    making.add("hits per slot", slots * sizeof(Hit));
+    if (onPlan && !onPlan(making)) return out;
+    const auto start = Clock::now();
+    const SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
+    const double makeMs = msSince(start);
+    out.rays = rays.rays.size();
+    if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
+        out.result.hits = hitsPerSlot(rays, {});
+    } else {
+        FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays.rays, primary.sceneBox);
+        g.trianglesVersion = primary.trianglesVersion;
+        out.result = traceOnBackend(g, request, onPlan, {});
+        if (out.result.hits.empty()) return out;  // stopped at the plan
+        out.result.hits = hitsPerSlot(rays, out.result.hits);
+    }
+    out.result.phaseMs.insert(out.result.phaseMs.begin(), {"make rays", makeMs});
+    return out;
+}
+
+std::uint32_t BackendDispatcher::validationErrors() const { return gpu_ ? gpu_->validationErrors() : 0; }
+
+bool BackendDispatcher::reportValidationErrors(std::ostream& err) const {
+    if (!gpu_ || !devices_.validate || gpu_->validationErrors() == 0) return false;
+    for (const std::string& m : gpu_->validationMessages()) err << "dacrt: validation " << m << "\n";
+    err << "dacrt: error: " << gpu_->validationErrors() << " Vulkan validation errors\n";
+    return true;
+}
+
+}  // namespace dacrt

@@ -1,0 +1,100 @@
+#pragma once
+// The one place where a backend choice becomes a trace, for render, bench and stress: the
+// request checked against the backend, the devices and pipelines opened once per process,
+// the frame traced, and the validation epilogue with its exit code.
+#include <cstdint>
+#include <iosfwd>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/thread_pool.hpp"
+#include "cpu/cpu_tracers.hpp"
+#include "cpu/frame_geometry.hpp"
+#include "cpu/memory_plan.hpp"
+#include "cpu/options.hpp"
+#include "cpu/secondary_rays.hpp"
+#include "cpu/trace_result.hpp"
+#include "gpu/context.hpp"
+#include "gpu/gpu_tracer.hpp"
+#include "gpu/pipeline_cache.hpp"
+#include "peers/rayquery_tracer.hpp"
+#include "peers/embree_tracer.hpp"
+
+namespace dacrt {
+
+struct BackendRequest {
+    TraceOptions trace;
+    // gpu: keep the frame's rays, hits and triangles on the device for traceSecondary.
+    bool keepForPasses = false;
+    GpuTuning gpuTuning;        // gpu only
+    EmbreeOptions embree;       // embree only (threads: the request's)
+    RayQueryBuild rayQueryBuild = RayQueryBuild::Dynamic;  // rayquery only (bench: persistent scenes)
+};
+
+// Throws InputError, naming the command-line options, when the request gives a backend an
+// option it does not take.
+void checkBackendRequest(const BackendRequest& request);
+
+struct DeviceChoice {
+    std::string device;     // gpu: index or part of the name; empty: the best device
+    bool validate = false;  // gpu: Khronos validation layers, errors counted
+};
+
+// Throws InputError when --device or --validate is given but no gpu backend runs.
+void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends);
+
+class BackendDispatcher {
+public:
+    // Opens the Vulkan device now when `backends` includes gpu or rayquery, so that a missing or
+    // unmatched device fails before any long work.
+    BackendDispatcher(const DeviceChoice& devices, const std::vector<Backend>& backends);
+    ~BackendDispatcher();
+
+    // Threads a request runs on: 1 for cpu-seq, else its own count or every core.
+    static unsigned threadsOf(const TraceOptions& options);
+    ThreadPool& pool(unsigned threads);
+    gpu::Context* gpuContext() { return gpu_.get(); }  // null unless gpu or rayquery was asked for
+    gpu::PipelineCache* pipelines() { return pipelines_.get(); }
+    const gpu::Context* gpuContext() const { return gpu_.get(); }
+
+    // Checks the request (checkBackendRequest), then traces one frame on its backend: for
+    // dacrt's backends, after the triangle skips the request allows (triangle_skips.hpp),
+    // whose counts open the plan's work lines.
+    // onProgress is called by the backends that report progress (brute force).
+    TraceResult trace(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan = {},
+                      const ProgressHook& onProgress = {});
+
+    // A secondary pass of the frame the last trace() traced (with request.keepForPasses on
+    // gpu): its rays made from the primary hits (on the device for gpu, where the primary pass
+    // left them; on the host for the others, and for gpu where it kept nothing) and traced for
+    // any hit by the same backend, over
+    // every triangle (no skips: a shadow may fall from anywhere). `primary` is the frame as
+    // given to trace(). Returns one hit per slot (hitsPerSlot) and the rays made.
+    struct PassTrace {
+        TraceResult result;
+        std::uint64_t rays = 0;
+    };
+    PassTrace traceSecondary(const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const SecondaryPass& pass,
+                             const BackendRequest& request, const PlanHook& onPlan = {});
+
+    std::uint32_t validationErrors() const;
+    // Under --validate: prints every validation message; true when there were errors (the
+    // command then fails with its validation exit code).
+    bool reportValidationErrors(std::ostream& err) const;
+
+private:
+    // The trace itself, on the triangles the skips left (dacrt's backends) or on every one.
+    TraceResult traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan,
+                               const ProgressHook& onProgress);
+
+    DeviceChoice devices_;
+    std::map<unsigned, std::unique_ptr<ThreadPool>> pools_;
+    std::unique_ptr<gpu::Context> gpu_;
+    std::unique_ptr<gpu::PipelineCache> pipelines_;
+    std::unique_ptr<gpu::ResidentTriangles> resident_;  // gpu: the triangles kept on the device
+    GpuPassSourcePtr passSource_;                       // gpu: the last frame kept for its secondary passes
+};
+
+}  // namespace dacrt

@@ -1,0 +1,148 @@
+#include "library/frame_passes.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+#include "core/lights.hpp"
+#include "core/timing.hpp"
+
+namespace dacrt {
+
+void checkPassOptions(const PassOptions& o) {
+    for (const std::string& light : o.lights) parseLightSpec(light);
+    if (o.occlusionSamples > 1024) throw InputError("--ao " + std::to_string(o.occlusionSamples) + ": at most 1024 rays per hit");
+    if (!std::isfinite(o.occlusionDistance) || o.occlusionDistance < 0.0 || o.occlusionDistance > kMaxCoordinate ||
+        (o.occlusionDistance > 0.0 && o.occlusionDistance < 1e-30))
+        throw InputError("--ao-distance must be a length from 1e-30 to " + std::to_string(kMaxCoordinate) +
+                         " (0: a tenth of the scene's diagonal)");
+}
+
+float occlusionDistance(const PassOptions& o, const Box& box) {
+    if (o.occlusionDistance > 0.0) return float(o.occlusionDistance);
+    return float(0.1 * glm::length(glm::dvec3(box.extent())));
+}
+
+std::vector<SecondaryPass> secondaryPasses(const std::vector<Light>& lights, const PassOptions& o, const Box& box,
+                                           std::uint32_t seed) {
+    std::vector<SecondaryPass> passes;
+    for (const Light& light : lights) {
+        SecondaryPass p;
+        p.name = "shadow: " + (light.name.empty() ? toString(light.type) + " light" : light.name);
+        p.kind = shared::kPassShadow;
+        p.light = shadowLightOf(light);
+        passes.push_back(p);
+    }
+    if (o.occlusionSamples > 0) {
+        SecondaryPass p;
+        p.name = "occlusion";
+        p.kind = shared::kPassOcclusion;
+        p.raysPerHit = o.occlusionSamples;
+        p.occlusionDistance = occlusionDistance(o, box);
+        p.sampleSeed = seed;
+        passes.push_back(p);
+    }
+    return passes;
+}
+
+namespace {
+
+// Samples of an occlusion pass per batch: all of them, but on a device whose storage buffers
+// cannot hold the pass's rays (lavapipe: 128 MiB, 2 million rays), as many as they can.
+std::uint32_t samplesPerBatch(const SecondaryPass& pass, std::uint64_t primaryRays, const BackendDispatcher& backends,
+                              const BackendRequest& request) {
+    if (request.trace.backend != Backend::Gpu || !backends.gpuContext() || primaryRays == 0) return pass.raysPerHit;
+    const std::uint64_t fit = backends.gpuContext()->info().maxStorageBufferRange / sizeof(Ray) / primaryRays;
+    return std::uint32_t(std::clamp<std::uint64_t>(fit, 1, pass.raysPerHit));
+}
+
+// A batch's result folded into the whole pass's: slots, rays, time and counters.
+void addBatch(TracedPass& whole, const SecondaryPass& batch, TracedPass&& part, std::uint64_t primaryRays) {
+    const std::uint32_t total = whole.pass.raysPerHit;
+    if (whole.result.hits.empty()) {
+        whole.result.hits.assign(primaryRays * total, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f});
+        whole.result.memory = part.result.memory;
+        whole.result.gpu = part.result.gpu;
+        whole.result.regions = part.result.regions;
+        whole.result.axis = part.result.axis;
+        whole.result.threads = part.result.threads;
+    } else if (whole.result.gpu && part.result.gpu) {
+        whole.result.gpu->dispatchMs.insert(whole.result.gpu->dispatchMs.end(), part.result.gpu->dispatchMs.begin(),
+                                            part.result.gpu->dispatchMs.end());
+        whole.result.gpu->dispatches += part.result.gpu->dispatches;
+    }
+    for (std::uint64_t i = 0; i < primaryRays; ++i)
+        for (std::uint32_t k = 0; k < batch.raysPerHit; ++k)
+            whole.result.hits[i * total + batch.firstSample + k] = part.result.hits[i * batch.raysPerHit + k];
+    whole.result.counters.add(part.result.counters);
+    whole.result.phaseMs.insert(whole.result.phaseMs.end(), part.result.phaseMs.begin(), part.result.phaseMs.end());
+    whole.rays += part.rays;
+    whole.ms += part.ms;
+}
+
+}  // namespace
+
+std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& passes, const FrameGeometry& primary,
+                                             const std::vector<Hit>& primaryHits, BackendDispatcher& backends,
+                                             const BackendRequest& request, const PlanHook& onPlan) {
+    std::vector<TracedPass> traced;
+    const std::uint64_t primaryRays = primary.rays->size();
+    for (const SecondaryPass& pass : passes) {
+        const std::uint32_t batch = samplesPerBatch(pass, primaryRays, backends, request);
+        TracedPass whole{pass, {}, 0, 0.0};
+        for (std::uint32_t first = 0; first < pass.raysPerHit; first += batch) {
+            SecondaryPass part = pass;
+            part.firstSample = first;
+            part.raysPerHit = std::min(batch, pass.raysPerHit - first);
+            part.samplesPerHit = pass.raysPerHit;
+            const auto start = Clock::now();
+            BackendDispatcher::PassTrace t = backends.traceSecondary(primary, primaryHits, part, request, onPlan);
+            if (t.result.hits.empty()) return traced;  // stopped at the plan
+            if (batch == pass.raysPerHit) {
+                whole = TracedPass{pass, std::move(t.result), t.rays, msSince(start)};
+                break;
+            }
+            addBatch(whole, part, TracedPass{part, std::move(t.result), t.rays, msSince(start)}, primaryRays);
+        }
+        if (batch < pass.raysPerHit)
+            whole.result.memory.addWork("occlusion batches", (pass.raysPerHit + batch - 1) / batch,
+                                        std::to_string(batch) + " samples per hit each: the device's storage buffers hold no more rays");
+        traced.push_back(std::move(whole));
+    }
+    return traced;
+}
+
+Lighting lightingOf(const std::vector<Light>& lights, const std::vector<TracedPass>& traced) {
+    Lighting l;
+    std::size_t shadow = 0;
+    for (const TracedPass& t : traced) {
+        if (t.pass.kind == shared::kPassOcclusion) {
+            l.occlusion = &t.result.hits;
+            l.occlusionSamples = t.pass.raysPerHit;
+        } else {
+            l.lights.push_back(&lights.at(shadow++));
+            l.shadows.push_back(&t.result.hits);
+        }
+    }
+    return l;
+}
+
+MemoryPlan secondaryPassBound(const SecondaryPass& pass, std::uint64_t primaryRays, Backend backend) {
+    const std::uint64_t slots = secondarySlots(pass, primaryRays);
+    MemoryPlan plan;
+    plan.add("rays (at most)", slots * sizeof(Ray));
+    plan.add("hits (at most)", slots * sizeof(Hit));
+    plan.add("hits per slot", slots * sizeof(Hit));
+    if (backend == Backend::Gpu) {
+        plan.add("device: ray ids and scratch", slots * 8);
+    } else if (backend == Backend::Cpu || backend == Backend::CpuSeq) {
+        plan.add("ray ids and binning (at most)", slots * 8);
+        plan.add("partition scratch (at most, per thread)", slots * 4);
+    }
+    plan.addWork("rays (at most)", slots,
+                 std::to_string(primaryRays) + " primary rays x " + std::to_string(pass.raysPerHit) +
+                     "; none where the primary ray misses or the surface cannot send one");
+    return plan;
+}
+
+}  // namespace dacrt

@@ -1,0 +1,51 @@
+#pragma once
+// A frame's secondary passes: which the lights and --ao ask for, traced after the primary
+// pass by the same backend, and the lighting the shade stage takes from them.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "library/backend_dispatcher.hpp"
+#include "core/shading.hpp"
+#include "cpu/secondary_rays.hpp"
+
+namespace dacrt {
+
+// What the command line asks of the secondary passes.
+struct PassOptions {
+    std::vector<std::string> lights;  // --light values; empty: the scene's lights, else a key light
+    std::uint32_t occlusionSamples = 0;  // --ao
+    double occlusionDistance = 0.0;      // --ao-distance; 0: a tenth of the scene box's diagonal
+};
+
+// Throws InputError on a bad --light, --ao or --ao-distance, before anything is loaded.
+void checkPassOptions(const PassOptions& options);
+
+// The occlusion rays' length: --ao-distance, or a tenth of the scene box's diagonal.
+float occlusionDistance(const PassOptions& options, const Box& sceneBox);
+
+// One shadow pass per light, then the occlusion pass (with --ao), in the order their results
+// are shaded. seed picks the occlusion sample sequence (an antialiasing sample's own).
+std::vector<SecondaryPass> secondaryPasses(const std::vector<Light>& lights, const PassOptions& options,
+                                           const Box& sceneBox, std::uint32_t seed);
+
+struct TracedPass {
+    SecondaryPass pass;
+    TraceResult result;        // hits: one per slot
+    std::uint64_t rays = 0;    // rays made
+    double ms = 0.0;           // making and tracing them
+};
+
+// Each pass in turn on the backend that traced `primary` (the dispatcher's last frame).
+std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& passes, const FrameGeometry& primary,
+                                             const std::vector<Hit>& primaryHits, BackendDispatcher& backends,
+                                             const BackendRequest& request, const PlanHook& onPlan);
+
+// The shade stage's view of the traced passes (which must outlive it).
+Lighting lightingOf(const std::vector<Light>& lights, const std::vector<TracedPass>& traced);
+
+// What a pass will allocate at most, from the counts alone (--plan: the primary hits that
+// decide how many rays each pass makes are not traced then).
+MemoryPlan secondaryPassBound(const SecondaryPass& pass, std::uint64_t primaryRays, Backend backend);
+
+}  // namespace dacrt

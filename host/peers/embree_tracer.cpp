@@ -1,0 +1,433 @@
+#include "peers/embree_tracer.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
+
+#include "core/timing.hpp"
+
+namespace dacrt {
+
+namespace {
+
+// Large enough that the pool's hand-out of indices costs nothing next to the rays, small
+// enough that a frame of a few hundred thousand rays still balances over the threads.
+// Whole 16-wide packets, so that only a frame's last packet runs partly empty.
+constexpr std::size_t kRaysPerChunk = 4096;
+static_assert(kRaysPerChunk % 16 == 0);
+
+const char* errorName(RTCError code) {
+    switch (code) {
+        case RTC_ERROR_NONE: return "RTC_ERROR_NONE";
+        case RTC_ERROR_UNKNOWN: return "RTC_ERROR_UNKNOWN";
+        case RTC_ERROR_INVALID_ARGUMENT: return "RTC_ERROR_INVALID_ARGUMENT";
+        case RTC_ERROR_INVALID_OPERATION: return "RTC_ERROR_INVALID_OPERATION";
+        case RTC_ERROR_OUT_OF_MEMORY: return "RTC_ERROR_OUT_OF_MEMORY";
+        case RTC_ERROR_UNSUPPORTED_CPU: return "RTC_ERROR_UNSUPPORTED_CPU";
+        case RTC_ERROR_CANCELLED: return "RTC_ERROR_CANCELLED";
+    }
+    return "unknown RTCError";
+}
+
+struct GeometryReleaser {
+    void operator()(RTCGeometry geometry) const { rtcReleaseGeometry(geometry); }
+};
+using GeometryHandle = std::unique_ptr<RTCGeometryTy, GeometryReleaser>;
+
+// One Embree device per thread count for the whole process: a device is Embree's thread pool
+// and ISA dispatch, which a renderer creates once, so a dynamic scene's frame must not pay
+// for it. Deliberately never released: releasing it during static destruction could run
+// after TBB's own teardown.
+struct SharedDevice {
+    RTCDevice device = nullptr;
+    // Embree passes the error text only to the callback, and may call it from any thread
+    // that uses the device (the pool's workers during a trace, TBB's during a commit).
+    std::mutex messageMutex;
+    std::string lastMessage;
+
+    static void recordError(void* self, RTCError, const char* message) {
+        SharedDevice& d = *static_cast<SharedDevice*>(self);
+        std::lock_guard<std::mutex> lock(d.messageMutex);
+        d.lastMessage = message ? message : "";
+    }
+};
+
+SharedDevice& sharedDevice(unsigned threads) {
+    static std::mutex mutex;
+    static std::map<unsigned, SharedDevice*> devices;
+    std::lock_guard<std::mutex> lock(mutex);
+    SharedDevice*& slot = devices[threads];
+    if (!slot) {
+        const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
+        RTCDevice device = rtcNewDevice(config.c_str());
+        if (!device) {
+            // No device, so no callback to have received a message: only the code is known.
+            throw std::runtime_error(std::string("embree: rtcNewDevice: ") + errorName(rtcGetDeviceError(nullptr)) +
+                                     ": device creation failed (config \"" + config + "\")");
+        }
+        slot = new SharedDevice;
+        slot->device = device;
+        rtcSetDeviceErrorFunction(device, &SharedDevice::recordError, slot);
+    }
+    return *slot;
+}
+
+// The identity index buffer of n triangles stored as 3n consecutive vertices, made once per
+// count and shared by every scene of that count: a renderer keeps its topology's indices.
+const std::vector<std::uint32_t>& identityIndices(std::size_t triangles) {
+    static std::mutex mutex;
+    static std::map<std::size_t, std::vector<std::uint32_t>> cache;
+    std::lock_guard<std::mutex> lock(mutex);
+    std::vector<std::uint32_t>& v = cache[triangles];
+    if (v.size() != triangles * 3) {
+        v.resize(triangles * 3);
+        for (std::size_t i = 0; i < v.size(); ++i) v[i] = std::uint32_t(i);
+    }
+    return v;
+}
+
+// Flush-to-zero and denormals-are-zero for the calling thread while it lives, as Embree
+// recommends for speed; the previous mode comes back after (dacrt's tracers share the threads).
+class FlushDenormals {
+public:
+    FlushDenormals() : csr_(_mm_getcsr()) {
+        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    }
+    ~FlushDenormals() { _mm_setcsr(csr_); }
+
+private:
+    unsigned csr_;
+};
+
+RTCBuildQuality geometryQualityOf(EmbreeBuild build) {
+    switch (build) {
+        case EmbreeBuild::Dynamic: return RTC_BUILD_QUALITY_LOW;
+        case EmbreeBuild::Refit: return RTC_BUILD_QUALITY_REFIT;
+        case EmbreeBuild::Static: return RTC_BUILD_QUALITY_HIGH;
+    }
+    return RTC_BUILD_QUALITY_MEDIUM;
+}
+
+// dacrt's face rule (shaders/triangle_rules.glsl) as Embree 3 users apply it without a build
+// of their own (EMBREE_BACKFACE_CULLING is a compile-time option, off in Debian's): an
+// intersection and occluded filter that rejects the back faces of single-sided triangles. Called only for
+// candidate hits, so a frame pays for it per hit found, not per test.
+void rejectCulledBackFaces(const RTCFilterFunctionNArguments* args) {
+    const auto& triangles = *static_cast<const std::vector<Triangle>*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0) continue;
+        const Triangle& t = triangles[RTCHitN_primID(args->hit, args->N, i)];
+        if (!t.cullBackFace) continue;
+        const glm::dvec3 n = glm::cross(glm::dvec3(t.v1) - glm::dvec3(t.v0), glm::dvec3(t.v2) - glm::dvec3(t.v0));
+        const glm::dvec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                           RTCRayN_dir_z(args->ray, args->N, i));
+        if (glm::dot(n, d) >= 0.0) args->valid[i] = 0;
+    }
+}
+
+// Embree's end of a ray's segment: dacrt's whole ray (kNoHitT, finite only so that dacrt's
+// arithmetic stays finite) is Embree's unbounded one, so primary rays are traced as before.
+float segmentEnd(const Ray& ray) {
+    return ray.tmax == kNoHitT ? std::numeric_limits<float>::infinity() : ray.tmax;
+}
+
+// dacrt accepts only t > tmin while Embree's tnear is inclusive (t >= tnear). The two differ
+// only for a triangle through the point at exactly tmin, which for primary rays (tmin 0)
+// means a triangle through the eye, and for secondary rays (tmin 0, origins offset off their
+// surface) a triangle through the offset origin; that case is left to Embree rather than
+// nudging tnear, which would move every other answer too.
+RTCRay embreeRay(const Ray& ray) {
+    RTCRay r{};
+    r.org_x = ray.origin.x;
+    r.org_y = ray.origin.y;
+    r.org_z = ray.origin.z;
+    r.tnear = ray.tmin;
+    r.dir_x = ray.dir.x;
+    r.dir_y = ray.dir.y;
+    r.dir_z = ray.dir.z;
+    r.tfar = segmentEnd(ray);
+    r.mask = ~0u;
+    return r;
+}
+
+void setLane(RTCRay16& packet, int lane, const Ray& ray) {
+    const RTCRay r = embreeRay(ray);
+    packet.org_x[lane] = r.org_x;
+    packet.org_y[lane] = r.org_y;
+    packet.org_z[lane] = r.org_z;
+    packet.tnear[lane] = r.tnear;
+    packet.dir_x[lane] = r.dir_x;
+    packet.dir_y[lane] = r.dir_y;
+    packet.dir_z[lane] = r.dir_z;
+    packet.time[lane] = 0.0f;
+    packet.tfar[lane] = r.tfar;
+    packet.mask[lane] = r.mask;
+    packet.id[lane] = unsigned(lane);
+    packet.flags[lane] = 0;
+}
+
+Hit closestHitOf(const Ray& ray, float tfar, unsigned geomID, unsigned primID, float u, float v) {
+    if (geomID == RTC_INVALID_GEOMETRY_ID) return missHit(ray);
+    return Hit{tfar, primID, u, v};  // Embree's u and v weight v1 and v2, as dacrt's do
+}
+
+// rtcOccluded marks an occluded ray by setting its tfar to -infinity and keeps nothing of the
+// hit; the segment's start is the one depth known to precede it.
+Hit occlusionOf(const Ray& ray, float tfar) {
+    if (tfar == -std::numeric_limits<float>::infinity()) return Hit{ray.tmin, kUnnamedHitPrim, 0.0f, 0.0f};
+    return missHit(ray);
+}
+
+}  // namespace
+
+struct EmbreeScene::Impl {
+    SharedDevice* shared = nullptr;
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    RTCGeometry geometry = nullptr;  // owned by the scene once attached
+    EmbreeOptions options;
+
+    Impl() = default;
+    Impl(const Impl&) = delete;
+    Impl& operator=(const Impl&) = delete;
+
+    // Owns the scene from the moment it exists, so a constructor that throws halfway still
+    // releases it (~EmbreeScene does not run then).
+    ~Impl() {
+        if (scene) rtcReleaseScene(scene);
+    }
+
+    // The error code is per thread, so this reports failures of calls made on this thread.
+    std::string pendingError(const char* call) {
+        const RTCError code = rtcGetDeviceError(device);
+        if (code == RTC_ERROR_NONE) return {};
+        std::lock_guard<std::mutex> lock(shared->messageMutex);
+        return std::string("embree: ") + call + ": " + errorName(code) + ": " +
+               (shared->lastMessage.empty() ? "(no message)" : shared->lastMessage);
+    }
+
+    void check(const char* call) {
+        const std::string error = pendingError(call);
+        if (!error.empty()) throw std::runtime_error(error);
+    }
+
+    void traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, HitQuery query,
+                     std::vector<Hit>& hits) const;
+    // One packet: lane l traces rays[index[l]] where valid[l] is -1.
+    void tracePacket(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16], bool coherent,
+                     HitQuery query, std::vector<Hit>& hits) const;
+};
+
+EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->shared = &sharedDevice(options.threads);
+    impl_->device = impl_->shared->device;
+    impl_->options = options;
+
+    // Only what a new frame repeats is timed: the scene, its geometry and the BVH build.
+    const Clock::time_point start = Clock::now();
+    impl_->scene = rtcNewScene(impl_->device);
+    impl_->check("rtcNewScene");
+    int flags = options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE;
+    if (options.build != EmbreeBuild::Static) flags |= RTC_SCENE_FLAG_DYNAMIC;
+    rtcSetSceneFlags(impl_->scene, RTCSceneFlags(flags));
+    impl_->check("rtcSetSceneFlags");
+    rtcSetSceneBuildQuality(impl_->scene, options.build == EmbreeBuild::Static ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_LOW);
+    impl_->check("rtcSetSceneBuildQuality");
+
+    // An empty list has nothing to attach: the committed empty scene is one every ray misses.
+    if (!triangles.empty()) {
+        GeometryHandle geometry(rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE));
+        impl_->check("rtcNewGeometry");
+        // The scene's quality picks the top-level builder only; each mesh is built at its own
+        // quality, which defaults to MEDIUM (SAH). LOW selects the Morton builder that dynamic
+        // scenes are meant to use (4x faster on the Dragon), REFIT keeps the topology's tree.
+        rtcSetGeometryBuildQuality(geometry.get(), geometryQualityOf(options.build));
+        impl_->check("rtcSetGeometryBuildQuality");
+        // dacrt's Triangle is three 16-byte vertex slots (a float3 and padding each), so the
+        // array is a vertex buffer of stride 16 as it is, and every 16-byte load Embree makes
+        // stays inside it. The index buffer is the identity: primID is the triangle's index.
+        rtcSetSharedGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, triangles.data(), 0,
+                                   16, triangles.size() * 3);
+        impl_->check("rtcSetSharedGeometryBuffer(vertex)");
+        rtcSetSharedGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                   identityIndices(triangles.size()).data(), 0, 3 * sizeof(std::uint32_t),
+                                   triangles.size());
+        impl_->check("rtcSetSharedGeometryBuffer(index)");
+        if (options.faceFilter && singleSidedTriangles(triangles) > 0) {
+            rtcSetGeometryUserData(geometry.get(), const_cast<std::vector<Triangle>*>(&triangles));
+            // Embree 3 calls a geometry's intersection filter from rtcIntersect only and its
+            // occluded filter from rtcOccluded only: the face rule needs both.
+            rtcSetGeometryIntersectFilterFunction(geometry.get(), &rejectCulledBackFaces);
+            impl_->check("rtcSetGeometryIntersectFilterFunction");
+            rtcSetGeometryOccludedFilterFunction(geometry.get(), &rejectCulledBackFaces);
+            impl_->check("rtcSetGeometryOccludedFilterFunction");
+        }
+        rtcCommitGeometry(geometry.get());
+        impl_->check("rtcCommitGeometry");
+        rtcAttachGeometry(impl_->scene, geometry.get());
+        impl_->check("rtcAttachGeometry");
+        impl_->geometry = geometry.get();  // the scene now holds its own reference; ours is released
+    }
+
+    rtcCommitScene(impl_->scene);
+    impl_->check("rtcCommitScene");
+    buildMs_ = msSince(start);
+}
+
+EmbreeScene::~EmbreeScene() = default;
+
+double EmbreeScene::update() {
+    const Clock::time_point start = Clock::now();
+    if (impl_->geometry) {
+        rtcUpdateGeometryBuffer(impl_->geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+        impl_->check("rtcUpdateGeometryBuffer");
+        rtcCommitGeometry(impl_->geometry);
+        impl_->check("rtcCommitGeometry");
+    }
+    rtcCommitScene(impl_->scene);
+    impl_->check("rtcCommitScene");
+    return msSince(start);
+}
+
+void EmbreeScene::Impl::traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, HitQuery query,
+                                    std::vector<Hit>& hits) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    for (std::size_t i = begin; i < end; ++i) {
+        const Ray& ray = rays[i];
+        if (query == HitQuery::Any) {
+            RTCRay occlusion = embreeRay(ray);
+            rtcOccluded1(scene, &context, &occlusion);
+            hits[i] = occlusionOf(ray, occlusion.tfar);
+            continue;
+        }
+        RTCRayHit closest{};
+        closest.ray = embreeRay(ray);
+        closest.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        closest.hit.primID = RTC_INVALID_GEOMETRY_ID;
+        closest.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(scene, &context, &closest);
+        hits[i] = closestHitOf(ray, closest.ray.tfar, closest.hit.geomID, closest.hit.primID, closest.hit.u, closest.hit.v);
+    }
+}
+
+void EmbreeScene::Impl::tracePacket(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16],
+                                    bool coherent, HitQuery query, std::vector<Hit>& hits) const {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    if (coherent) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    // Inactive lanes carry a copy of an active lane's ray (they are masked out, but their
+    // fields must still be finite); a packet with no active lane is skipped.
+    int active = 0;
+    while (active < 16 && !valid[active]) ++active;
+    if (active == 16) return;
+    auto rayOfLane = [&](int l) -> const Ray& { return rays[valid[l] ? index[l] : index[active]]; };
+    if (query == HitQuery::Any) {
+        alignas(64) RTCRay16 q;
+        for (int l = 0; l < 16; ++l) setLane(q, l, rayOfLane(l));
+        rtcOccluded16(valid, scene, &context, &q);
+        for (int l = 0; l < 16; ++l)
+            if (valid[l]) hits[index[l]] = occlusionOf(rays[index[l]], q.tfar[l]);
+        return;
+    }
+    alignas(64) RTCRayHit16 q;
+    for (int l = 0; l < 16; ++l) {
+        setLane(q.ray, l, rayOfLane(l));
+        q.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+        q.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+        q.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, scene, &context, &q);
+    for (int l = 0; l < 16; ++l)
+        if (valid[l])
+            hits[index[l]] = closestHitOf(rays[index[l]], q.ray.tfar[l], q.hit.geomID[l], q.hit.primID[l], q.hit.u[l], q.hit.v[l]);
+}
+
+TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool, HitQuery query,
+                               std::optional<std::uint32_t> imageWidth) const {
+    TraceResult result;
+    result.hits.resize(rays.size());
+    result.threads = pool.size();
+    result.regions = 1;
+    result.axis = -1;
+
+    // The pool's workers must not throw (nothing would catch it there), so the first
+    // failure is kept and thrown from this thread once every chunk is done.
+    const bool packets = impl_->options.packets, any = query == HitQuery::Any;
+    const char* call = packets ? (any ? "rtcOccluded16" : "rtcIntersect16") : (any ? "rtcOccluded1" : "rtcIntersect1");
+    std::mutex failureMutex;
+    std::string failure;
+    auto keepFailure = [&] {
+        const std::string error = impl_->pendingError(call);
+        if (error.empty()) return;
+        std::lock_guard<std::mutex> lock(failureMutex);
+        if (failure.empty()) failure = error;
+    };
+
+    const Clock::time_point start = Clock::now();
+    const std::size_t width = imageWidth.value_or(impl_->options.imageWidth);
+    if (packets && width != 0) {
+        // Tiles of 4x4 pixels, a row of tiles per work unit: rays of one camera through
+        // neighbouring pixels, what the coherent flag is for.
+        const std::size_t height = (rays.size() + width - 1) / width;
+        const std::size_t tileColumns = (width + 3) / 4, tileRows = (height + 3) / 4;
+        pool.parallelFor(tileRows, [&](std::size_t row, unsigned) {
+            const FlushDenormals ftz;
+            for (std::size_t column = 0; column < tileColumns; ++column) {
+                std::size_t index[16];
+                alignas(64) int valid[16];  // the 16-wide calls want the mask, like the packet, 64-byte aligned
+                for (int l = 0; l < 16; ++l) {
+                    const std::size_t x = column * 4 + std::size_t(l % 4), y = row * 4 + std::size_t(l / 4);
+                    index[l] = y * width + x;
+                    valid[l] = x < width && index[l] < rays.size() ? -1 : 0;
+                }
+                impl_->tracePacket(rays, index, valid, true, query, result.hits);
+            }
+            keepFailure();
+        });
+    } else {
+        // Rays that are not an image (secondary rays leave surfaces every way) have no
+        // neighbourhood to exploit: packets of 16 consecutive rays, without the coherent flag.
+        const std::size_t chunks = (rays.size() + kRaysPerChunk - 1) / kRaysPerChunk;
+        pool.parallelFor(chunks, [&](std::size_t chunk, unsigned) {
+            const FlushDenormals ftz;
+            const std::size_t begin = chunk * kRaysPerChunk, end = std::min(rays.size(), begin + kRaysPerChunk);
+            if (!packets) {
+                impl_->traceSingle(rays, begin, end, query, result.hits);
+            } else {
+                for (std::size_t first = begin; first < end; first += 16) {
+                    std::size_t index[16];
+                    alignas(64) int valid[16];
+                    for (int l = 0; l < 16; ++l) {
+                        index[l] = first + std::size_t(l);
+                        valid[l] = index[l] < end ? -1 : 0;
+                    }
+                    impl_->tracePacket(rays, index, valid, false, query, result.hits);
+                }
+            }
+            keepFailure();
+        });
+    }
+    if (!failure.empty()) throw std::runtime_error(failure);
+    result.phaseMs.emplace_back("trace", msSince(start));
+    return result;
+}
+
+TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool) {
+    const EmbreeScene scene(*geometry.triangles, options);
+    TraceResult result = scene.trace(*geometry.rays, pool, geometry.query, geometry.imageWidth);
+    result.phaseMs.insert(result.phaseMs.begin(), {"build", scene.buildMs()});
+    return result;
+}
+
+}  // namespace dacrt

@@ -1,0 +1,88 @@
+#pragma once
+// Embree 3 as a peer backend and an independent oracle: a BVH over the same float32
+// triangles, traced with the same rays. Its answers are Embree's own (not watertight by
+// construction, ties between coincident triangles unspecified), so dacrt's benchmark
+// measures its error against the float64 reference like any other backend.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/enum_names.hpp"
+#include "core/thread_pool.hpp"
+#include "cpu/frame_geometry.hpp"
+#include "cpu/trace_result.hpp"
+
+namespace dacrt {
+
+// How the BVH follows the frames, as Embree's users configure each case.
+// Dynamic: RTC_SCENE_FLAG_DYNAMIC with RTC_BUILD_QUALITY_LOW, a new BVH every frame (a scene
+// whose topology changes). Refit: one scene kept across frames, its geometry at
+// RTC_BUILD_QUALITY_REFIT, the vertex buffer updated and recommitted each frame (valid while
+// only vertices move). Static: RTC_BUILD_QUALITY_HIGH, built once, frames pay the trace only.
+enum class EmbreeBuild { Dynamic, Refit, Static };
+template <>
+struct EnumNames<EmbreeBuild> {
+    static constexpr std::array<std::pair<EmbreeBuild, std::string_view>, 3> table{
+        {{EmbreeBuild::Dynamic, "dynamic"}, {EmbreeBuild::Refit, "refit"}, {EmbreeBuild::Static, "static"}}};
+};
+
+struct EmbreeOptions {
+    // RTC_SCENE_FLAG_ROBUST: no leaks through shared edges. On by default, unlike Embree
+    // itself: without it Embree leaks real pixels on the Bunny's orbit (docs/benchmarks.md).
+    bool robust = true;
+    unsigned threads = 0;  // threads of Embree's BVH build; 0: every core
+    EmbreeBuild build = EmbreeBuild::Dynamic;
+    // 16-wide packets (rtcIntersect16, rtcOccluded16): on 4x4 pixel tiles with the coherent
+    // flag where the rays are an image, else on runs of 16 consecutive rays; false: one
+    // rtcIntersect1 or rtcOccluded1 per ray.
+    bool packets = true;
+    // The rays' image width, for the tiles, where a trace names none; 0: not an image
+    // (secondary rays).
+    std::uint32_t imageWidth = 0;
+    // The face rule as intersection and occlusion filters where some triangles are
+    // single-sided (the rule every backend applies); false: both faces hit, Embree's fastest,
+    // which gives the same image wherever no back face is visible (closed meshes seen from
+    // outside).
+    bool faceFilter = true;
+};
+
+// One Embree device (per thread count, for the whole process) and one committed scene over
+// the given triangles, whose vertices Embree reads in place (a shared buffer: the array must
+// outlive the scene and keep its address). Throws std::runtime_error with Embree's error text
+// on failure.
+class EmbreeScene {
+public:
+    EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOptions& options);
+    ~EmbreeScene();
+    EmbreeScene(const EmbreeScene&) = delete;
+    EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+    double buildMs() const { return buildMs_; }
+
+    // After the triangles' vertices moved (same count): refit (Refit) or rebuild (otherwise).
+    // Returns the milliseconds it took.
+    double update();
+
+    // Every ray's answer within its segment (ray.tmin < t <= ray.tmax), traced on the pool's
+    // threads with flush-to-zero and denormals-are-zero on (restored afterwards: the same
+    // threads run dacrt). Closest: the closest hit (rtcIntersect), missHit(ray) for a miss.
+    // Any: occlusion (rtcOccluded), which stops at any hit and reports none of it: an occluded
+    // ray gets Hit{ray.tmin, kUnnamedHitPrim, 0, 0}, t being only a bound the hit lies beyond,
+    // an unoccluded one missHit(ray). imageWidth: the rays' image width (0: not an image), for
+    // a scene that traces both a camera's rays and secondary rays; unset: the options'.
+    // phaseMs holds {"trace", ms}; counters stay zero (Embree does not report them).
+    TraceResult trace(const std::vector<Ray>& rays, ThreadPool& pool, HitQuery query = HitQuery::Closest,
+                      std::optional<std::uint32_t> imageWidth = std::nullopt) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    double buildMs_ = 0.0;
+};
+
+// A dynamic-scene frame: build, then trace the frame's rays for its query, in tiles where the
+// frame says its rays are an image. phaseMs holds {"build", ms} and {"trace", ms}.
+TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool);
+
+}  // namespace dacrt

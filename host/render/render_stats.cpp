@@ -1,0 +1,174 @@
+#include "render/render_stats.hpp"
+
+#include "app/json_keys.hpp"
+
+namespace dacrt {
+namespace {
+
+nlohmann::ordered_json vec(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+
+nlohmann::ordered_json countersJson(const Counters& c) {
+    nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < c.terminatedPerRound.size(); ++i)
+        rounds.push_back({{"round", c.roundNames[i]}, {"terminated", c.terminatedPerRound[i]}});
+    return {{"ray_box_tests", c.rayBoxTests},
+            {"packet_box_tests", c.packetBoxTests},
+            {"ray_triangle_tests", c.rayTriangleTests},
+            {"leaves", c.leaves},
+            {"rays_retired_without_hit", c.raysRetired},
+            {"rays_culled", c.raysCulled},
+            {"rays_terminated_step1", c.terminatedStep1},
+            {"rays_terminated_per_round", rounds},
+            {"transfer_work_items", c.transferWorkItems},
+            {"transfer_work_items_skipped", c.transferWorkItemsSkipped}};
+}
+
+nlohmann::ordered_json memoryJson(const MemoryPlan& plan) {
+    nlohmann::ordered_json mem;
+    for (const auto& [name, bytes] : plan.buffers) mem[jsonKey(name)] = bytes;
+    mem["total"] = plan.total();
+    return mem;
+}
+
+nlohmann::ordered_json gpuJson(const GpuReport& g) {
+    nlohmann::ordered_json dispatches = nlohmann::ordered_json::array();
+    for (const auto& [name, ms] : g.dispatchMs) dispatches.push_back({{"name", name}, {"gpu_ms", ms}});
+    return {{"device", g.device},
+            {"driver", g.driver},
+            {"workgroup_size", g.workgroupSize},
+            {"subgroup_size", g.subgroupSize},
+            {"ray_groups", g.rayGroups},
+            {"dispatches", g.dispatches},
+            {"dispatch_times", dispatches},
+            {"work_items_run", g.workItemsRun},
+            {"work_items_empty", g.workItemsEmpty},
+            {"work_item_slices", g.slices},
+            {"rays_finished", g.raysFinished},
+            {"validation_errors", g.validationErrors}};
+}
+
+double perSecond(std::uint64_t rays, double ms) { return ms > 0.0 ? double(rays) / (ms * 1e-3) : 0.0; }
+
+// Each pass in frame order: the primary (its details are the top level's), then each secondary
+// pass with its rays, time, rays per second, counters, memory and work plan.
+nlohmann::ordered_json passesJson(const RenderedFrame& frame, double primaryMs) {
+    nlohmann::ordered_json passes = nlohmann::ordered_json::array();
+    passes.push_back({{"name", "primary"}, {"rays", frame.rayCount}, {"trace_ms", primaryMs},
+                      {"rays_per_second", perSecond(frame.rayCount, primaryMs)}});
+    if (!frame.passes) return passes;
+    for (const TracedPass& t : *frame.passes) {
+        double compile = 0.0;
+        nlohmann::ordered_json phases;
+        for (const auto& [name, ms] : t.result.phaseMs) {  // a batched pass has each phase once per batch
+            const std::string key = jsonKey(name);
+            phases[key] = (phases.contains(key) ? phases[key].get<double>() : 0.0) + ms;
+            if (name == kPipelinePhase) compile += ms;
+        }
+        const double ms = t.ms - compile;
+        std::uint64_t hits = 0;
+        for (const Hit& h : t.result.hits) hits += h.prim != kMissPrim && h.prim != kNotTracedPrim;
+        nlohmann::ordered_json p = {{"name", t.pass.name},
+                                    {"kind", t.pass.kind == shared::kPassShadow ? "shadow" : "occlusion"},
+                                    {"slots", t.result.hits.size()},
+                                    {"rays", t.rays},
+                                    {"rays_hit", hits},
+                                    {"trace_ms", ms},
+                                    {"rays_per_second", perSecond(t.rays, ms)},
+                                    {"trace_phases", phases},
+                                    {"counters", countersJson(t.result.counters)},
+                                    {"memory_plan_bytes", memoryJson(t.result.memory)}};
+        if (t.pass.kind == shared::kPassOcclusion) {
+            p["rays_per_hit"] = t.pass.raysPerHit;
+            p["distance"] = t.pass.occlusionDistance;
+        }
+        nlohmann::ordered_json work = nlohmann::ordered_json::array();
+        for (const WorkLine& w : t.result.memory.work) work.push_back({{"name", w.name}, {"count", w.count}, {"why", w.why}});
+        p["work_plan"] = work;
+        if (t.result.gpu) p["gpu"] = gpuJson(*t.result.gpu);
+        passes.push_back(p);
+    }
+    return passes;
+}
+
+nlohmann::ordered_json lightsJson(const RenderedFrame& frame) {
+    nlohmann::ordered_json lights = nlohmann::ordered_json::array();
+    for (const Light& l : frame.lights) {
+        nlohmann::ordered_json j = {{"name", l.name}, {"type", toString(l.type)}, {"intensity", l.intensity},
+                                    {"color", {l.color.r, l.color.g, l.color.b}}};
+        if (l.type == LightType::Directional) j["direction"] = vec(l.direction);
+        else j["position"] = vec(l.position);
+        lights.push_back(j);
+    }
+    return lights;
+}
+
+}  // namespace
+
+nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFrame& frame) {
+    const Scene& scene = frame.scene;
+    const Camera& camera = frame.camera;
+    const TraceResult& r = frame.result;
+    const TraceOptions& trace = o.request.trace;
+    nlohmann::ordered_json j;
+    j["backend"] = toString(trace.backend);
+    j["scene"] = o.scenePath;
+    j["frame"] = frame.instant.frame ? nlohmann::ordered_json(*frame.instant.frame) : nlohmann::ordered_json(nullptr);
+    j["time_s"] = frame.instant.time;
+    j["animation"] = o.animationChoice.empty() ? std::string("(all)") : o.animationChoice;
+    j["triangles"] = scene.triangleCount();
+    j["triangles_dropped_degenerate"] = scene.degenerateTrianglesDropped;
+    j["rays"] = frame.rayCount;
+    j["width"] = o.width;
+    j["height"] = o.height;
+    j["regions"] = r.regions;
+    j["threads"] = r.threads;
+    j["division_axis"] = r.axis < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(std::string(1, "xyz"[r.axis]));
+    j["camera"] = {{"index", frame.cameraIndex}, {"projection", toString(camera.projection)}, {"eye", vec(camera.eye)},
+                   {"forward", vec(camera.forward)}, {"up", vec(camera.up)}};
+    if (camera.projection == Projection::Perspective) j["camera"]["yfov_degrees"] = glm::degrees(camera.yfovRadians);
+    else j["camera"]["ymag"] = camera.ymag;
+    if (scene.camera && !scene.camera->name.empty()) j["camera"]["name"] = scene.camera->name;
+    const DacrtOptions dacrt = trace.dacrt.resolvedFor(trace.backend);
+    j["options"] = {{"ray_limit", dacrt.rayLimit}, {"tri_limit", dacrt.triLimit},
+                    {"max_depth", trace.dacrt.maxDepth}, {"split", toString(trace.dacrt.split)},
+                    {"axis", toString(trace.axis)}, {"intersector", toString(trace.dacrt.intersector)},
+                    {"triangle_filter", toString(trace.dacrt.triangleFilter)},
+                    {"precision", toString(trace.dacrt.precision)},
+                    {"cull", toString(o.cull)},
+                    {"skip_backfaces", trace.skips.backFaces},
+                    {"skip_frustum", trace.skips.frustum},
+                    {"skip_uploads", trace.skips.uploads},
+                    {"skip_subscenes", trace.skips.subScenes}};
+    if (trace.backend == Backend::Embree)
+        j["options"] = {{"robust", o.request.embree.robust}, {"build", toString(o.request.embree.build)},
+                        {"packets", o.request.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
+    nlohmann::ordered_json t;
+    for (const auto& [name, ms] : frame.timingsMs) t[name] = ms;
+    nlohmann::ordered_json phases;
+    for (const auto& [name, ms] : r.phaseMs) phases[jsonKey(name)] = ms;
+    if (!phases.empty()) t["trace_phases"] = phases;
+    if (!r.step1RegionMs.empty()) t["step1_region"] = r.step1RegionMs;
+    j["timings_ms"] = t;
+    j["memory_plan_bytes"] = memoryJson(r.memory);
+    nlohmann::ordered_json work = nlohmann::ordered_json::array();
+    work.push_back({{"name", "degenerate triangles dropped at load"}, {"count", frame.scene.degenerateTrianglesDropped},
+                    {"why", "no area: never hit"}});
+    for (const WorkLine& w : r.memory.work) work.push_back({{"name", w.name}, {"count", w.count}, {"why", w.why}});
+    j["work_plan"] = work;
+    j["counters"] = countersJson(r.counters);
+    std::uint64_t hits = 0;
+    for (const Hit& h : r.hits) hits += h.prim != kMissPrim;
+    j["hits"] = hits;
+    if (r.gpu) j["gpu"] = gpuJson(*r.gpu);
+    double primaryMs = 0.0;
+    for (const auto& [name, ms] : frame.timingsMs)
+        if (name == "trace") primaryMs = ms;
+    j["lights"] = lightsJson(frame);
+    j["shading"] = {{"model", frame.lights.empty() ? "headlight" : "lambert with shadows"},
+                    {"exposure", frame.exposure},
+                    {"occlusion_rays_per_hit", o.passes.occlusionSamples}};
+    j["passes"] = passesJson(frame, primaryMs);
+    return j;
+}
+
+}  // namespace dacrt

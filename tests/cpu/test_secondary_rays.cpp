@@ -1,0 +1,293 @@
+// Secondary rays: the exact arithmetic they are made with, the origin offset, the sample
+// sequence, and brute / cpu-seq / cpu agreeing on rays that start on surfaces.
+#include <bit>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "core/procedural.hpp"
+#include "core/random.hpp"
+#include "cpu/secondary_rays.hpp"
+#include "support/frames.hpp"
+
+using namespace dacrt;
+using namespace dacrt::test;
+
+// The integer versions the device runs (the host takes its own IEEE division and square root:
+// these tests are why it may).
+namespace device_math {
+using namespace dacrt::shared;
+using dacrt::shared::abs;  // glm has its own of each: these are the shaders'
+using dacrt::shared::floatBitsToUint;
+using dacrt::shared::max;
+using dacrt::shared::uintBitsToFloat;
+#undef DACRT_EXACT_MATH_GLSL
+#define precise
+#define DACRT_UNROLL
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wunused-variable"
+#include "exact_math.glsl"
+#pragma GCC diagnostic pop
+#undef DACRT_UNROLL
+#undef precise
+}  // namespace device_math
+
+namespace {
+
+// A float with a random significand and an exponent in [lo, hi], random sign.
+float randomFloat(Random& random, int lo, int hi) {
+    const int e = lo + int(random.index(std::size_t(hi - lo + 1)));
+    const float m = 1.0f + float(random.uniform());
+    const float v = std::ldexp(m, e);
+    return random.uniform() < 0.5 ? -v : v;
+}
+
+bool sameBits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
+
+}  // namespace
+
+TEST(ExactMath, DivideRoundedIsIeeeDivision) {
+    Random random(11);
+    std::size_t checked = 0;
+    for (int i = 0; i < 2000000; ++i) {
+        const float a = randomFloat(random, -60, 60), b = randomFloat(random, -60, 60);
+        ASSERT_TRUE(sameBits(device_math::divideRounded(a, b), a / b)) << a << " / " << b;
+        ++checked;
+    }
+    // Quotients that need the round-to-even rule and the carry into the next power of two.
+    for (float a : {1.0f, 3.0f, 0.1f, 1.9999999f, 16777215.0f, 0.0f, -0.0f})
+        for (float b : {1.0f, 3.0f, 7.0f, 0.1f, 1.0000001f, -2.5f, 16777213.0f})
+            EXPECT_TRUE(sameBits(device_math::divideRounded(a, b), a / b)) << a << " / " << b;
+    EXPECT_EQ(checked, 2000000u);
+}
+
+TEST(ExactMath, SqrtRoundedIsIeeeSqrt) {
+    Random random(12);
+    for (int i = 0; i < 2000000; ++i) {
+        const float x = std::abs(randomFloat(random, -120, 120));
+        ASSERT_TRUE(sameBits(device_math::sqrtRounded(x), std::sqrt(x))) << x;
+    }
+    for (float x : {0.0f, 1.0f, 2.0f, 4.0f, 0.25f, 16777215.0f, 1.0000001f, 0.99999994f, 1e-30f, 3e30f})
+        EXPECT_TRUE(sameBits(device_math::sqrtRounded(x), std::sqrt(x))) << x;
+}
+
+TEST(ExactMath, NormalizeRoundedGivesUnitVectorsAtEveryScale) {
+    Random random(13);
+    for (int i = 0; i < 100000; ++i) {
+        const glm::vec3 v(randomFloat(random, -40, 40), randomFloat(random, -40, 40), randomFloat(random, -40, 40));
+        const glm::vec3 n = device_math::normalizeRounded(v);
+        ASSERT_EQ(n, shared::normalizeRounded(v));
+        const glm::dvec3 exact = glm::normalize(glm::dvec3(v));
+        for (int a = 0; a < 3; ++a) ASSERT_NEAR(n[a], exact[a], 4e-7) << i;
+    }
+}
+
+TEST(ExactMath, PcgHashIsTheRxsMXsStep) {
+    // Reference values computed independently (Python, modulo 2^32).
+    EXPECT_EQ(shared::pcgHash(0u), 129708002u);
+    EXPECT_EQ(shared::pcgHash(1u), 2831084092u);
+    EXPECT_EQ(shared::pcgHash(2u), 2055130248u);
+    EXPECT_EQ(shared::pcgHash(123456789u), 4272394698u);
+    EXPECT_EQ(shared::pcgHash(0xFFFFFFFFu), 3861530882u);
+    EXPECT_EQ(shared::unitInterval(0xFFFFFFFFu), 1.0f - 0x1p-24f);
+    EXPECT_EQ(shared::unitInterval(0xFFu), 0.0f);
+}
+
+TEST(SecondaryRays, SegmentRaysDivideAsTheHardwareDoes) {
+    Random random(14);
+    for (int i = 0; i < 100000; ++i) {
+        const glm::vec3 d(randomFloat(random, -20, 20), randomFloat(random, -20, 20), randomFloat(random, -20, 20));
+        const Ray r = shared::segmentRay(glm::vec3(1, 2, 3), d, 1.0f);
+        for (int a = 0; a < 3; ++a) ASSERT_TRUE(sameBits(r.invDir[a], 1.0f / d[a]));
+        const int kx = int(r.axes & 3u), ky = int((r.axes >> 2) & 3u), kz = int((r.axes >> 4) & 3u);
+        ASSERT_TRUE(sameBits(r.shear.x, d[kx] / d[kz]) && sameBits(r.shear.y, d[ky] / d[kz]) &&
+                    sameBits(r.shear.z, 1.0f / d[kz]));
+        ASSERT_EQ(r.tmax, 1.0f);
+    }
+    // Components below 2^-64 are flushed, as makeRay flushes them.
+    const Ray r = shared::segmentRay(glm::vec3(0), glm::vec3(1.0f, 1e-25f, -1e-30f), 2.0f);
+    EXPECT_EQ(r.dir.y, 0.0f);
+    EXPECT_EQ(r.dir.z, 0.0f);
+    EXPECT_EQ(r.invDir.y, 0.0f);
+}
+
+// Rays leaving random points of random triangles, at scales from 1e-4 to 1e6 and offsets up
+// to 1e6, into their hemisphere (grazing ones included): the origin lies on the normal's side
+// of the triangle's plane, and the watertight test never finds the triangle itself.
+TEST(SecondaryRays, OffsetOriginsNeverSeeTheirOwnTriangle) {
+    Random random(15);
+    std::size_t grazing = 0;
+    std::uint32_t slot = 0;
+    for (double scale : {1e-4, 1e-2, 1.0, 1e3, 1e6}) {
+        for (double shift : {0.0, 1.0, 1e3, 1e6}) {
+            for (int i = 0; i < 2000; ++i) {
+                const glm::dvec3 centre = random.inBox(-1.0, 1.0) * shift;
+                Triangle tri{};
+                tri.v0 = glm::vec3(centre + random.inBox(-1.0, 1.0) * scale);
+                tri.v1 = glm::vec3(centre + random.inBox(-1.0, 1.0) * scale);
+                tri.v2 = glm::vec3(centre + random.inBox(-1.0, 1.0) * scale);
+                if (shared::triangleHasNoArea(tri.v0, tri.v1, tri.v2)) continue;
+                const float u = float(random.uniform()), v = float(random.uniform()) * (1.0f - u);
+                const glm::dvec3 normal = glm::normalize(glm::cross(glm::dvec3(tri.v1 - tri.v0), glm::dvec3(tri.v2 - tri.v0)));
+                // A primary ray from the front or from the back.
+                const glm::vec3 incoming = glm::vec3(random.uniform() < 0.5 ? -normal : normal);
+                const Ray primary = makeRay(glm::vec3(0), glm::dvec3(incoming));
+                const shared::SurfaceSample s = shared::surfaceOfHit(primary, Hit{1.0f, 0u, u, v}, tri);
+                ASSERT_TRUE(s.valid);
+                const double side = glm::dot(glm::dvec3(s.origin) - glm::dvec3(tri.v0), glm::dvec3(s.normal));
+                ASSERT_GT(side, 0.0) << "scale " << scale << " shift " << shift;
+                for (int k = 0; k < 8; ++k) {
+                    const Ray ray = shared::occlusionRay(s, slot++, 3u, kNoHitT).ray;
+                    const double cosine = glm::dot(glm::normalize(glm::dvec3(ray.dir)), glm::dvec3(s.normal));
+                    ASSERT_GT(cosine, 0.0);
+                    grazing += cosine < 0.01;
+                    const shared::TriangleHit h = shared::intersectWatertight(ray, tri.v0, tri.v1, tri.v2, false);
+                    ASSERT_FALSE(h.hit && h.t > 0.0f) << "scale " << scale << " shift " << shift << " t " << h.t;
+                }
+            }
+        }
+    }
+    EXPECT_GT(grazing, 0u) << "the sample should include grazing rays";
+}
+
+TEST(SecondaryRays, OcclusionRaysAreCosineDistributed) {
+    const Triangle tri{{0, 0, 0}, 0u, {1, 0, 0}, 0.0f, {0, 1, 0}, 0.0f};
+    const Ray primary = makeRay(glm::vec3(0.2f, 0.2f, 5.0f), glm::dvec3(0, 0, -1));
+    const shared::SurfaceSample s = shared::surfaceOfHit(primary, Hit{5.0f, 0u, 0.2f, 0.2f}, tri);
+    ASSERT_EQ(s.normal, glm::vec3(0, 0, 1));
+    const int n = 40000;
+    double cosine = 0.0, cosineSquared = 0.0;
+    for (int i = 0; i < n; ++i) {
+        const Ray r = shared::occlusionRay(s, std::uint32_t(i), 1u, 2.0f).ray;
+        ASSERT_NEAR(glm::length(glm::dvec3(r.dir)), 1.0, 1e-6);
+        ASSERT_EQ(r.tmax, 2.0f);
+        cosine += r.dir.z;
+        cosineSquared += double(r.dir.z) * r.dir.z;
+    }
+    // A cosine-weighted hemisphere: E[cos] = 2/3, E[cos^2] = 1/2.
+    EXPECT_NEAR(cosine / n, 2.0 / 3.0, 0.005);
+    EXPECT_NEAR(cosineSquared / n, 0.5, 0.005);
+}
+
+TEST(SecondaryRays, ShadowRaysOnlyWhereTheLightCanReach) {
+    const Triangle tri{{-1, 0, -1}, 0u, {0, 0, 1}, 0.0f, {1, 0, -1}, 0.0f};  // the plane y = 0, normal +y
+    const Ray primary = makeRay(glm::vec3(0, 3, 0), glm::dvec3(0, -1, 0));
+    const shared::SurfaceSample s = shared::surfaceOfHit(primary, Hit{3.0f, 0u, 0.25f, 0.25f}, tri);
+    ASSERT_GT(s.origin.y, 0.0f);
+    ShadowLight light{};
+    light.type = shared::kLightPoint;
+    light.position = glm::vec3(0, 2, 0);
+    shared::GeneratedRay g = shared::shadowRay(s, light);
+    ASSERT_TRUE(g.traced);
+    EXPECT_EQ(g.ray.tmax, 1.0f);
+    light.position = glm::vec3(0, -2, 0);  // behind the surface: in shadow without a ray
+    EXPECT_FALSE(shared::shadowRay(s, light).traced);
+    light.position = glm::vec3(0, 2, 0);
+    light.range = 1.5f;  // out of range
+    EXPECT_FALSE(shared::shadowRay(s, light).traced);
+    light.range = 0.0f;
+    light.type = shared::kLightSpot;
+    light.direction = glm::vec3(0, -1, 0);
+    light.cosOuterSquared = 0.5f;  // 45 degrees
+    EXPECT_TRUE(shared::shadowRay(s, light).traced);
+    light.direction = glm::vec3(1, 0, 0);  // pointing sideways: outside the cone
+    EXPECT_FALSE(shared::shadowRay(s, light).traced);
+    light.type = shared::kLightDirectional;
+    light.direction = glm::vec3(0, -1, 0);  // shining down onto the surface
+    g = shared::shadowRay(s, light);
+    ASSERT_TRUE(g.traced);
+    EXPECT_EQ(g.ray.tmax, kNoHitT);
+    EXPECT_EQ(g.ray.dir, glm::vec3(0, 1, 0));
+}
+
+namespace {
+
+// Brute force against cpu-seq and cpu (regions and threads) on one pass.
+void expectPassAgrees(const PassFrame& pass, bool closest) {
+    const TraceResult reference = pass.trace(Backend::Brute, 0, 2);
+    auto same = [&](const std::vector<Hit>& hits) {
+        return closest ? identicalHits(reference.hits, hits) : identicalVisibility(reference.hits, hits);
+    };
+    EXPECT_TRUE(same(pass.trace(Backend::CpuSeq).hits)) << "cpu-seq";
+    for (unsigned regions : {1u, 2u, 4u, 8u})
+        for (unsigned threads : {1u, 2u})
+            EXPECT_TRUE(same(pass.trace(Backend::Cpu, regions, threads).hits)) << "cpu, " << regions << " regions, "
+                                                                               << threads << " threads";
+    for (DivisionAxis axis : {DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z})
+        EXPECT_TRUE(same(pass.trace(Backend::Cpu, 3, 2, axis).hits)) << "cpu along axis " << int(axis) - 1;
+    DacrtOptions octants;
+    octants.rayOrder = RayOrder::Octants;
+    EXPECT_TRUE(same(pass.trace(Backend::CpuSeq, 0, 1, DivisionAxis::Best, octants).hits)) << "cpu-seq by octants";
+    EXPECT_TRUE(same(pass.trace(Backend::Cpu, 4, 2, DivisionAxis::Best, octants).hits)) << "cpu by octants";
+}
+
+}  // namespace
+
+TEST(BackendsAgree, OcclusionRaysClosestAndAnyHit) {
+    // Rays from every visible surface in every direction of its hemisphere: no common near
+    // side, so every split classifies them (ChildOrder::PerRay).
+    CameraOptions o;
+    o.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(shapesScene(), 48, 36, o);
+    const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
+    for (float length : {0.8f, kNoHitT}) {
+        SCOPED_TRACE("length " + std::to_string(length));
+        for (HitQuery query : {HitQuery::Closest, HitQuery::Any}) {
+            const PassFrame pass(frame, primary.hits, occlusionPass(4, length), query);
+            ASSERT_EQ(pass.geometry.order, ChildOrder::PerRay);
+            ASSERT_GT(pass.rays.rays.size(), 3000u);
+            ASSERT_GT(hitCount(pass.trace(Backend::Brute, 0, 2).hits), pass.rays.rays.size() / 20);
+            expectPassAgrees(pass, query == HitQuery::Closest);
+        }
+    }
+}
+
+TEST(BackendsAgree, ShadowRaysTowardsPointAndDirectionalLights) {
+    CameraOptions o;
+    o.eye = glm::dvec3(-1.0, 2.0, 4.0);
+    const Frame frame(shapesScene(), 48, 36, o);
+    const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
+    const SecondaryPass directional = directionalShadowPass({0.4, -1.0, -0.3});
+    for (const SecondaryPass& p : {pointShadowPass({0.3f, 1.6f, 0.4f}), pointShadowPass({0.0f, -0.2f, 0.0f}), directional}) {
+        for (HitQuery query : {HitQuery::Closest, HitQuery::Any}) {
+            const PassFrame pass(frame, primary.hits, p, query);
+            ASSERT_GT(pass.rays.rays.size(), 500u);
+            if (p.light.type == shared::kLightDirectional) {
+                EXPECT_EQ(pass.geometry.order, ChildOrder::NearSide);
+            }
+            expectPassAgrees(pass, query == HitQuery::Closest);
+        }
+    }
+}
+
+TEST(SecondaryRays, ABatchOfSamplesMakesTheRaysTheWholePassWould) {
+    // The gpu splits an occlusion pass its device buffers cannot hold into batches of samples
+    // (cmd/frame_passes.cpp): each batch must draw the same random streams as the whole pass.
+    CameraOptions o;
+    o.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(shapesScene(), 24, 18, o);
+    const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
+    ThreadPool pool(2);
+    const SecondaryPass whole = occlusionPass(7, 0.8f);
+    const SecondaryRays all = makeSecondaryRays(whole, frame.rays, primary.hits, frame.scene.triangles, pool);
+    std::size_t compared = 0;
+    for (std::uint32_t first : {0u, 3u, 6u}) {
+        SecondaryPass batch = whole;
+        batch.firstSample = first;
+        batch.raysPerHit = std::min(3u, 7u - first);
+        batch.samplesPerHit = 7;
+        const SecondaryRays part = makeSecondaryRays(batch, frame.rays, primary.hits, frame.scene.triangles, pool);
+        ASSERT_EQ(part.slotCount, frame.rays.size() * batch.raysPerHit);
+        for (std::size_t r = 0; r < part.rays.size(); ++r) {
+            const std::uint32_t pixel = part.slots[r] / batch.raysPerHit, sample = first + part.slots[r] % batch.raysPerHit;
+            const auto at = std::lower_bound(all.slots.begin(), all.slots.end(), pixel * 7 + sample);
+            ASSERT_TRUE(at != all.slots.end() && *at == pixel * 7 + sample);
+            ASSERT_EQ(std::memcmp(&all.rays[std::size_t(at - all.slots.begin())], &part.rays[r], sizeof(Ray)), 0);
+            ++compared;
+        }
+    }
+    EXPECT_EQ(compared, all.rays.size());
+}

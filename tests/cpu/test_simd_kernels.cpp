@@ -1,0 +1,327 @@
+// The SIMD kernels against the scalar predicates they replace, on every instruction set this
+// binary holds that the machine runs: same ids in the same order, same hits bit for bit.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/camera.hpp"
+#include "core/random.hpp"
+#include "cpu/predicates.hpp"
+#include "cpu/simd_kernels.hpp"
+#include "cpu/traversal.hpp"
+#include "cpu/triangle_skips.hpp"
+
+using namespace dacrt;
+
+namespace {
+
+// Every available target in turn, then the best again.
+class EveryTarget : public ::testing::Test {
+protected:
+    template <typename Body>
+    void forEachTarget(Body body) {
+        const std::vector<std::string> targets = simd::availableTargets();
+        ASSERT_FALSE(targets.empty());
+        for (const std::string& t : targets) {
+            SCOPED_TRACE("target " + t);
+            simd::forceTarget(t);
+            ASSERT_EQ(simd::activeTarget(), t);
+            body();
+        }
+    }
+    void TearDown() override { simd::forceTarget(""); }
+};
+
+// Coordinates drawn from a few values on purpose: equal coordinates (a ray origin on a cell
+// face, bounds touching a cell) and zero direction components are where a kernel that
+// differs from the scalar rule would show.
+float adversarialCoordinate(Random& rng) {
+    static const float kValues[] = {-1.0f, -0.5f, 0.0f, -0.0f, 0.25f, 0.5f, 1.0f, 1e-30f, 3.0f};
+    if (rng.uniform() < 0.4) return kValues[rng.index(std::size(kValues))];
+    return rng.uniformFloat(-2.0f, 2.0f) * (rng.uniform() < 0.2 ? 1e6f : 1.0f);
+}
+
+Ray randomRay(Random& rng) {
+    glm::vec3 origin{adversarialCoordinate(rng), adversarialCoordinate(rng), adversarialCoordinate(rng)};
+    glm::dvec3 dir = rng.onSphere();
+    for (int a = 0; a < 3; ++a)
+        if (rng.uniform() < 0.15) dir[a] = 0.0;  // parallel to a slab
+    if (dir == glm::dvec3(0.0)) dir.z = 1.0;
+    return makeRay(origin, dir, rng.uniform() < 0.3 ? rng.uniformFloat(0.0f, 1.0f) : 0.0f);
+}
+
+Box randomCell(Random& rng) {
+    Box b;
+    for (int a = 0; a < 3; ++a) {
+        float p = adversarialCoordinate(rng), q = rng.uniform() < 0.1 ? p : adversarialCoordinate(rng);
+        b.lo[a] = std::min(p, q);
+        b.hi[a] = std::max(p, q);
+    }
+    return b;
+}
+
+std::vector<std::uint32_t> scalarPartition(std::vector<std::uint32_t> ids, std::uint32_t& kept,
+                                           const std::function<bool(std::uint32_t)>& passes) {
+    std::vector<std::uint32_t> out, rest;
+    for (std::uint32_t id : ids) (passes(id) ? out : rest).push_back(id);
+    kept = std::uint32_t(out.size());
+    out.insert(out.end(), rest.begin(), rest.end());
+    return out;
+}
+
+std::vector<std::uint32_t> shuffledIds(Random& rng, std::uint32_t universe, std::uint32_t count) {
+    std::vector<std::uint32_t> ids(universe);
+    for (std::uint32_t i = 0; i < universe; ++i) ids[i] = i;
+    rng.shuffle(ids);
+    ids.resize(count);
+    return ids;
+}
+
+// A kernel's partition against the scalar one (same ids, same order), tallying both answers
+// so that a test can require both to be common.
+struct PartitionTally {
+    std::uint32_t kept = 0, rejected = 0;
+    ::testing::AssertionResult check(std::uint32_t kept_, std::uint32_t expectedKept, const std::vector<std::uint32_t>& ids,
+                                     const std::vector<std::uint32_t>& expected) {
+        if (kept_ != expectedKept || ids != expected)
+            return ::testing::AssertionFailure() << "kept " << kept_ << " ids against the scalar " << expectedKept;
+        kept += kept_;
+        rejected += std::uint32_t(ids.size()) - kept_;
+        return ::testing::AssertionSuccess();
+    }
+};
+
+bool sameHit(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit)) == 0; }
+
+}  // namespace
+
+// With their own starts, and sharing one (the broadcast path).
+TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
+    forEachTarget([] {
+      for (const bool shareStart : {false, true}) {
+        SCOPED_TRACE(shareStart ? "rays share their start" : "rays start apart");
+        Random rng(11);
+        PartitionTally tally;
+        std::vector<Ray> rays(300);
+        std::vector<Hit> hits(rays.size(), missHit());
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            rays[i] = randomRay(rng);
+            if (shareStart && i > 0) {
+                rays[i].origin = rays[0].origin;
+                rays[i].tmin = rays[0].tmin;
+            }
+            if (rng.uniform() < 0.5) hits[i] = Hit{rng.uniform() < 0.2 ? 0.0f : rng.uniformFloat(0.0f, 4.0f), 1, 0, 0};
+        }
+        for (int trial = 0; trial < 400; ++trial) {
+            const Box cell = randomCell(rng);
+            const std::uint32_t count = std::uint32_t(rng.index(70));  // every tail length of every width
+            std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(rays.size()), count);
+            std::uint32_t expectedKept = 0;
+            const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
+                return shared::rayMayCrossCell(rays[id], cell.lo, cell.hi, hits[id].t);
+            });
+            std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
+            const std::uint32_t kept = simd::partitionRaysMayCrossCell(rays.data(), hits.data(), ids.data(), count, cell,
+                                                                       shareStart, scratch.data());
+            ASSERT_TRUE(tally.check(kept, expectedKept, ids, expected)) << "trial " << trial;
+        }
+        EXPECT_GT(tally.kept, 400u);  // both answers are common, so both are compared
+        EXPECT_GT(tally.rejected, 1000u);
+      }
+    });
+}
+
+// Children of a cell the triangles overlap: the one-face test answers boundsOverlap.
+TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCell) {
+    forEachTarget([] {
+        Random rng(14);
+        PartitionTally tally;
+        for (int trial = 0; trial < 300; ++trial) {
+            const Box parent = randomCell(rng);
+            std::vector<Bounds> bounds(200);
+            for (Bounds& b : bounds)
+                for (int a = 0; a < 3; ++a) {  // lo <= parent.hi and hi >= parent.lo: they overlap it
+                    b.lo[a] = std::min(adversarialCoordinate(rng), parent.hi[a]);
+                    b.hi[a] = std::max({b.lo[a], parent.lo[a], adversarialCoordinate(rng)});
+                }
+            const int axis = int(rng.index(3));
+            const bool lowSide = rng.uniform() < 0.5;
+            Box child = parent;
+            const float face = rng.uniform() < 0.3 ? bounds[rng.index(bounds.size())].lo[axis]
+                                                    : rng.uniformFloat(parent.lo[axis], parent.hi[axis]);
+            (lowSide ? child.hi : child.lo)[axis] = face;
+            const std::uint32_t count = std::uint32_t(rng.index(70));
+            std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(bounds.size()), count);
+            for (const Bounds& b : bounds) ASSERT_TRUE(shared::boundsOverlap(b.lo, b.hi, parent.lo, parent.hi));
+            std::uint32_t expectedKept = 0;
+            const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
+                return shared::boundsOverlap(bounds[id].lo, bounds[id].hi, child.lo, child.hi);
+            });
+            std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
+            const std::uint32_t kept =
+                simd::partitionTrianglesOnFace(bounds.data(), ids.data(), count, axis, lowSide, face, scratch.data());
+            ASSERT_TRUE(tally.check(kept, expectedKept, ids, expected)) << "trial " << trial;
+        }
+        EXPECT_GT(tally.kept, 1000u);
+        EXPECT_GT(tally.rejected, 1000u);
+    });
+}
+
+// Rays aimed at vertices and edges shared by neighbouring triangles, duplicated triangles
+// (equal t: the tie rule decides), degenerate ones, far offsets and grazing directions.
+TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
+    forEachTarget([] {
+        Random rng(13);
+        std::size_t hitsFound = 0, tiesOnDuplicates = 0;
+        for (int trial = 0; trial < 300; ++trial) {
+            const float scale = rng.uniform() < 0.3 ? 1e5f : 1.0f;
+            const glm::vec3 offset = rng.uniform() < 0.3 ? rng.vec3(-1e6f, 1e6f) : glm::vec3(0.0f);
+            std::vector<Triangle> tris(std::uint32_t(rng.index(90)) + 1);
+            // A fan around a shared vertex, so rays through it and along its edges meet several.
+            const glm::vec3 hub = offset + rng.vec3(-1.0f, 1.0f) * scale;
+            for (std::size_t i = 0; i < tris.size(); ++i) {
+                Triangle& t = tris[i];
+                if (i > 0 && rng.uniform() < 0.15) {
+                    t = tris[rng.index(i)];  // a duplicate under another id
+                    continue;
+                }
+                t.v0 = rng.uniform() < 0.6 ? hub : offset + rng.vec3(-1.0f, 1.0f) * scale;
+                t.v1 = offset + rng.vec3(-1.0f, 1.0f) * scale;
+                t.v2 = rng.uniform() < 0.1 ? t.v1 : offset + rng.vec3(-1.0f, 1.0f) * scale;  // some have no area
+                t.cullBackFace = rng.uniform() < 0.5 ? 1u : 0u;  // the face rule in half the lanes
+            }
+            std::vector<Ray> rays(40);
+            for (Ray& r : rays) {
+                const glm::vec3 eye = offset + rng.vec3(-3.0f, 3.0f) * scale;
+                const Triangle& aim = tris[rng.index(tris.size())];
+                const double pick = rng.uniform();
+                const glm::vec3 target = pick < 0.3 ? hub : (pick < 0.5 ? aim.v1 : (pick < 0.7 ? 0.5f * (aim.v0 + aim.v1) : aim.v2));
+                glm::dvec3 d = glm::dvec3(target) - glm::dvec3(eye);
+                if (glm::length(d) == 0.0) d = {0.0, 0.0, 1.0};
+                r = makeRay(eye, glm::normalize(d), rng.uniform() < 0.2 ? rng.uniformFloat(0.0f, 2.0f) * scale : 0.0f);
+            }
+            std::vector<std::uint32_t> triIds = shuffledIds(rng, std::uint32_t(tris.size()), std::uint32_t(tris.size()));
+            triIds.resize(std::min<std::size_t>(triIds.size(), simd::kLeafBatch));
+            std::vector<std::uint32_t> rayIds = shuffledIds(rng, std::uint32_t(rays.size()), std::uint32_t(rays.size()));
+            std::vector<Hit> expected(rays.size(), missHit()), got(rays.size(), missHit());
+            for (std::size_t i = 0; i < rays.size(); ++i)
+                if (rng.uniform() < 0.3) expected[i] = got[i] = Hit{rng.uniformFloat(0.0f, 5.0f) * scale, 7, 0.25f, 0.5f};
+            for (std::uint32_t id : rayIds)
+                for (std::uint32_t prim : triIds) testTriangle(rays[id], tris[prim], prim, expected[id]);
+            simd::LeafTriangles batch;
+            simd::gatherLeafTriangles(tris.data(), triIds.data(), std::uint32_t(triIds.size()), batch);
+            simd::intersectBatch(rays.data(), got.data(), rayIds.data(), std::uint32_t(rayIds.size()), batch);
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                if (expected[i].prim != kMissPrim && expected[i].prim != 7) ++hitsFound;
+                for (std::uint32_t prim : triIds)
+                    if (prim != expected[i].prim && expected[i].prim < tris.size() &&
+                        std::memcmp(&tris[prim], &tris[expected[i].prim], sizeof(Triangle)) == 0)
+                        ++tiesOnDuplicates;
+            }
+            for (std::size_t i = 0; i < rays.size(); ++i)
+                ASSERT_TRUE(sameHit(got[i], expected[i]))
+                    << "trial " << trial << " ray " << i << ": simd prim " << got[i].prim << " t " << got[i].t
+                    << ", scalar prim " << expected[i].prim << " t " << expected[i].t;
+        }
+        EXPECT_GT(hitsFound, 2000u);
+        EXPECT_GT(tiesOnDuplicates, 50u);  // the tie rule is exercised, not only distinct depths
+    });
+}
+
+// A packet's answer covers every one of its rays' answers (with no best hit yet), and it
+// still rejects: rays sharing a start, directions within a small cone, random cells.
+TEST(PacketFilter, NeverRejectsACellOneOfItsRaysMayCross) {
+    Random rng(15);
+    std::size_t rejected = 0, trials = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        const glm::vec3 origin{adversarialCoordinate(rng), adversarialCoordinate(rng), adversarialCoordinate(rng)};
+        const float tmin = rng.uniform() < 0.3 ? rng.uniformFloat(0.0f, 1.0f) : 0.0f;
+        const glm::dvec3 axis = rng.onSphere();
+        const double spread = rng.uniform() < 0.5 ? 0.05 : 0.5;
+        std::vector<Ray> rays(1 + rng.index(64));
+        for (Ray& r : rays) {
+            glm::dvec3 d = axis + spread * rng.onSphere();
+            for (int a = 0; a < 3; ++a)
+                if (rng.uniform() < 0.05) d[a] = 0.0;  // a component exactly 0: that axis goes unbounded
+            if (d == glm::dvec3(0.0)) d = axis;
+            r = makeRay(origin, d, tmin);
+        }
+        RayPacket p;
+        p.invLo = glm::vec3(kNoHitT);
+        p.invHi = glm::vec3(-kNoHitT);
+        for (const Ray& r : rays)
+            for (int a = 0; a < 3; ++a) {
+                if (r.invDir[a] == 0.0f) p.unboundedAxes |= 1u << a;
+                p.invLo[a] = std::min(p.invLo[a], r.invDir[a]);
+                p.invHi[a] = std::max(p.invHi[a], r.invDir[a]);
+            }
+        const Box cell = randomCell(rng);
+        bool anyRay = false;
+        for (const Ray& r : rays) anyRay |= shared::rayMayCrossCell(r, cell.lo, cell.hi, kNoHitT);
+        const bool packet = packetMayCrossCell(p, origin, tmin, cell);
+        if (anyRay) {
+            ASSERT_TRUE(packet) << "trial " << trial;
+        }
+        rejected += !packet;
+        ++trials;
+    }
+    EXPECT_GT(rejected, trials / 5) << "the packet test must reject cells, not only keep them";
+}
+
+TEST(SimdTargets, TheBestIsChosenByDefaultAndForcingAnUnknownOneIsAnError) {
+    simd::forceTarget("");
+    const std::vector<std::string> targets = simd::availableTargets();
+    ASSERT_FALSE(targets.empty());
+    EXPECT_EQ(simd::activeTarget(), targets.front());
+    EXPECT_THROW(simd::forceTarget("no-such-target"), std::invalid_argument);
+    simd::forceTarget("");
+    EXPECT_EQ(simd::activeTarget(), targets.front());
+}
+
+TEST_F(EveryTarget, FacingVerdictsNeverContradictTheFloat64Skip) {
+    // Triangles at every distance, size and slant (nearly edge-on ones, tiny and huge ones,
+    // some double-sided): a certified verdict is always facesAwayFrom's, and most are certified.
+    forEachTarget([] {
+        Random rng(5);
+        std::size_t certified = 0, dropped = 0, total = 0;
+        for (int round = 0; round < 40; ++round) {
+            const glm::vec3 origin = rng.vec3(-10.0f, 10.0f) * (round % 4 == 3 ? 1e6f : 1.0f);
+            std::vector<Triangle> tris(std::size_t(rng.index(200)) + 1);
+            for (Triangle& t : tris) {
+                const double distance = std::pow(10.0, rng.uniform(-12.0, 8.0));
+                const glm::dvec3 centre = glm::dvec3(origin) + distance * glm::normalize(rng.inBox(-1.0, 1.0) + 1e-9);
+                const double size = distance * std::pow(10.0, rng.uniform(-7.0, 0.5));
+                glm::dvec3 p[3];
+                for (glm::dvec3& q : p) q = centre + size * rng.inBox(-1.0, 1.0);
+                if (rng.uniform() < 0.3) {  // nearly edge-on from the origin
+                    const glm::dvec3 n = glm::normalize(glm::cross(centre - glm::dvec3(origin), p[1] - p[0]));
+                    const double squeeze = std::pow(10.0, rng.uniform(-9.0, -1.0));
+                    for (glm::dvec3& q : p) q -= (1.0 - squeeze) * glm::dot(q - glm::dvec3(origin), n) * n;
+                }
+                t.v0 = glm::vec3(p[0]);
+                t.v1 = glm::vec3(p[1]);
+                t.v2 = glm::vec3(p[2]);
+                t.cullBackFace = rng.uniform() < 0.9 ? 1u : 0u;
+            }
+            std::vector<std::uint8_t> verdict(tris.size(), 0xFF);
+            simd::classifyFacing(tris.data(), std::uint32_t(tris.size()), origin, verdict.data());
+            for (std::size_t i = 0; i < tris.size(); ++i) {
+                const bool away = tris[i].cullBackFace && facesAwayFrom(tris[i], glm::dvec3(origin));
+                ASSERT_NE(verdict[i], 0xFF) << "every verdict written";
+                if (verdict[i] == simd::kUndecided) continue;
+                ++certified;
+                dropped += away;
+                ASSERT_EQ(verdict[i] == simd::kDrop, away) << "round " << round << ", triangle " << i;
+            }
+            total += tris.size();
+        }
+        // This mix is mostly extreme on purpose (lengths down to 1e-12, edge-on slivers).
+        EXPECT_GT(certified, total * 4 / 10);
+        EXPECT_GT(dropped, total / 10);
+    });
+}
