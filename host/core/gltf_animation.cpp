@@ -63,6 +63,125 @@ std::size_t morphTargetsOf(const tinygltf::Model& model, const tinygltf::Node& n
     return mesh.primitives.empty() ? 0 : mesh.primitives.front().targets.size();
 }
 
+// How the channels read each sampler: the path they animate and the numbers per key (none:
+// no channel reads it).
+using SamplerUses = std::vector<std::optional<std::pair<AnimatedPath, std::size_t>>>;
+
+// The animation's channels, checked, and how they read its samplers (`use`). A sampler's width
+// is known from the channels that use it, so channels come first.
+std::vector<AnimationChannel> readChannels(const AccessorReader& reader, const tinygltf::Animation& source,
+                                           const std::string& where, SamplerUses& use, std::vector<std::string>& warnings) {
+    const tinygltf::Model& model = reader.model();
+    std::vector<AnimationChannel> channels;
+    for (std::size_t c = 0; c < source.channels.size(); ++c) {
+        const tinygltf::AnimationChannel& ch = source.channels[c];
+        const std::string w = where + " channel " + str(c);
+        if (ch.sampler < 0 || std::size_t(ch.sampler) >= source.samplers.size())
+            reader.fail(w + " names sampler " + std::to_string(ch.sampler) + ", which does not exist");
+        AnimatedPath path;
+        if (ch.target_path == "translation") path = AnimatedPath::Translation;
+        else if (ch.target_path == "rotation") path = AnimatedPath::Rotation;
+        else if (ch.target_path == "scale") path = AnimatedPath::Scale;
+        else if (ch.target_path == "weights") path = AnimatedPath::Weights;
+        else {
+            warnings.push_back(reader.name() + ": " + w + ": target path '" + ch.target_path + "' is not animated");
+            continue;
+        }
+        if (ch.target_node < 0) continue;  // the specification leaves such a channel to extensions
+        if (std::size_t(ch.target_node) >= model.nodes.size())
+            reader.fail(w + " targets node " + std::to_string(ch.target_node) + ", which does not exist");
+        const tinygltf::Node& node = model.nodes[std::size_t(ch.target_node)];
+        if (node.matrix.size() == 16)
+            reader.fail(w + " animates node " + std::to_string(ch.target_node) +
+                        ", which has a matrix (glTF animates translation, rotation and scale only)");
+        std::size_t width = path == AnimatedPath::Rotation ? 4 : 3;
+        if (path == AnimatedPath::Weights) {
+            width = morphTargetsOf(model, node);
+            if (width == 0)
+                reader.fail(w + " animates the weights of node " + std::to_string(ch.target_node) +
+                            ", whose mesh has no morph targets");
+        }
+        const std::size_t s = std::size_t(ch.sampler);
+        if (use[s] && (use[s]->second != width))
+            reader.fail(w + ": sampler " + str(s) + " is used for outputs of different sizes");
+        use[s] = std::make_pair(path, width);
+        channels.push_back({ch.target_node, path, s});
+    }
+    return channels;
+}
+
+// A sampler as its channels read it (`path`, `width` numbers per key): key times finite and
+// strictly increasing, as many finite values as the keys need.
+AnimationSampler readSampler(const AccessorReader& reader, const tinygltf::AnimationSampler& src, AnimatedPath path,
+                             std::size_t width, const std::string& w) {
+    AnimationSampler out;
+    out.width = width;
+    if (src.interpolation.empty() || src.interpolation == "LINEAR") out.interpolation = Interpolation::Linear;
+    else if (src.interpolation == "STEP") out.interpolation = Interpolation::Step;
+    else if (src.interpolation == "CUBICSPLINE") out.interpolation = Interpolation::CubicSpline;
+    else reader.fail(w + ": interpolation '" + src.interpolation + "' is none of STEP, LINEAR, CUBICSPLINE");
+    for (const glm::dvec4& v : reader.readVectors(src.input, {TINYGLTF_TYPE_SCALAR}, w + " input")) out.times.push_back(v.x);
+    if (out.times.empty()) reader.fail(w + ": the input accessor has no keys");
+    for (std::size_t k = 0; k < out.times.size(); ++k) {
+        if (!std::isfinite(out.times[k])) reader.fail(w + ": key " + str(k) + " has a non-finite time");
+        if (k > 0 && !(out.times[k] > out.times[k - 1]))
+            reader.fail(w + ": key times must increase strictly (key " + str(k) + " at " + std::to_string(out.times[k]) +
+                        " s follows " + std::to_string(out.times[k - 1]) + " s)");
+    }
+    const bool scalar = path == AnimatedPath::Weights;
+    const int type = scalar ? TINYGLTF_TYPE_SCALAR : out.width == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3;
+    const std::vector<glm::dvec4> values = reader.readVectors(src.output, {type}, w + " output");
+    const std::size_t perKey = (scalar ? out.width : 1) * (out.interpolation == Interpolation::CubicSpline ? 3 : 1);
+    if (values.size() != out.times.size() * perKey)
+        reader.fail(w + ": the output accessor has " + str(values.size()) + " elements; " + str(out.times.size()) +
+                    " keys need " + str(out.times.size() * perKey));
+    for (const glm::dvec4& v : values)
+        for (std::size_t c = 0; c < (scalar ? 1 : out.width); ++c) {
+            if (!std::isfinite(v[int(c)])) reader.fail(w + ": the output has a non-finite number");
+            out.values.push_back(v[int(c)]);
+        }
+    return out;
+}
+
+// Scales and rotations keyed as the file has them; a rotation key that is not a unit
+// quaternion (beyond the 1% the loader allows a node's rotation) is refused.
+void checkRotationKeys(const AccessorReader& reader, const Animation& anim, const std::string& where) {
+    for (const AnimationChannel& ch : anim.channels) {
+        if (ch.path != AnimatedPath::Rotation) continue;
+        const AnimationSampler& smp = anim.samplers[ch.sampler];
+        for (std::size_t i = 0; i + 3 < smp.values.size(); i += 4) {
+            const double len = std::sqrt(smp.values[i] * smp.values[i] + smp.values[i + 1] * smp.values[i + 1] +
+                                         smp.values[i + 2] * smp.values[i + 2] + smp.values[i + 3] * smp.values[i + 3]);
+            const bool tangent = smp.interpolation == Interpolation::CubicSpline && (i / 4) % 3 != 1;
+            if (!tangent && !(std::abs(len - 1.0) <= 1e-2))
+                reader.fail(where + ": sampler " + str(ch.sampler) + " rotates by a quaternion of length " +
+                            std::to_string(len) + ", not 1");
+        }
+    }
+}
+
+// Animation `a` of the file: its channels, the samplers they read, its start and end.
+Animation readAnimation(const AccessorReader& reader, std::size_t a, std::vector<std::string>& warnings) {
+    const tinygltf::Animation& source = reader.model().animations[a];
+    const std::string where = "animation " + str(a) + (source.name.empty() ? "" : " '" + source.name + "'");
+    Animation anim;
+    anim.name = source.name;
+    SamplerUses use(source.samplers.size());
+    anim.channels = readChannels(reader, source, where, use, warnings);
+    anim.samplers.resize(source.samplers.size());
+    bool any = false;
+    for (std::size_t s = 0; s < source.samplers.size(); ++s) {
+        if (!use[s]) continue;  // no channel reads it
+        AnimationSampler& sampler = anim.samplers[s];
+        sampler = readSampler(reader, source.samplers[s], use[s]->first, use[s]->second, where + " sampler " + str(s));
+        anim.start = any ? std::min(anim.start, sampler.times.front()) : sampler.times.front();
+        anim.end = any ? std::max(anim.end, sampler.times.back()) : sampler.times.back();
+        any = true;
+    }
+    checkRotationKeys(reader, anim, where);
+    return anim;
+}
+
 }  // namespace
 
 std::vector<double> sampleAt(const AnimationSampler& sampler, double t, bool quaternion) {
@@ -97,101 +216,8 @@ std::vector<double> sampleAt(const AnimationSampler& sampler, double t, bool qua
 }
 
 std::vector<Animation> readAnimations(const AccessorReader& reader, std::vector<std::string>& warnings) {
-    const tinygltf::Model& model = reader.model();
     std::vector<Animation> out;
-    for (std::size_t a = 0; a < model.animations.size(); ++a) {
-        const tinygltf::Animation& source = model.animations[a];
-        const std::string where = "animation " + str(a) + (source.name.empty() ? "" : " '" + source.name + "'");
-        Animation anim;
-        anim.name = source.name;
-        // A sampler's width is known from the channels that use it, so channels come first.
-        std::vector<std::optional<std::pair<AnimatedPath, std::size_t>>> use(source.samplers.size());
-        for (std::size_t c = 0; c < source.channels.size(); ++c) {
-            const tinygltf::AnimationChannel& ch = source.channels[c];
-            const std::string w = where + " channel " + str(c);
-            if (ch.sampler < 0 || std::size_t(ch.sampler) >= source.samplers.size())
-                reader.fail(w + " names sampler " + std::to_string(ch.sampler) + ", which does not exist");
-            AnimatedPath path;
-            if (ch.target_path == "translation") path = AnimatedPath::Translation;
-            else if (ch.target_path == "rotation") path = AnimatedPath::Rotation;
-            else if (ch.target_path == "scale") path = AnimatedPath::Scale;
-            else if (ch.target_path == "weights") path = AnimatedPath::Weights;
-            else {
-                warnings.push_back(reader.name() + ": " + w + ": target path '" + ch.target_path + "' is not animated");
-                continue;
-            }
-            if (ch.target_node < 0) continue;  // the specification leaves such a channel to extensions
-            if (std::size_t(ch.target_node) >= model.nodes.size())
-                reader.fail(w + " targets node " + std::to_string(ch.target_node) + ", which does not exist");
-            const tinygltf::Node& node = model.nodes[std::size_t(ch.target_node)];
-            if (node.matrix.size() == 16)
-                reader.fail(w + " animates node " + std::to_string(ch.target_node) +
-                            ", which has a matrix (glTF animates translation, rotation and scale only)");
-            std::size_t width = path == AnimatedPath::Rotation ? 4 : 3;
-            if (path == AnimatedPath::Weights) {
-                width = morphTargetsOf(model, node);
-                if (width == 0)
-                    reader.fail(w + " animates the weights of node " + std::to_string(ch.target_node) +
-                                ", whose mesh has no morph targets");
-            }
-            const std::size_t s = std::size_t(ch.sampler);
-            if (use[s] && (use[s]->second != width))
-                reader.fail(w + ": sampler " + str(s) + " is used for outputs of different sizes");
-            use[s] = std::make_pair(path, width);
-            anim.channels.push_back({ch.target_node, path, s});
-        }
-        anim.samplers.resize(source.samplers.size());
-        bool any = false;
-        for (std::size_t s = 0; s < source.samplers.size(); ++s) {
-            if (!use[s]) continue;  // no channel reads it
-            const tinygltf::AnimationSampler& src = source.samplers[s];
-            const std::string w = where + " sampler " + str(s);
-            AnimationSampler& out = anim.samplers[s];
-            out.width = use[s]->second;
-            if (src.interpolation.empty() || src.interpolation == "LINEAR") out.interpolation = Interpolation::Linear;
-            else if (src.interpolation == "STEP") out.interpolation = Interpolation::Step;
-            else if (src.interpolation == "CUBICSPLINE") out.interpolation = Interpolation::CubicSpline;
-            else reader.fail(w + ": interpolation '" + src.interpolation + "' is none of STEP, LINEAR, CUBICSPLINE");
-            for (const glm::dvec4& v : reader.readVectors(src.input, {TINYGLTF_TYPE_SCALAR}, w + " input")) out.times.push_back(v.x);
-            if (out.times.empty()) reader.fail(w + ": the input accessor has no keys");
-            for (std::size_t k = 0; k < out.times.size(); ++k) {
-                if (!std::isfinite(out.times[k])) reader.fail(w + ": key " + str(k) + " has a non-finite time");
-                if (k > 0 && !(out.times[k] > out.times[k - 1]))
-                    reader.fail(w + ": key times must increase strictly (key " + str(k) + " at " + std::to_string(out.times[k]) +
-                                " s follows " + std::to_string(out.times[k - 1]) + " s)");
-            }
-            const bool scalar = use[s]->first == AnimatedPath::Weights;
-            const int type = scalar ? TINYGLTF_TYPE_SCALAR : out.width == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3;
-            const std::vector<glm::dvec4> values = reader.readVectors(src.output, {type}, w + " output");
-            const std::size_t perKey = (scalar ? out.width : 1) * (out.interpolation == Interpolation::CubicSpline ? 3 : 1);
-            if (values.size() != out.times.size() * perKey)
-                reader.fail(w + ": the output accessor has " + str(values.size()) + " elements; " + str(out.times.size()) +
-                            " keys need " + str(out.times.size() * perKey));
-            for (const glm::dvec4& v : values)
-                for (std::size_t c = 0; c < (scalar ? 1 : out.width); ++c) {
-                    if (!std::isfinite(v[int(c)])) reader.fail(w + ": the output has a non-finite number");
-                    out.values.push_back(v[int(c)]);
-                }
-            anim.start = any ? std::min(anim.start, out.times.front()) : out.times.front();
-            anim.end = any ? std::max(anim.end, out.times.back()) : out.times.back();
-            any = true;
-        }
-        // Scales and rotations keyed as the file has them; a rotation key that is not a unit
-        // quaternion (beyond the 1% the loader allows a node's rotation) is refused.
-        for (const AnimationChannel& ch : anim.channels) {
-            if (ch.path != AnimatedPath::Rotation) continue;
-            const AnimationSampler& smp = anim.samplers[ch.sampler];
-            for (std::size_t i = 0; i + 3 < smp.values.size(); i += 4) {
-                const double len = std::sqrt(smp.values[i] * smp.values[i] + smp.values[i + 1] * smp.values[i + 1] +
-                                             smp.values[i + 2] * smp.values[i + 2] + smp.values[i + 3] * smp.values[i + 3]);
-                const bool tangent = smp.interpolation == Interpolation::CubicSpline && (i / 4) % 3 != 1;
-                if (!tangent && !(std::abs(len - 1.0) <= 1e-2))
-                    reader.fail(where + ": sampler " + str(ch.sampler) + " rotates by a quaternion of length " +
-                                std::to_string(len) + ", not 1");
-            }
-        }
-        out.push_back(std::move(anim));
-    }
+    for (std::size_t a = 0; a < reader.model().animations.size(); ++a) out.push_back(readAnimation(reader, a, warnings));
     return out;
 }
 

@@ -704,20 +704,63 @@ private:
         return out;
     }
 
+    // A primitive's shading inputs, each checked to hold one element per vertex (null where absent).
+    struct VertexShading {
+        const std::vector<glm::dvec4>* normals = nullptr;
+        const std::vector<glm::dvec4>* colors = nullptr;
+        const std::vector<glm::dvec4>* texCoords = nullptr;
+        bool colorHasAlpha = false;
+    };
+
+    // A primitive's vertices and normals in the mesh's space, morph targets' offsets weighted in.
+    struct MorphedVertices {
+        std::vector<glm::dvec3> positions;
+        std::vector<glm::dvec3> normals;
+    };
+
+    // A primitive's vertices placed in the world at this instant, with what the corners' normals
+    // and winding need: the normals before placing, and what placed each vertex (its skinning
+    // matrix when skinned, else the node's transform).
+    struct PlacedVertices {
+        std::vector<glm::vec3> worldPositions;
+        std::vector<glm::dvec3> localNormals;
+        bool skinned = false;
+        std::vector<glm::dmat4> skinning;
+        glm::dmat3 nodeNormalMatrix{1.0};
+        bool nodeMirrored = false;
+    };
+
+    // One primitive of a node's mesh into the scene: its triangles as placed at this instant.
     void addPrimitive(std::uint32_t node, std::uint32_t meshIndex, std::uint32_t primIndex,
                       const tinygltf::Primitive& prim, const glm::dmat4& world) {
         const std::string where = "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(primIndex);
         int mode = modeOf(prim);
+        const std::uint32_t material = primitiveMaterial(prim, where);
+        checkPositionType(prim, where);
+        const gltf::PrimitiveData& data = primitiveData(meshIndex, primIndex, prim, material, where);
+        if (data.trianglesListed) mode = TINYGLTF_MODE_TRIANGLES;
+        if (!data.attributes.count(kPosition)) check_.fail(where + ": no POSITION data");
+        const std::vector<std::uint32_t> corners = triangleCorners(mode, data, where);
+        const VertexShading shading = vertexShading(prim, data, material, where);
+        const PlacedVertices placed = placeVertices(node, meshIndex, prim, data, shading.normals, world, where);
+        addTriangles(TriangleSource{node, meshIndex, primIndex, 0}, material, corners, placed, shading, where);
+        touchTriangles(scene_);
+    }
+
+    // The primitive's material, the default one when it names none.
+    std::uint32_t primitiveMaterial(const tinygltf::Primitive& prim, const std::string& where) const {
         std::uint32_t material = defaultMaterial_;
         if (prim.material >= 0) {
             if (std::size_t(prim.material) >= model_.materials.size())
                 check_.fail(where + ": material " + std::to_string(prim.material) + " does not exist");
             material = std::uint32_t(prim.material);
         }
-        checkPositionType(prim, where);
-        const gltf::PrimitiveData& data = primitiveData(meshIndex, primIndex, prim, material, where);
-        if (data.trianglesListed) mode = TINYGLTF_MODE_TRIANGLES;
-        if (!data.attributes.count(kPosition)) check_.fail(where + ": no POSITION data");
+        return material;
+    }
+
+    // Three vertex indices per triangle, as TRIANGLES: an unindexed primitive's vertices in
+    // order, strips and fans unrolled.
+    std::vector<std::uint32_t> triangleCorners(int mode, const gltf::PrimitiveData& data, const std::string& where) const {
         const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
         std::vector<std::uint32_t> indices = data.indices;
         if (!data.indexed) {
@@ -736,24 +779,39 @@ private:
             }
         }
         if (corners.size() % 3 != 0) check_.fail(where + ": " + str(corners.size()) + " indices is not a multiple of 3");
+        return corners;
+    }
 
-        auto attribute = [&](const std::string& name) -> const std::vector<glm::dvec4>* {
-            auto it = data.attributes.find(name);
-            if (it == data.attributes.end()) return nullptr;
-            if (it->second.size() != positions.size())
-                check_.fail(where + ": " + name + " has " + str(it->second.size()) + " elements, POSITION has " + str(positions.size()));
-            return &it->second;
-        };
-        const std::vector<glm::dvec4>* normals = attribute(kNormal);
-        const std::vector<glm::dvec4>* colors = attribute(kColor);
+    // The primitive's attribute `name`, checked to hold one element per vertex; null when absent.
+    const std::vector<glm::dvec4>* vertexAttribute(const gltf::PrimitiveData& data, const std::string& name,
+                                                   const std::string& where) const {
+        const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
+        auto it = data.attributes.find(name);
+        if (it == data.attributes.end()) return nullptr;
+        if (it->second.size() != positions.size())
+            check_.fail(where + ": " + name + " has " + str(it->second.size()) + " elements, POSITION has " + str(positions.size()));
+        return &it->second;
+    }
+
+    VertexShading vertexShading(const tinygltf::Primitive& prim, const gltf::PrimitiveData& data, std::uint32_t material,
+                                const std::string& where) const {
+        VertexShading shading;
+        shading.normals = vertexAttribute(data, kNormal, where);
+        shading.colors = vertexAttribute(data, kColor, where);
         const TextureBinding& texture = scene_.materials[material].baseColorTexture;
-        const std::vector<glm::dvec4>* texCoords = texture.texture >= 0 ? attribute(texCoordName(texture.texCoord)) : nullptr;
-        const bool colorHasAlpha = colors && prim.attributes.count(kColor) &&
-                                   model_.accessors[std::size_t(prim.attributes.at(kColor))].type == TINYGLTF_TYPE_VEC4;
+        shading.texCoords = texture.texture >= 0 ? vertexAttribute(data, texCoordName(texture.texCoord), where) : nullptr;
+        shading.colorHasAlpha = shading.colors && prim.attributes.count(kColor) &&
+                                model_.accessors[std::size_t(prim.attributes.at(kColor))].type == TINYGLTF_TYPE_VEC4;
+        return shading;
+    }
 
-        // Morph targets first (offsets weighted in the mesh's space), then the skin or the node.
-        std::vector<glm::dvec3> local(positions.size());
-        std::vector<glm::dvec3> localNormals(normals ? positions.size() : 0);
+    MorphedVertices morphedVertices(std::uint32_t node, std::uint32_t meshIndex, const tinygltf::Primitive& prim,
+                                    const gltf::PrimitiveData& data, const std::vector<glm::dvec4>* normals,
+                                    const std::string& where) const {
+        const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
+        MorphedVertices morphed{std::vector<glm::dvec3>(positions.size()), std::vector<glm::dvec3>(normals ? positions.size() : 0)};
+        std::vector<glm::dvec3>& local = morphed.positions;
+        std::vector<glm::dvec3>& localNormals = morphed.normals;
         for (std::size_t i = 0; i < positions.size(); ++i) local[i] = glm::dvec3(positions[i]);
         for (std::size_t i = 0; i < localNormals.size(); ++i) localNormals[i] = glm::dvec3((*normals)[i]);
         if (!prim.targets.empty()) {
@@ -761,40 +819,57 @@ private:
                 morphWeights(node, model_.meshes[meshIndex], prim.targets.size(), "node " + std::to_string(node) + " " + where);
             for (std::size_t t = 0; t < weights.size(); ++t) {
                 if (weights[t] == 0.0) continue;
-                if (const auto* d = attribute("TARGET" + std::to_string(t) + ":" + kPosition))
+                if (const auto* d = vertexAttribute(data, "TARGET" + std::to_string(t) + ":" + kPosition, where))
                     for (std::size_t i = 0; i < local.size(); ++i) local[i] += weights[t] * glm::dvec3((*d)[i]);
-                if (const auto* d = attribute("TARGET" + std::to_string(t) + ":" + kNormal); d && normals)
+                if (const auto* d = vertexAttribute(data, "TARGET" + std::to_string(t) + ":" + kNormal, where); d && normals)
                     for (std::size_t i = 0; i < localNormals.size(); ++i) localNormals[i] += weights[t] * glm::dvec3((*d)[i]);
             }
         }
-        const int skin = model_.nodes[node].skin;
-        std::vector<glm::dmat4> skinning;
-        if (skin >= 0) skinning = vertexSkinning(data, jointMatrices(skin, where), positions.size(), where);
-        auto transformOf = [&](std::uint32_t vertex) -> const glm::dmat4& { return skin >= 0 ? skinning[vertex] : world; };
+        return morphed;
+    }
 
-        std::vector<glm::vec3> worldPositions(positions.size());
-        for (std::size_t i = 0; i < positions.size(); ++i) {
+    // Morph targets first (offsets weighted in the mesh's space), then the skin or the node.
+    PlacedVertices placeVertices(std::uint32_t node, std::uint32_t meshIndex, const tinygltf::Primitive& prim,
+                                 const gltf::PrimitiveData& data, const std::vector<glm::dvec4>* normals, const glm::dmat4& world,
+                                 const std::string& where) {
+        MorphedVertices morphed = morphedVertices(node, meshIndex, prim, data, normals, where);
+        const std::vector<glm::dvec3>& local = morphed.positions;
+        PlacedVertices placed;
+        const int skin = model_.nodes[node].skin;
+        placed.skinned = skin >= 0;
+        if (skin >= 0) placed.skinning = vertexSkinning(data, jointMatrices(skin, where), local.size(), where);
+        auto transformOf = [&](std::uint32_t vertex) -> const glm::dmat4& { return skin >= 0 ? placed.skinning[vertex] : world; };
+
+        placed.worldPositions.resize(local.size());
+        for (std::size_t i = 0; i < local.size(); ++i) {
             const glm::dvec3& p = local[i];
             if (!finite3(p))
                 check_.fail(where + ": vertex " + std::to_string(i) + " has a non-finite position (" + std::to_string(p.x) +
                             ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
-            worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(p, 1.0));
+            placed.worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(p, 1.0));
         }
-        const glm::dmat3 nodeNormalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
-        const bool nodeMirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+        placed.localNormals = std::move(morphed.normals);
+        placed.nodeNormalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+        placed.nodeMirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+        return placed;
+    }
 
+    // The primitive's triangles into the scene, front faces counter-clockwise, each with its
+    // provenance (`primitive`, numbered within it), material and corners' attributes.
+    void addTriangles(const TriangleSource& primitive, std::uint32_t material, const std::vector<std::uint32_t>& corners,
+                      const PlacedVertices& placed, const VertexShading& shading, const std::string& where) {
+        const std::size_t vertices = placed.worldPositions.size();
         const std::uint32_t cullBackFace = scene_.materials[material].doubleSided ? 0u : 1u;
-        CornerAttributes& out = scene_.corners;
         for (std::size_t t = 0; t * 3 < corners.size(); ++t) {
             for (int k = 0; k < 3; ++k)
-                if (corners[t * 3 + std::size_t(k)] >= positions.size())
+                if (corners[t * 3 + std::size_t(k)] >= vertices)
                     check_.fail(where + ": index " + std::to_string(corners[t * 3 + std::size_t(k)]) + " (triangle " +
-                                std::to_string(t) + ") is out of range for " + str(positions.size()) + " vertices");
+                                std::to_string(t) + ") is out of range for " + str(vertices) + " vertices");
             // glTF: a transform that mirrors (negative determinant) turns the triangles' winding
             // clockwise; swapping two corners keeps counter-clockwise the front. A skinned
             // triangle mirrors with its first corner's skinning.
             const bool mirrored =
-                skin >= 0 ? glm::determinant(glm::dmat3(skinning[corners[t * 3]])) < 0.0 : nodeMirrored;
+                placed.skinned ? glm::determinant(glm::dmat3(placed.skinning[corners[t * 3]])) < 0.0 : placed.nodeMirrored;
             const int order[3] = {0, mirrored ? 2 : 1, mirrored ? 1 : 2};
             Triangle tri{};
             tri.cullBackFace = cullBackFace;
@@ -802,7 +877,7 @@ private:
             std::uint32_t index[3];
             for (int k = 0; k < 3; ++k) {
                 index[k] = corners[t * 3 + std::size_t(order[k])];
-                *v[k] = worldPositions[index[k]];
+                *v[k] = placed.worldPositions[index[k]];
             }
             // Never hit, so never traced. (A non-finite vertex gives a non-zero cross product:
             // such a triangle stays, for validateScene to refuse.)
@@ -812,35 +887,42 @@ private:
             }
             const std::size_t at = scene_.triangles.size();
             scene_.triangles.push_back(tri);
-            scene_.sources.push_back(TriangleSource{node, meshIndex, primIndex, std::uint32_t(t)});
+            scene_.sources.push_back(TriangleSource{primitive.node, primitive.mesh, primitive.primitive, std::uint32_t(t)});
             scene_.materialOfTriangle.push_back(material);
-            if (normals || !out.normals.empty()) {
-                fillTo(out.normals, at + 1, glm::vec3(0.0f));
-                for (int k = 0; normals && k < 3; ++k) {
-                    const glm::dmat3 normalMatrix =
-                        skin >= 0 ? glm::transpose(glm::inverse(glm::dmat3(skinning[index[k]]))) : nodeNormalMatrix;
-                    const glm::dvec3 n = normalMatrix * localNormals[index[k]];
-                    const double length = glm::length(n);
-                    out.normals[at][std::size_t(k)] = length > 0.0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f);
-                }
-            }
-            if (colors || !out.colors.empty()) {
-                fillTo(out.colors, at + 1, glm::vec4(1.0f));
-                for (int k = 0; colors && k < 3; ++k) {
-                    glm::vec4 c((*colors)[index[k]]);
-                    if (!colorHasAlpha) c.a = 1.0f;
-                    out.colors[at][std::size_t(k)] = glm::clamp(c, 0.0f, 1.0f);
-                }
-            }
-            if (texCoords || !out.texCoords.empty()) {
-                fillTo(out.texCoords, at + 1, glm::vec2(0.0f));
-                for (int k = 0; texCoords && k < 3; ++k) {
-                    const glm::vec2 uv((*texCoords)[index[k]]);
-                    out.texCoords[at][std::size_t(k)] = std::isfinite(uv.x) && std::isfinite(uv.y) ? uv : glm::vec2(0.0f);
-                }
+            addCornerAttributes(at, index, placed, shading);
+        }
+    }
+
+    // Triangle `at`'s corners' normals, colours and texture coordinates (its vertices `index`);
+    // once any triangle has one of these, every triangle has it, with its default where absent.
+    void addCornerAttributes(std::size_t at, const std::uint32_t (&index)[3], const PlacedVertices& placed,
+                             const VertexShading& shading) {
+        CornerAttributes& out = scene_.corners;
+        if (shading.normals || !out.normals.empty()) {
+            fillTo(out.normals, at + 1, glm::vec3(0.0f));
+            for (int k = 0; shading.normals && k < 3; ++k) {
+                const glm::dmat3 normalMatrix =
+                    placed.skinned ? glm::transpose(glm::inverse(glm::dmat3(placed.skinning[index[k]]))) : placed.nodeNormalMatrix;
+                const glm::dvec3 n = normalMatrix * placed.localNormals[index[k]];
+                const double length = glm::length(n);
+                out.normals[at][std::size_t(k)] = length > 0.0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f);
             }
         }
-        touchTriangles(scene_);
+        if (shading.colors || !out.colors.empty()) {
+            fillTo(out.colors, at + 1, glm::vec4(1.0f));
+            for (int k = 0; shading.colors && k < 3; ++k) {
+                glm::vec4 c((*shading.colors)[index[k]]);
+                if (!shading.colorHasAlpha) c.a = 1.0f;
+                out.colors[at][std::size_t(k)] = glm::clamp(c, 0.0f, 1.0f);
+            }
+        }
+        if (shading.texCoords || !out.texCoords.empty()) {
+            fillTo(out.texCoords, at + 1, glm::vec2(0.0f));
+            for (int k = 0; shading.texCoords && k < 3; ++k) {
+                const glm::vec2 uv((*shading.texCoords)[index[k]]);
+                out.texCoords[at][std::size_t(k)] = std::isfinite(uv.x) && std::isfinite(uv.y) ? uv : glm::vec2(0.0f);
+            }
+        }
     }
 
     void takeInventory(int sceneIndex) {

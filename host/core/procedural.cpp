@@ -130,80 +130,91 @@ Scene sceneFromMeshes(const std::vector<Mesh>& meshes, const std::string& name) 
     return s;
 }
 
+namespace {
+
+// One buffer view and one accessor over `count` elements appended to the buffer; the accessor's index.
+int addAccessor(tinygltf::Model& model, tinygltf::Buffer& buffer, const void* data, std::size_t count, std::size_t elementBytes,
+                int target, int componentType, int type) {
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = buffer.data.size();
+    view.byteLength = count * elementBytes;
+    view.target = target;
+    buffer.data.resize(view.byteOffset + view.byteLength);
+    std::memcpy(buffer.data.data() + view.byteOffset, data, view.byteLength);
+    model.bufferViews.push_back(view);
+    tinygltf::Accessor accessor;
+    accessor.bufferView = int(model.bufferViews.size() - 1);
+    accessor.componentType = componentType;
+    accessor.type = type;
+    accessor.count = count;
+    model.accessors.push_back(accessor);
+    return int(model.accessors.size() - 1);
+}
+
+// The mesh as a node of the scene: one primitive with its own material.
+void addMesh(tinygltf::Model& model, tinygltf::Buffer& buffer, tinygltf::Scene& scene, const Mesh& m) {
+    glm::vec3 lo(kNoHitT), hi(-kNoHitT);
+    for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    const int positions = addAccessor(model, buffer, m.positions.data(), m.positions.size(), sizeof(glm::vec3),
+                                      TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3);
+    model.accessors[std::size_t(positions)].minValues = {lo.x, lo.y, lo.z};
+    model.accessors[std::size_t(positions)].maxValues = {hi.x, hi.y, hi.z};
+    const int indices = addAccessor(model, buffer, m.indices.data(), m.indices.size(), 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
+                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR);
+
+    tinygltf::Material mat;
+    mat.name = m.name;
+    mat.pbrMetallicRoughness.baseColorFactor = {m.color.r, m.color.g, m.color.b, m.color.a};
+    mat.doubleSided = m.doubleSided;
+    model.materials.push_back(mat);
+    tinygltf::Primitive prim;
+    prim.attributes["POSITION"] = positions;
+    prim.indices = indices;
+    prim.material = int(model.materials.size() - 1);
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    tinygltf::Mesh mesh;
+    mesh.name = m.name;
+    mesh.primitives.push_back(prim);
+    model.meshes.push_back(mesh);
+    tinygltf::Node node;
+    node.name = m.name;
+    node.mesh = int(model.meshes.size() - 1);
+    model.nodes.push_back(node);
+    scene.nodes.push_back(int(model.nodes.size() - 1));
+}
+
+// The camera as the scene's camera 0, on a node of its own.
+void addCamera(tinygltf::Model& model, tinygltf::Scene& scene, const SceneCamera& camera) {
+    tinygltf::Camera cam;
+    cam.type = "perspective";
+    cam.perspective.yfov = camera.yfovRadians;
+    cam.perspective.znear = 0.01;
+    model.cameras.push_back(cam);
+    // The camera node's rotation maps the glTF camera frame (-z forward, +y up) onto ours.
+    const glm::dvec3 back = -glm::normalize(camera.forward);
+    const glm::dvec3 right = glm::normalize(glm::cross(camera.up, back));
+    const glm::dvec3 up = glm::cross(back, right);
+    const glm::dquat q = glm::quat_cast(glm::dmat3(right, up, back));
+    tinygltf::Node node;
+    node.name = "camera";
+    node.camera = 0;
+    node.translation = {camera.eye.x, camera.eye.y, camera.eye.z};
+    node.rotation = {q.x, q.y, q.z, q.w};
+    model.nodes.push_back(node);
+    scene.nodes.push_back(int(model.nodes.size() - 1));
+}
+
+}  // namespace
+
 void writeGltf(const std::string& path, const std::vector<Mesh>& meshes, const std::optional<SceneCamera>& camera) {
     tinygltf::Model model;
     model.asset.version = "2.0";
     model.asset.generator = "dacrt";
     tinygltf::Buffer buffer;
     tinygltf::Scene scene;
-    // One buffer view and one accessor over `count` elements appended to the buffer.
-    auto addAccessor = [&](const void* data, std::size_t count, std::size_t elementBytes, int target,
-                           int componentType, int type) {
-        tinygltf::BufferView view;
-        view.buffer = 0;
-        view.byteOffset = buffer.data.size();
-        view.byteLength = count * elementBytes;
-        view.target = target;
-        buffer.data.resize(view.byteOffset + view.byteLength);
-        std::memcpy(buffer.data.data() + view.byteOffset, data, view.byteLength);
-        model.bufferViews.push_back(view);
-        tinygltf::Accessor accessor;
-        accessor.bufferView = int(model.bufferViews.size() - 1);
-        accessor.componentType = componentType;
-        accessor.type = type;
-        accessor.count = count;
-        model.accessors.push_back(accessor);
-        return int(model.accessors.size() - 1);
-    };
-    for (const Mesh& m : meshes) {
-        glm::vec3 lo(kNoHitT), hi(-kNoHitT);
-        for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-        const int positions = addAccessor(m.positions.data(), m.positions.size(), sizeof(glm::vec3),
-                                          TINYGLTF_TARGET_ARRAY_BUFFER, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3);
-        model.accessors[std::size_t(positions)].minValues = {lo.x, lo.y, lo.z};
-        model.accessors[std::size_t(positions)].maxValues = {hi.x, hi.y, hi.z};
-        const int indices = addAccessor(m.indices.data(), m.indices.size(), 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER,
-                                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR);
-
-        tinygltf::Material mat;
-        mat.name = m.name;
-        mat.pbrMetallicRoughness.baseColorFactor = {m.color.r, m.color.g, m.color.b, m.color.a};
-        mat.doubleSided = m.doubleSided;
-        model.materials.push_back(mat);
-        tinygltf::Primitive prim;
-        prim.attributes["POSITION"] = positions;
-        prim.indices = indices;
-        prim.material = int(model.materials.size() - 1);
-        prim.mode = TINYGLTF_MODE_TRIANGLES;
-        tinygltf::Mesh mesh;
-        mesh.name = m.name;
-        mesh.primitives.push_back(prim);
-        model.meshes.push_back(mesh);
-        tinygltf::Node node;
-        node.name = m.name;
-        node.mesh = int(model.meshes.size() - 1);
-        model.nodes.push_back(node);
-        scene.nodes.push_back(int(model.nodes.size() - 1));
-    }
-    if (camera) {
-        tinygltf::Camera cam;
-        cam.type = "perspective";
-        cam.perspective.yfov = camera->yfovRadians;
-        cam.perspective.znear = 0.01;
-        model.cameras.push_back(cam);
-        // The camera node's rotation maps the glTF camera frame (-z forward, +y up) onto ours.
-        const glm::dvec3 back = -glm::normalize(camera->forward);
-        const glm::dvec3 right = glm::normalize(glm::cross(camera->up, back));
-        const glm::dvec3 up = glm::cross(back, right);
-        const glm::dquat q = glm::quat_cast(glm::dmat3(right, up, back));
-        tinygltf::Node node;
-        node.name = "camera";
-        node.camera = 0;
-        node.translation = {camera->eye.x, camera->eye.y, camera->eye.z};
-        node.rotation = {q.x, q.y, q.z, q.w};
-        model.nodes.push_back(node);
-        scene.nodes.push_back(int(model.nodes.size() - 1));
-    }
+    for (const Mesh& m : meshes) addMesh(model, buffer, scene, m);
+    if (camera) addCamera(model, scene, *camera);
     model.buffers.push_back(buffer);
     model.scenes.push_back(scene);
     model.defaultScene = 0;

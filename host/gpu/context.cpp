@@ -67,6 +67,70 @@ VkInstance createInstance(bool validate) {
     return instance;
 }
 
+// Each memory heap as "N MiB", marked where device-local.
+std::vector<std::string> memoryHeaps(VkPhysicalDevice d) {
+    std::vector<std::string> heaps;
+    VkPhysicalDeviceMemoryProperties memory;
+    vkGetPhysicalDeviceMemoryProperties(d, &memory);
+    for (std::uint32_t h = 0; h < memory.memoryHeapCount; ++h)
+        heaps.push_back(std::to_string(memory.memoryHeaps[h].size >> 20) + " MiB" +
+                        (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT ? " (device-local)" : ""));
+    return heaps;
+}
+
+std::vector<VkExtensionProperties> deviceExtensions(VkPhysicalDevice d) {
+    std::uint32_t extensionCount = 0;
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, nullptr));
+    std::vector<VkExtensionProperties> extensions(extensionCount);
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, extensions.data()));
+    return extensions;
+}
+
+bool hasExtension(const std::vector<VkExtensionProperties>& extensions, const char* name) {
+    return std::any_of(extensions.begin(), extensions.end(),
+                       [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+// What the device lacks of what the rayquery backend needs (Vulkan 1.2, kRayQueryExtensions
+// and their features); empty when it has everything.
+std::vector<std::string> rayQueryMissing(VkPhysicalDevice d, std::uint32_t apiVersion,
+                                         const std::vector<VkExtensionProperties>& extensions) {
+    std::vector<std::string> missing;
+    if (apiVersion < VK_API_VERSION_1_2) missing.push_back("Vulkan 1.2");
+    for (const char* e : kRayQueryExtensions)
+        if (!hasExtension(extensions, e)) missing.push_back(e);
+    if (missing.empty()) {
+        VkPhysicalDeviceRayQueryFeaturesKHR rq{};
+        rq.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
+        VkPhysicalDeviceAccelerationStructureFeaturesKHR as{};
+        as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+        as.pNext = &rq;
+        VkPhysicalDeviceBufferDeviceAddressFeatures bda{};
+        bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
+        bda.pNext = &as;
+        VkPhysicalDeviceFeatures2 features{};
+        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+        features.pNext = &bda;
+        vkGetPhysicalDeviceFeatures2(d, &features);
+        if (!rq.rayQuery) missing.push_back("the rayQuery feature");
+        if (!as.accelerationStructure) missing.push_back("the accelerationStructure feature");
+        if (!bda.bufferDeviceAddress) missing.push_back("the bufferDeviceAddress feature");
+    }
+    return missing;
+}
+
+// Whether the device can promise full subgroups to a compute shader (it has
+// VK_EXT_subgroup_size_control; this asks for the feature).
+bool computeFullSubgroups(VkPhysicalDevice d) {
+    VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
+    control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    features.pNext = &control;
+    vkGetPhysicalDeviceFeatures2(d, &features);
+    return control.computeFullSubgroups == VK_TRUE;
+}
+
 DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     VkPhysicalDeviceDriverProperties driver{};
     driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
@@ -91,11 +155,7 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     info.driver = hasDriverProps ? std::string(driver.driverName) + " " + driver.driverInfo
                                  : "driver version " + std::to_string(props.properties.driverVersion);
     info.apiVersion = apiString(props.properties.apiVersion);
-    VkPhysicalDeviceMemoryProperties memory;
-    vkGetPhysicalDeviceMemoryProperties(d, &memory);
-    for (std::uint32_t h = 0; h < memory.memoryHeapCount; ++h)
-        info.heaps.push_back(std::to_string(memory.memoryHeaps[h].size >> 20) + " MiB" +
-                             (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT ? " (device-local)" : ""));
+    info.heaps = memoryHeaps(d);
     info.maxStorageBufferRange = l.maxStorageBufferRange;
     info.maxMemoryAllocationSize = maintenance3.maxMemoryAllocationSize;
     info.maxComputeSharedMemorySize = l.maxComputeSharedMemorySize;
@@ -109,49 +169,12 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     info.subgroupOperations = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
                               (subgroup.supportedOperations & needed) == needed;
     info.timestamps = l.timestampComputeAndGraphics && l.timestampPeriod > 0.0f;
-    std::uint32_t extensionCount = 0;
-    VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, nullptr));
-    std::vector<VkExtensionProperties> extensions(extensionCount);
-    VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, extensions.data()));
-    auto hasExtension = [&](const char* name) {
-        return std::any_of(extensions.begin(), extensions.end(),
-                           [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
-    };
-    const bool sizeControl = hasExtension(VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
-    {
-        std::vector<std::string> missing;
-        if (basic.apiVersion < VK_API_VERSION_1_2) missing.push_back("Vulkan 1.2");
-        for (const char* e : kRayQueryExtensions)
-            if (!hasExtension(e)) missing.push_back(e);
-        if (missing.empty()) {
-            VkPhysicalDeviceRayQueryFeaturesKHR rq{};
-            rq.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
-            VkPhysicalDeviceAccelerationStructureFeaturesKHR as{};
-            as.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
-            as.pNext = &rq;
-            VkPhysicalDeviceBufferDeviceAddressFeatures bda{};
-            bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
-            bda.pNext = &as;
-            VkPhysicalDeviceFeatures2 features{};
-            features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-            features.pNext = &bda;
-            vkGetPhysicalDeviceFeatures2(d, &features);
-            if (!rq.rayQuery) missing.push_back("the rayQuery feature");
-            if (!as.accelerationStructure) missing.push_back("the accelerationStructure feature");
-            if (!bda.bufferDeviceAddress) missing.push_back("the bufferDeviceAddress feature");
-        }
-        info.rayQuery = missing.empty();
-        for (std::size_t i = 0; i < missing.size(); ++i) info.rayQueryMissing += (i ? ", " : "") + missing[i];
-    }
-    if (sizeControl) {
-        VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
-        control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
-        VkPhysicalDeviceFeatures2 features{};
-        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-        features.pNext = &control;
-        vkGetPhysicalDeviceFeatures2(d, &features);
-        info.fullSubgroups = control.computeFullSubgroups == VK_TRUE;
-    }
+    const std::vector<VkExtensionProperties> extensions = deviceExtensions(d);
+    const bool sizeControl = hasExtension(extensions, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
+    const std::vector<std::string> missing = rayQueryMissing(d, basic.apiVersion, extensions);
+    info.rayQuery = missing.empty();
+    for (std::size_t i = 0; i < missing.size(); ++i) info.rayQueryMissing += (i ? ", " : "") + missing[i];
+    if (sizeControl) info.fullSubgroups = computeFullSubgroups(d);
     return info;
 }
 
@@ -222,32 +245,117 @@ struct Context::Messages {
     std::mutex mutex;
     std::uint32_t errors = 0;
     std::vector<std::string> text;
+
+    // The debug messenger's callback (`user` is the Messages): counts the errors, keeps every message.
+    static VKAPI_ATTR VkBool32 VKAPI_CALL record(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+                                                 const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+        auto* m = static_cast<Messages*>(user);
+        std::lock_guard<std::mutex> lock(m->mutex);
+        const bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+        if (error) ++m->errors;
+        m->text.push_back(std::string(error ? "error: " : "warning: ") + (data->pMessage ? data->pMessage : ""));
+        return VK_FALSE;
+    }
 };
+
+namespace {
+
+// Validation's errors and warnings, passed to `callback` with `user`.
+void createMessenger(VkInstance instance, PFN_vkDebugUtilsMessengerCallbackEXT callback, void* user,
+                     VkDebugUtilsMessengerEXT& messenger) {
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    if (!create) throw InputError("Vulkan validation was asked for, but VK_EXT_debug_utils is unavailable");
+    VkDebugUtilsMessengerCreateInfoEXT info{};
+    info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+    info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    info.pfnUserCallback = callback;
+    info.pUserData = user;
+    VK_CHECK(create(instance, &info, nullptr, &messenger));
+}
+
+// The first queue family that computes. A family without timestamps turns the device's
+// (`info.timestamps`) off.
+std::uint32_t computeQueueFamily(VkPhysicalDevice physical, DeviceInfo& info) {
+    std::uint32_t familyCount = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(physical, &familyCount, nullptr);
+    std::vector<VkQueueFamilyProperties> families(familyCount);
+    vkGetPhysicalDeviceQueueFamilyProperties(physical, &familyCount, families.data());
+    std::uint32_t queueFamily = 0;
+    bool found = false;
+    for (std::uint32_t f = 0; f < familyCount && !found; ++f)
+        if (families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) queueFamily = f, found = true;
+    if (!found) throw InputError("device '" + info.name + "' has no compute queue");
+    if (families[queueFamily].timestampValidBits == 0) info.timestamps = false;
+    return queueFamily;
+}
+
+// The logical device with one queue of `queueFamily`, and the extensions and features `info`
+// says the device has and dacrt uses.
+void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const DeviceInfo& info, VkDevice& device) {
+    const float priority = 1.0f;
+    VkDeviceQueueCreateInfo queueInfo{};
+    queueInfo.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+    queueInfo.queueFamilyIndex = queueFamily;
+    queueInfo.queueCount = 1;
+    queueInfo.pQueuePriorities = &priority;
+    VkDeviceCreateInfo deviceInfo{};
+    deviceInfo.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+    deviceInfo.queueCreateInfoCount = 1;
+    deviceInfo.pQueueCreateInfos = &queueInfo;
+    // The kernel's subgroups must be full (leaves shuffle triangles across all lanes):
+    // requested where the device can promise it; elsewhere the workgroup size stays a
+    // multiple of the subgroup size, which every driver known to us fills.
+    std::vector<const char*> enabled;
+    void* chain = nullptr;
+    VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
+    control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
+    if (info.fullSubgroups) {
+        control.computeFullSubgroups = VK_TRUE;
+        control.pNext = chain;
+        chain = &control;
+        enabled.push_back(VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
+    }
+    // Ray query where the device has it: the rayquery backend builds acceleration
+    // structures from device addresses and traces them from a compute shader.
+    VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{};
+    rayQuery.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{};
+    accel.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+    VkPhysicalDeviceBufferDeviceAddressFeatures addresses{};
+    addresses.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
+    if (info.rayQuery) {
+        rayQuery.rayQuery = VK_TRUE;
+        accel.accelerationStructure = VK_TRUE;
+        addresses.bufferDeviceAddress = VK_TRUE;
+        rayQuery.pNext = chain;
+        accel.pNext = &rayQuery;
+        addresses.pNext = &accel;
+        chain = &addresses;
+        for (const char* e : kRayQueryExtensions) enabled.push_back(e);
+    }
+    deviceInfo.pNext = chain;
+    deviceInfo.enabledExtensionCount = std::uint32_t(enabled.size());
+    deviceInfo.ppEnabledExtensionNames = enabled.data();
+    VK_CHECK(vkCreateDevice(physical, &deviceInfo, nullptr, &device));
+}
+
+void createCommandPool(VkDevice device, std::uint32_t queueFamily, VkCommandPool& commandPool) {
+    VkCommandPoolCreateInfo poolInfo{};
+    poolInfo.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    poolInfo.queueFamilyIndex = queueFamily;
+    VK_CHECK(vkCreateCommandPool(device, &poolInfo, nullptr, &commandPool));
+}
+
+}  // namespace
 
 Context::Context(const ContextOptions& options) : messages_(std::make_unique<Messages>()) {
     instance_ = createInstance(options.validate);
     try {
-        if (options.validate) {
-            auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-                vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-            if (!create) throw InputError("Vulkan validation was asked for, but VK_EXT_debug_utils is unavailable");
-            VkDebugUtilsMessengerCreateInfoEXT info{};
-            info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
-            info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
-            info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                               VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-            info.pfnUserCallback = [](VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
-                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) -> VkBool32 {
-                auto* m = static_cast<Messages*>(user);
-                std::lock_guard<std::mutex> lock(m->mutex);
-                const bool error = severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-                if (error) ++m->errors;
-                m->text.push_back(std::string(error ? "error: " : "warning: ") + (data->pMessage ? data->pMessage : ""));
-                return VK_FALSE;
-            };
-            info.pUserData = messages_.get();
-            VK_CHECK(create(instance_, &info, nullptr, &messenger_));
-        }
+        if (options.validate) createMessenger(instance_, &Messages::record, messages_.get(), messenger_);
 
         const std::vector<VkPhysicalDevice> devices = physicalDevices(instance_);
         std::vector<DeviceInfo> infos;
@@ -256,69 +364,10 @@ Context::Context(const ContextOptions& options) : messages_(std::make_unique<Mes
         physical_ = devices[chosen];
         info_ = infos[chosen];
 
-        std::uint32_t familyCount = 0;
-        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, nullptr);
-        std::vector<VkQueueFamilyProperties> families(familyCount);
-        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &familyCount, families.data());
-        bool found = false;
-        for (std::uint32_t f = 0; f < familyCount && !found; ++f)
-            if (families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) queueFamily_ = f, found = true;
-        if (!found) throw InputError("device '" + info_.name + "' has no compute queue");
-        if (families[queueFamily_].timestampValidBits == 0) info_.timestamps = false;
-
-        const float priority = 1.0f;
-        VkDeviceQueueCreateInfo queueInfo{};
-        queueInfo.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
-        queueInfo.queueFamilyIndex = queueFamily_;
-        queueInfo.queueCount = 1;
-        queueInfo.pQueuePriorities = &priority;
-        VkDeviceCreateInfo deviceInfo{};
-        deviceInfo.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
-        deviceInfo.queueCreateInfoCount = 1;
-        deviceInfo.pQueueCreateInfos = &queueInfo;
-        // The kernel's subgroups must be full (leaves shuffle triangles across all lanes):
-        // requested where the device can promise it; elsewhere the workgroup size stays a
-        // multiple of the subgroup size, which every driver known to us fills.
-        std::vector<const char*> enabled;
-        void* chain = nullptr;
-        VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
-        control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
-        if (info_.fullSubgroups) {
-            control.computeFullSubgroups = VK_TRUE;
-            control.pNext = chain;
-            chain = &control;
-            enabled.push_back(VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
-        }
-        // Ray query where the device has it: the rayquery backend builds acceleration
-        // structures from device addresses and traces them from a compute shader.
-        VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{};
-        rayQuery.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
-        VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{};
-        accel.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
-        VkPhysicalDeviceBufferDeviceAddressFeatures addresses{};
-        addresses.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
-        if (info_.rayQuery) {
-            rayQuery.rayQuery = VK_TRUE;
-            accel.accelerationStructure = VK_TRUE;
-            addresses.bufferDeviceAddress = VK_TRUE;
-            rayQuery.pNext = chain;
-            accel.pNext = &rayQuery;
-            addresses.pNext = &accel;
-            chain = &addresses;
-            for (const char* e : kRayQueryExtensions) enabled.push_back(e);
-        }
-        deviceInfo.pNext = chain;
-        deviceInfo.enabledExtensionCount = std::uint32_t(enabled.size());
-        deviceInfo.ppEnabledExtensionNames = enabled.data();
-        VK_CHECK(vkCreateDevice(physical_, &deviceInfo, nullptr, &device_));
+        queueFamily_ = computeQueueFamily(physical_, info_);
+        createDevice(physical_, queueFamily_, info_, device_);
         vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
-
-        VkCommandPoolCreateInfo poolInfo{};
-
-        poolInfo.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
-        poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-        poolInfo.queueFamilyIndex = queueFamily_;
-        VK_CHECK(vkCreateCommandPool(device_, &poolInfo, nullptr, &commandPool_));
+        createCommandPool(device_, queueFamily_, commandPool_);
 
         VkPhysicalDeviceProperties p;
         vkGetPhysicalDeviceProperties(physical_, &p);
