@@ -77,13 +77,6 @@ constexpr std::uint32_t kPacketFlushDefault = 16;
 constexpr std::uint64_t kSequentialBelowRays = 16384;
 constexpr std::uint64_t kSequentialBelowPairs = std::uint64_t(1) << 28;
 
-// How cpu and cpu-seq give rays without a common near side (ChildOrder::PerRay) their
-// front-to-back order: each split classifies its live rays by the sign of their direction
-// (the default), or each work item first groups them by direction octant and traces each
-// group with the near side its signs give (measured against each other by
-// tools/bench/secondary_order.cpp: docs/secondary-rays.md).
-enum class RayOrder { PerSplit, Octants };
-
 struct DacrtOptions {
     std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default
     std::uint32_t triLimit = 0;    // a node with fewer triangles is a leaf; 0: the backend's default
@@ -96,7 +89,6 @@ struct DacrtOptions {
     // the recursion, one by one below; the SIMD path of rays that share their start only.
     bool packets = true;
     std::uint32_t packetFlush = 0;  // a node with fewer packets goes on ray by ray; 0: the default
-    RayOrder rayOrder = RayOrder::PerSplit;
 
     // These options with the leaf limits of `backend` filled in where they are 0.
     DacrtOptions resolvedFor(Backend backend) const {

@@ -1,7 +1,6 @@
 #include "cpu/traversal.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <utility>
 
 #include "cpu/option_predicates.hpp"
@@ -114,8 +113,6 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
     const std::uint32_t crossing = filterRays(widen(box, margin_), terminated, rayEnd);
     if (packets_)
         tracePackets(box, terminated, crossing, triBegin, triEnd);
-    else if (order_ == ChildOrder::PerRay && options_.rayOrder == RayOrder::Octants)
-        traceOctants(box, terminated, crossing, triBegin, triEnd);
     else
         node(box, terminated, crossing, triBegin, triEnd, 0, 0);
     if (retire.axis < 0) return crossing;
@@ -134,30 +131,6 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
         }
     }
     return crossing;
-}
-
-// RayOrder::Octants: the live rays of each direction octant in turn, moved to the front of the
-// live range and traced with the near side their signs share (ChildOrder::NearSide); rays of
-// earlier octants that stay live wait behind them, as any unfinished ray does.
-void DacrtTraversal::traceOctants(const Box& box, std::uint32_t& terminated, std::uint32_t crossing,
-                                  std::uint32_t triBegin, std::uint32_t triEnd) {
-    auto octantOf = [&](std::uint32_t id) {
-        const glm::vec3& d = rays_[id].dir;
-        return (d.x < 0.0f ? 1u : 0u) | (d.y < 0.0f ? 2u : 0u) | (d.z < 0.0f ? 4u : 0u);
-    };
-    const ChildOrder order = order_;
-    const glm::vec3 point = orderPoint_;
-    order_ = ChildOrder::NearSide;
-    for (std::uint32_t octant = 0; octant < 8; ++octant) {
-        std::uint32_t* groupEnd = std::partition(rayIds_ + terminated, rayIds_ + crossing,
-                                                 [&](std::uint32_t id) { return octantOf(id) == octant; });
-        if (groupEnd == rayIds_ + terminated) continue;
-        for (int a = 0; a < 3; ++a)
-            orderPoint_[a] = (octant >> a) & 1u ? std::numeric_limits<float>::max() : -std::numeric_limits<float>::max();
-        node(box, terminated, std::uint32_t(groupEnd - rayIds_), triBegin, triEnd, 0, 0);
-    }
-    order_ = order;
-    orderPoint_ = point;
 }
 
 [[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {

@@ -112,8 +112,6 @@ private:
     std::uint32_t filterRaysMoving(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving);
     void tracePackets(const Box& box, std::uint32_t& terminated, std::uint32_t crossing, std::uint32_t triBegin,
                       std::uint32_t triEnd);
-    void traceOctants(const Box& box, std::uint32_t& terminated, std::uint32_t crossing, std::uint32_t triBegin,
-                      std::uint32_t triEnd);
     std::uint32_t buildPackets(std::uint32_t begin, std::uint32_t end);
     void nodePackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,
                      std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);

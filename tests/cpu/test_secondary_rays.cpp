@@ -218,10 +218,6 @@ void expectPassAgrees(const PassFrame& pass, bool closest) {
                                                                                << threads << " threads";
     for (DivisionAxis axis : {DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z})
         EXPECT_TRUE(same(pass.trace(Backend::Cpu, 3, 2, axis).hits)) << "cpu along axis " << int(axis) - 1;
-    DacrtOptions octants;
-    octants.rayOrder = RayOrder::Octants;
-    EXPECT_TRUE(same(pass.trace(Backend::CpuSeq, 0, 1, DivisionAxis::Best, octants).hits)) << "cpu-seq by octants";
-    EXPECT_TRUE(same(pass.trace(Backend::Cpu, 4, 2, DivisionAxis::Best, octants).hits)) << "cpu by octants";
 }
 
 }  // namespace
