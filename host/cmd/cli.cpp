@@ -21,6 +21,7 @@
 #include "core/atomic_file.hpp"
 #include "core/cpu_model.hpp"
 #include "core/errors.hpp"
+#include "cpu/backend_options.hpp"
 #include "cpu/simd_kernels.hpp"
 #include "gpu/context.hpp"
 #include "gpu/vulkan_error.hpp"
@@ -90,29 +91,34 @@ CLI::Option* addBackendListOption(CLI::App* cmd, const std::string& flags, std::
 
 std::vector<std::string> dacrtBackendNames() { return {"brute", "cpu-seq", "cpu", "gpu"}; }
 
-// The DACRT options that render and bench share.
+// The DACRT options (render's only: bench sweeps them); their help comes from the table.
 void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
-    addEnumOption(cmd, "--split", o.split, "DACRT split (cpu, cpu-seq; gpu always splits at the spatial median)");
+    addEnumOption(cmd, "--split", o.split, "");
     const std::string gpu = ", " + std::to_string(kGpuLeafLimit) + " on gpu";
-    cmd->add_option("--ray-limit", o.rayLimit, "leaf when fewer live rays (cpu-seq, cpu, gpu)")
+    cmd->add_option("--ray-limit", o.rayLimit)
         ->check(CLI::Range(1u, 1u << 30))
         ->default_str(std::to_string(kCpuSimdRayLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +
                       " with a non-default intersector, filter or precision)" + gpu);
-    cmd->add_option("--tri-limit", o.triLimit, "leaf when fewer triangles (cpu-seq, cpu, gpu)")
+    cmd->add_option("--tri-limit", o.triLimit)
         ->check(CLI::Range(1u, 1u << 30))
         ->default_str(std::to_string(kCpuSimdTriangleLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +
                       " with a non-default intersector, filter or precision)" + gpu);
-    cmd->add_option("--packets", o.packets,
-                    "filter primary rays 8x8 pixels at a time high in the recursion, one by one below "
-                    "(cpu, cpu-seq; the default tests only): on or off")
-        ->default_str("on");
-    cmd->add_option("--packet-flush", o.packetFlush, "a node with fewer packets goes on ray by ray (cpu, cpu-seq)")
+    cmd->add_option("--packets", o.packets)->default_str("on");
+    cmd->add_option("--packet-flush", o.packetFlush)
         ->check(CLI::Range(1u, 1u << 30))
         ->default_str(std::to_string(kPacketFlushDefault));
-    addEnumOption(cmd, "--intersector", o.intersector, "leaf ray/triangle test (cpu, cpu-seq)");
-    addEnumOption(cmd, "--triangle-filter", o.triangleFilter,
-                  "triangle/box filter: bounds, sat (exact separating axes) or mora (inexact) (cpu, cpu-seq)");
-    addEnumOption(cmd, "--precision", o.precision, "leaf ray/triangle arithmetic (cpu, cpu-seq)");
+    addEnumOption(cmd, "--intersector", o.intersector, "");
+    addEnumOption(cmd, "--triangle-filter", o.triangleFilter, "");
+    addEnumOption(cmd, "--precision", o.precision, "");
+}
+
+// The help and heading of render's backend-specific options, from the table that also refuses
+// them (cpu/backend_options.hpp): each names its backends, the developers' knobs apart.
+void describeBackendOptions(CLI::App* cmd) {
+    for (const BackendOption& row : backendOptions())
+        cmd->get_option(std::string(row.flag))
+            ->description(backendOptionHelp(row))
+            ->group(row.advanced ? "Advanced (developer) options" : "Backend options");
 }
 
 // The camera options of render and bench, as text until the command runs.
@@ -140,7 +146,8 @@ void applyCameraOptions(const CLI::App& cmd, const CameraText& t, CameraOptions&
     }
 }
 
-// --no-skip LIST: the skips (options.hpp, Skip) to turn off, to measure what each saves.
+// --no-skip LIST: the skips (options.hpp, Skip) to turn off, to measure what each saves (its
+// help: the backend option table's).
 void addSkipListOption(CLI::App* cmd, SkipSwitches& skips) {
     cmd->add_option_function<std::vector<std::string>>(
            "--no-skip",
@@ -153,9 +160,7 @@ void addSkipListOption(CLI::App* cmd, SkipSwitches& skips) {
                    if (skip == Skip::SubScenes) skips.subScenes = false;
                }
            },
-           "skips to turn off (each changes speed only): backfaces (single-sided triangles facing away from the "
-           "camera), frustum (triangles outside the view), uploads (gpu: triangle buffers kept across frames), "
-           "subscenes (cpu: small frames traced as one sequential DACRT)")
+           "")
         ->check(CLI::IsMember(enumNameList<Skip>()))
         ->delimiter(',');
 }
@@ -246,15 +251,14 @@ Subcommand addRenderCommand(CLI::App& app) {
     cmd->add_option("--normal-png", render.normalPngPath, "viewable normals: n * 0.5 + 0.5 as RGB, misses black");
     addEnumOption(cmd, "--backend", render.request.trace.backend, "tracer");
     cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
-    cmd->add_option("--regions", render.request.trace.regions, "sub-scenes (cpu, gpu; default: one per thread, on gpu one per core of a CPU device, 16 on a GPU)")
-        ->check(CLI::Range(1u, 4096u));
-    cmd->add_option("--threads", render.request.trace.threads, "worker threads (every backend but cpu-seq; default: every core)")
-        ->check(CLI::Range(1u, 1024u));
-    addEnumOption(cmd, "--axis", render.request.trace.axis, "division axis (cpu, gpu)");
+    // The backend-specific options are added bare: describeBackendOptions gives them their help
+    // and heading from the table that also refuses them.
+    cmd->add_option("--regions", render.request.trace.regions)->check(CLI::Range(1u, 4096u));
+    cmd->add_option("--threads", render.request.trace.threads)->check(CLI::Range(1u, 1024u));
+    addEnumOption(cmd, "--axis", render.request.trace.axis, "");
     addDacrtOptions(cmd, render.request.trace.dacrt);
-    cmd->add_flag("--embree-fast", s->embreeFast, "without RTC_SCENE_FLAG_ROBUST: faster, leaks through edges (embree)");
-    cmd->add_flag("--embree-single-rays", s->embreeSingleRays,
-                  "one rtcIntersect1 per ray instead of 16-wide packets on 4x4 tiles (embree)");
+    cmd->add_flag("--embree-fast", s->embreeFast);
+    cmd->add_flag("--embree-single-rays", s->embreeSingleRays);
     addCameraOptions(cmd, s->camera);
     cmd->add_option("--orbit", render.camera.orbit, "K cameras on a circle about the vertical axis through the scene's centre")
         ->check(CLI::Range(1, 100000))->default_str("1");
@@ -263,15 +267,10 @@ Subcommand addRenderCommand(CLI::App& app) {
                   "back faces no ray hits: the materials' (glTF doubleSided false: culled), none, or every triangle's");
     addSkipListOption(cmd, render.request.trace.skips);
     addDeviceOptions(cmd, render.devices);
-    cmd->add_option("--workgroup-size", render.request.gpuTuning.workgroupSize,
-                    "invocations per workgroup (gpu; default: per device)")
-        ->check(CLI::Range(1u, 1024u));
-    cmd->add_option("--ray-groups", render.request.gpuTuning.rayGroups,
-                    "work items per region, each a band of its rays with its own copy of the region's "
-                    "triangle ids (gpu; default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; "
-                    "64 / regions on a GPU)")
-        ->check(CLI::Range(1u, 64u));
+    cmd->add_option("--workgroup-size", render.request.gpuTuning.workgroupSize)->check(CLI::Range(1u, 1024u));
+    cmd->add_option("--ray-groups", render.request.gpuTuning.rayGroups)->check(CLI::Range(1u, 64u));
     addFrameOptions(cmd, *s);
+    describeBackendOptions(cmd);
     return {cmd, [s, cmd] {
                 RenderOptions& r = s->render;
                 applyFrameOptions(*s, r);

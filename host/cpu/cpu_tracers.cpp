@@ -4,6 +4,7 @@
 #include <atomic>
 #include <numeric>
 
+#include "cpu/backend_options.hpp"
 #include "cpu/traversal.hpp"
 #include "core/errors.hpp"
 #include "cpu/scene_division.hpp"
@@ -181,18 +182,9 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     return result;
 }
 
-void checkCpuOptions(const TraceOptions& options) {
-    if (options.backend == Backend::Brute && !options.dacrt.exactDefaults())
-        throw InputError("brute force always runs the watertight float32 test; the intersector, triangle filter and "
-                         "precision options are DACRT's (cpu, cpu-seq)");
-    if (options.dacrt.precision == Precision::F64 && options.dacrt.intersector != Intersector::Watertight)
-        throw InputError("precision f64 runs the watertight test in float64; it does not combine with the " +
-                         toString(options.dacrt.intersector) + " intersector");
-}
-
 TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool, const PlanHook& onPlan,
                      const ProgressHook& onProgress) {
-    checkCpuOptions(options);
+    checkTraceOptions(options);
     switch (options.backend) {
         case Backend::Brute: return traceBrute(g, pool, onPlan, onProgress);
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);

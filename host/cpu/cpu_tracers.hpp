@@ -28,11 +28,8 @@ TraceResult traceSequential(const FrameGeometry& geometry, const DacrtOptions& o
 TraceResult traceParallel(const FrameGeometry& geometry, const TraceOptions& options, ThreadPool& pool,
                           const PlanHook& onPlan = {});
 
-// Throws InputError when the options do not combine (f64 with Moller-Trumbore) or ask brute
-// force for DACRT options. traceCpu checks this.
-void checkCpuOptions(const TraceOptions& options);
-
-// The backend options.backend names: brute, cpu-seq or cpu.
+// The backend options.backend names: brute, cpu-seq or cpu. Throws InputError first when the
+// options ask it for DACRT options it does not take, or do not combine (checkTraceOptions).
 TraceResult traceCpu(const FrameGeometry& geometry, const TraceOptions& options, ThreadPool& pool,
                      const PlanHook& onPlan = {}, const ProgressHook& onProgress = {});
 

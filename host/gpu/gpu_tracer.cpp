@@ -6,6 +6,7 @@
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
+#include "cpu/backend_options.hpp"
 #include "cpu/scene_division.hpp"
 #include "gpu/binding_set.hpp"
 #include "gpu/device_defaults.hpp"
@@ -291,15 +292,7 @@ void readBack(const gpu::WorkPlan& work, std::size_t rayCount, const gpu::DacrtB
 
 }  // namespace
 
-void checkGpuOptions(const TraceOptions& options) {
-    if (options.dacrt.split != SplitMethod::SpatialMedian)
-        throw InputError("the gpu backend splits at the spatial median only, not by " + toString(options.dacrt.split));
-    if (!options.dacrt.exactDefaults())
-        throw InputError("the gpu backend runs only the exact defaults (watertight intersector, bounds filter, f32), "
-                         "not intersector " + toString(options.dacrt.intersector) + ", triangle filter " +
-                         toString(options.dacrt.triangleFilter) + ", precision " + toString(options.dacrt.precision) +
-                         "; those are options of cpu and cpu-seq");
-}
+void checkGpuOptions(const TraceOptions& options) { checkTraceOptions(options); }
 
 TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
                      gpu::Context& context, ThreadPool& pool, const PlanHook& onPlan, gpu::PipelineCache* pipelines,

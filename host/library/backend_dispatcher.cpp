@@ -6,6 +6,7 @@
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
+#include "cpu/backend_options.hpp"
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/triangle_skips.hpp"
 #include "peers/embree_tracer.hpp"
@@ -13,36 +14,6 @@
 namespace dacrt {
 
 namespace {
-
-// The options given, as the command line names them, that `takes` says the backend ignores.
-std::vector<std::string> ignoredOptions(const BackendRequest& r) {
-    const Backend b = r.trace.backend;
-    const bool dacrt = b == Backend::CpuSeq || b == Backend::Cpu || b == Backend::Gpu;
-    const bool parallel = b == Backend::Cpu || b == Backend::Gpu;
-    const DacrtOptions defaults;
-    const DacrtOptions& d = r.trace.dacrt;
-    std::vector<std::string> out;
-    auto given = [&](bool set, bool taken, const char* flag) {
-        if (set && !taken) out.push_back(flag);
-    };
-    given(r.trace.regions != 0, parallel, "--regions");
-    given(r.trace.axis != DivisionAxis::Best, parallel, "--axis");
-    given(r.trace.threads > 1, b != Backend::CpuSeq && b != Backend::RayQuery, "--threads");
-    given(d.rayLimit != 0, dacrt, "--ray-limit");
-    given(d.triLimit != 0, dacrt, "--tri-limit");
-    given(d.split != defaults.split, b == Backend::CpuSeq || b == Backend::Cpu, "--split");
-    given(d.intersector != defaults.intersector, b == Backend::CpuSeq || b == Backend::Cpu, "--intersector");
-    given(d.triangleFilter != defaults.triangleFilter, b == Backend::CpuSeq || b == Backend::Cpu, "--triangle-filter");
-    given(d.precision != defaults.precision, b == Backend::CpuSeq || b == Backend::Cpu, "--precision");
-    given(d.packets != defaults.packets, b == Backend::CpuSeq || b == Backend::Cpu, "--packets");
-    given(d.packetFlush != 0, b == Backend::CpuSeq || b == Backend::Cpu, "--packet-flush");
-    given(r.gpuTuning.workgroupSize != 0, b == Backend::Gpu, "--workgroup-size");
-    given(r.gpuTuning.rayGroups != 0, b == Backend::Gpu, "--ray-groups");
-    given(!(r.trace.skips == SkipSwitches{}), !isPeer(b), "--no-skip");
-    given(!r.embree.robust, b == Backend::Embree, "--embree-fast");
-    given(!r.embree.packets, b == Backend::Embree, "--embree-single-rays");
-    return out;
-}
 
 // Whether any of `backends` opens the Vulkan device.
 bool usesVulkan(const std::vector<Backend>& backends) {
@@ -52,16 +23,7 @@ bool usesVulkan(const std::vector<Backend>& backends) {
 }  // namespace
 
 void checkBackendRequest(const BackendRequest& r) {
-    const std::vector<std::string> ignored = ignoredOptions(r);
-    if (!ignored.empty()) {
-        std::string list;
-        for (std::size_t i = 0; i < ignored.size(); ++i)
-            list += (i == 0 ? "" : i + 1 == ignored.size() ? " and " : ", ") + ignored[i];
-        throw InputError(list + (ignored.size() == 1 ? " is not an option of --backend " : " are not options of --backend ") +
-                         toString(r.trace.backend) + " (see dacrt render --help: each option names its backends)");
-    }
-    if (r.trace.backend == Backend::Gpu) checkGpuOptions(r.trace);
-    if (r.trace.backend != Backend::Gpu && !isPeer(r.trace.backend)) checkCpuOptions(r.trace);
+    checkRequestedOptions({r.trace, r.gpuTuning.workgroupSize, r.gpuTuning.rayGroups, r.embree.robust, r.embree.packets});
 }
 
 void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends) {

@@ -34,7 +34,7 @@ struct BackendRequest {
 };
 
 // Throws InputError, naming the command-line options, when the request gives a backend an
-// option it does not take.
+// option it does not take (the table of cpu/backend_options.hpp) or options that do not combine.
 void checkBackendRequest(const BackendRequest& request);
 
 struct DeviceChoice {

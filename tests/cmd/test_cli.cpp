@@ -16,6 +16,7 @@
 #include "support/frames.hpp"
 #include "core/image_io.hpp"
 #include "core/procedural.hpp"
+#include "cpu/backend_options.hpp"
 
 namespace {
 
@@ -137,6 +138,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCommand{"ZeroPacketFlush", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --packet-flush 0", "--packet-flush"},
         BadCommand{"RegionsWithCpuSeq", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu-seq --regions 4 --axis x",
                    "--regions and --axis are not options of --backend cpu-seq"},
+        BadCommand{"EmbreeSingleRaysOnGpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend gpu --embree-single-rays",
+                   "--embree-single-rays is not an option of --backend gpu"},
         BadCommand{"EmbreeFastOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --embree-fast", "--embree-fast"},
         BadCommand{"CompareNotAnAov", "compare " + dacrt::test::fixture("bad_not_gltf.gltf") + " x.exr", "bad_not_gltf.gltf"},
         BadCommand{"UnknownLightType", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --light spot:0,1,2",
@@ -170,6 +173,26 @@ TEST(Cli, HelpNamesChoicesAndExitCodes) {
     const dacrt::test::CommandResult top = dacrt::test::runDacrt("--help");
     EXPECT_NE(top.output.find("Exit codes"), std::string::npos) << top.output;
     EXPECT_NE(top.output.find("5 an internal error"), std::string::npos) << top.output;
+}
+
+// render --help lists each option of the backend table with its help and backends, under its
+// heading: the developers' knobs under the advanced one, after the others.
+TEST(Cli, HelpListsBackendOptionsFromTheirTableWithTheDevelopersKnobsApart) {
+    const CommandResult r = run("render --help");
+    ASSERT_EQ(r.code, 0) << r.output;
+    const std::size_t backendHeading = r.output.find("Backend options:");
+    const std::size_t advancedHeading = r.output.find("Advanced (developer) options:");
+    ASSERT_NE(backendHeading, std::string::npos) << r.output;
+    ASSERT_NE(advancedHeading, std::string::npos) << r.output;
+    ASSERT_LT(backendHeading, advancedHeading) << r.output;
+    for (const dacrt::BackendOption& row : dacrt::backendOptions()) {
+        const std::size_t at = r.output.find("\n  " + std::string(row.flag) + " ");
+        ASSERT_NE(at, std::string::npos) << row.flag << "\n" << r.output;
+        const std::string line = r.output.substr(at + 1, r.output.find('\n', at + 1) - at - 1);
+        EXPECT_NE(line.find(dacrt::backendOptionHelp(row)), std::string::npos) << line;
+        EXPECT_EQ(at > advancedHeading, row.advanced) << row.flag;
+        EXPECT_GT(at, backendHeading) << row.flag;
+    }
 }
 
 TEST(Cli, DevicesListsTheLimitsThatMatter) {

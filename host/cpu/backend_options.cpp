@@ -1,0 +1,110 @@
+#include "cpu/backend_options.hpp"
+
+#include <array>
+#include <vector>
+
+#include "core/errors.hpp"
+
+namespace dacrt {
+
+namespace {
+
+constexpr BackendSet kCpuDacrt{Backend::CpuSeq, Backend::Cpu};
+constexpr BackendSet kDacrt{Backend::CpuSeq, Backend::Cpu, Backend::Gpu};
+constexpr BackendSet kSubScenes{Backend::Cpu, Backend::Gpu};
+constexpr BackendSet kGpu{Backend::Gpu};
+constexpr BackendSet kEmbree{Backend::Embree};
+
+constexpr bool kAdvanced = true;
+constexpr bool kDacrtOption = true;
+
+// The order is the help's, and the order in which a refusal names the options.
+constexpr std::array<BackendOption, 16> kBackendOptions{{
+    {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 16 on a GPU",
+     !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
+    {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.axis != DivisionAxis::Best; }},
+    {"--threads", {Backend::Brute, Backend::Cpu, Backend::Gpu, Backend::Embree}, "worker threads",
+     "default: every core", !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.threads > 1; }},
+    {"--ray-limit", kDacrt, "leaf when fewer live rays", "", !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.rayLimit != 0; }},
+    {"--tri-limit", kDacrt, "leaf when fewer triangles", "", !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.triLimit != 0; }},
+    {"--split", kCpuDacrt, "DACRT split", "gpu always splits at the spatial median", !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.split != DacrtOptions{}.split; }},
+    {"--intersector", kCpuDacrt, "leaf ray/triangle test", "", !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.intersector != DacrtOptions{}.intersector; }},
+    {"--triangle-filter", kCpuDacrt, "triangle/box filter: bounds, sat (exact separating axes) or mora (inexact)", "",
+     !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.triangleFilter != DacrtOptions{}.triangleFilter; }},
+    {"--precision", kCpuDacrt, "leaf ray/triangle arithmetic", "", !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.precision != DacrtOptions{}.precision; }},
+    {"--packets", kCpuDacrt, "filter primary rays 8x8 pixels at a time high in the recursion, one by one below: on or off",
+     "with the default tests only", !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.packets != DacrtOptions{}.packets; }},
+    {"--packet-flush", kCpuDacrt, "a node with fewer packets goes on ray by ray", "", kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.packetFlush != 0; }},
+    {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,
+     [](const RequestedOptions& r) { return r.workgroupSize != 0; }},
+    {"--ray-groups", kGpu, "work items per region, each a band of its rays with its own copy of the region's triangle ids",
+     "default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; 64 / regions on a GPU",
+     kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.rayGroups != 0; }},
+    {"--no-skip", {Backend::Brute, Backend::CpuSeq, Backend::Cpu, Backend::Gpu},
+     "skips to turn off (each changes speed only): backfaces (single-sided triangles facing away from the camera), "
+     "frustum (triangles outside the view), uploads (gpu: triangle buffers kept across frames), subscenes (cpu: small "
+     "frames traced as one sequential DACRT)",
+     "", !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return !(r.trace.skips == SkipSwitches{}); }},
+    {"--embree-fast", kEmbree, "without RTC_SCENE_FLAG_ROBUST: faster, leaks through edges", "", !kAdvanced,
+     !kDacrtOption, [](const RequestedOptions& r) { return !r.embreeRobust; }},
+    {"--embree-single-rays", kEmbree, "one rtcIntersect1 per ray instead of 16-wide packets on 4x4 tiles", "",
+     kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return !r.embreePackets; }},
+}};
+
+// Refuses the options of the table (its DacrtOptions rows alone with `dacrtOnly`) that the
+// request gives a backend that does not take them, naming them all in one message.
+void refuseOptionsNotTaken(const RequestedOptions& request, bool dacrtOnly) {
+    const Backend backend = request.trace.backend;
+    std::vector<std::string_view> refused;
+    for (const BackendOption& o : kBackendOptions)
+        if ((o.dacrtOption || !dacrtOnly) && o.given(request) && !o.takenBy.has(backend)) refused.push_back(o.flag);
+    if (refused.empty()) return;
+    std::string list;
+    for (std::size_t i = 0; i < refused.size(); ++i)
+        list += std::string(i == 0 ? "" : i + 1 == refused.size() ? " and " : ", ") + std::string(refused[i]);
+    throw InputError(list + (refused.size() == 1 ? " is not an option of --backend " : " are not options of --backend ") +
+                     toString(backend) + " (see dacrt render --help: each option names its backends)");
+}
+
+}  // namespace
+
+std::string BackendSet::names() const {
+    std::string out;
+    for (const auto& [backend, name] : EnumNames<Backend>::table)
+        if (has(backend)) out += (out.empty() ? "" : ", ") + std::string(name);
+    return out;
+}
+
+std::span<const BackendOption> backendOptions() { return kBackendOptions; }
+
+std::string backendOptionHelp(const BackendOption& option) {
+    return std::string(option.help) + " (" + option.takenBy.names() +
+           (option.note.empty() ? "" : "; " + std::string(option.note)) + ")";
+}
+
+void checkOptionCombinations(const DacrtOptions& dacrt) {
+    if (dacrt.precision == Precision::F64 && dacrt.intersector != Intersector::Watertight)
+        throw InputError("precision f64 runs the watertight test in float64; it does not combine with the " +
+                         toString(dacrt.intersector) + " intersector");
+}
+
+void checkRequestedOptions(const RequestedOptions& request) {
+    refuseOptionsNotTaken(request, false);
+    checkOptionCombinations(request.trace.dacrt);
+}
+
+void checkTraceOptions(const TraceOptions& options) {
+    refuseOptionsNotTaken(RequestedOptions{options}, true);
+    checkOptionCombinations(options.dacrt);
+}
+
+}  // namespace dacrt
