@@ -3,25 +3,9 @@
 #include "bench/bench_frame.hpp"
 #include "core/errors.hpp"
 #include "core/timing.hpp"
-#include "gpu/gpu_tracer.hpp"
 
 namespace dacrt {
 namespace {
-
-// Pipeline compilation within a trace is a cost of the process, not of the frame.
-double compiledMs(const std::vector<std::pair<std::string, double>>& phases) {
-    double ms = 0.0;
-    for (const auto& [name, t] : phases)
-        if (name == kPipelinePhase) ms += t;
-    return ms;
-}
-
-double structureMs(const std::vector<std::pair<std::string, double>>& phases) {
-    double ms = 0.0;
-    for (const auto& [name, t] : phases)
-        if (name == "build" || name == "refit") ms += t;
-    return ms;
-}
 
 // A peer's structure over `a.shared` as it stands; returns the milliseconds the making took
 // (Embree builds its BVH in it; a ray query scene only allocates, its first trace builds).
@@ -82,17 +66,18 @@ AnimatedWork peerFrame(AnimatedConfig& a, const Scene& frame, const Camera& came
         result = a.peers.embree->trace(a.buffers.rays, pool);
     } else {
         result = a.peers.rayQuery->trace(a.buffers.rays);
-        buildMs += structureMs(result.phaseMs);
+        buildMs += result.phases.structureMs();
     }
     const double tracerMs = msSince(tracerStart);
-    const double compiled = compiledMs(result.phaseMs);
+    // Pipeline compilation within a trace is a cost of the process, not of the frame.
+    const double compiled = result.phases.compileMs();
     w.buildMs = buildMs;
     // Embree's update is timed inside the tracer's span; the ray queries' build runs in the
     // same command buffer as their trace (its GPU timestamps), the making of a new structure
     // before it.
     w.traceMs = tracerMs - compiled - (buildMs - makeMs);
     w.workMs = w.prepareMs + buildMs + w.traceMs;
-    for (const auto& p : result.phaseMs) w.parts.push_back(p);
+    for (const auto& p : result.phases.listed()) w.parts.push_back(p);
     addGpuTimestamps(result, w.parts);
     w.parts.emplace_back("not counted: vertex copy", w.copyMs);
     w.hits = std::move(result.hits);
@@ -115,9 +100,9 @@ AnimatedWork dacrtFrame(AnimatedConfig& a, Scene& frame, const Camera& camera, i
     w.parts.emplace_back("rays and bounds", w.prepareMs);
     const auto traceStart = Clock::now();
     TraceResult result = dispatcher.trace(geometry, a.config.request);
-    w.traceMs = msSince(traceStart) - compiledMs(result.phaseMs);
+    w.traceMs = msSince(traceStart) - result.phases.compileMs();
     w.workMs = w.prepareMs + w.traceMs;
-    for (const auto& p : result.phaseMs) w.parts.push_back(p);
+    for (const auto& p : result.phases.listed()) w.parts.push_back(p);
     addGpuTimestamps(result, w.parts);
     w.hits = std::move(result.hits);
     return w;
@@ -136,7 +121,7 @@ std::unique_ptr<AnimatedConfig> startAnimatedConfig(const BenchConfig& config, c
         // The first trace builds the structure (and compiles the pipeline): outside the frames.
         const auto start = Clock::now();
         const TraceResult built = a->peers.rayQuery->trace({makeRay(glm::vec3(0.0f), glm::dvec3(0.0, 0.0, -1.0))});
-        a->initialBuildMs += msSince(start) - compiledMs(built.phaseMs);
+        a->initialBuildMs += msSince(start) - built.phases.compileMs();
     }
     return a;
 }

@@ -89,14 +89,14 @@ FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& 
         const double updateMs = build == EmbreeBuild::Static ? 0.0 : peers.embree->update();
         out.result = peers.embree->trace(rays, pool);
         if (build != EmbreeBuild::Static)
-            out.result.phaseMs.insert(out.result.phaseMs.begin(), {build == EmbreeBuild::Refit ? "refit" : "build", updateMs});
+            (build == EmbreeBuild::Refit ? out.result.phases.refit : out.result.phases.build) = updateMs;
     } else {
         out.result = dispatcher.trace(out.geometry, c.request);
     }
     out.ms = msSince(start);
     out.parts.emplace_back(peer ? "rays" : "rays and bounds", prepareMs);
     out.parts.emplace_back("tracer", msSince(traceStart));
-    for (const auto& p : out.result.phaseMs) out.parts.push_back(p);
+    for (const auto& p : out.result.phases.listed()) out.parts.push_back(p);
     if (out.result.gpu) {
         double gpuMs = 0.0;
         for (const auto& [name, ms] : out.result.gpu->dispatchMs) gpuMs += ms;

@@ -33,15 +33,6 @@ struct PassFrame {
     std::vector<Hit> hits;  // per slot (the primary pass: per pixel)
 };
 
-// Pipeline compilation within a trace is a cost of the process, not of the pass (render
-// reports it apart too): with --warmup 0 the first frame would otherwise carry it.
-double compiledMs(const std::vector<std::pair<std::string, double>>& phases) {
-    double ms = 0.0;
-    for (const auto& [name, t] : phases)
-        if (name == kPipelinePhase) ms += t;
-    return ms;
-}
-
 // A dacrt backend's secondary pass: the dispatcher makes the rays from the primary hits (gpu:
 // on the device, from the primary pass it kept there) and traces them.
 PassFrame dacrtPass(const BenchConfig& c, const FrameOutcome& primary, const SecondaryPass& pass,
@@ -49,9 +40,11 @@ PassFrame dacrtPass(const BenchConfig& c, const FrameOutcome& primary, const Sec
     const auto start = Clock::now();
     BackendDispatcher::PassTrace t = dispatcher.traceSecondary(primary.geometry, primary.result.hits, pass, c.request);
     PassFrame f;
-    f.ms = msSince(start) - compiledMs(t.result.phaseMs);
+    // Pipeline compilation within a trace is a cost of the process, not of the pass (render
+    // reports it apart too): with --warmup 0 the first frame would otherwise carry it.
+    f.ms = msSince(start) - t.result.phases.compileMs();
     f.rays = t.rays;
-    f.parts = t.result.phaseMs;
+    f.parts = t.result.phases.listed();
     addGpuTimestamps(t.result, f.parts);
     f.hits = std::move(t.result.hits);
     return f;
@@ -74,21 +67,21 @@ PassFrame peerPass(const BenchConfig& c, const Scene& scene, const std::vector<R
                               : peers.rayQuery->trace(made.rays, HitQuery::Any);
     PassFrame f;
     f.hits = hitsPerSlot(made, traced.hits);
-    f.ms = msSince(start) - compiledMs(traced.phaseMs);
+    f.ms = msSince(start) - traced.phases.compileMs();
     f.rays = made.rays.size();
     f.parts.emplace_back("make rays", makeMs);
     // RayQueryScene::trace builds (dynamic) or refits (refit) its structure in every call: it
     // has no call that traces alone. The frame paid for that once, in its primary pass; the
     // repeat here is taken out of the pass's time by its GPU timestamps (the vertices' upload
     // before it, a copy in host memory on lavapipe, stays in).
-    for (const auto& [name, ms] : traced.phaseMs) {
-        if (peers.rayQuery && (name == "build" || name == "refit")) {
+    traced.phases.forEach([&](const std::string& name, PhaseTimes::Field phase, double ms) {
+        if (peers.rayQuery && (phase == &PhaseTimes::build || phase == &PhaseTimes::refit)) {
             f.ms -= ms;
             f.parts.emplace_back("not counted: " + name + " repeated by the pass", ms);
         } else {
             f.parts.emplace_back(name, ms);
         }
-    }
+    });
     addGpuTimestamps(traced, f.parts);
     return f;
 }
@@ -101,7 +94,7 @@ std::vector<PassFrame> traceLitFrame(const BenchConfig& c, const BenchScene& s, 
                                      BackendDispatcher& dispatcher, PeerScenes& peers, FrameBuffers& buffers) {
     std::vector<PassFrame> frame(1 + passes.size());
     FrameOutcome primary = traceFrame(c, s.scene, camera, cmd.width, cmd.height, dispatcher, peers, buffers);
-    frame[0].ms = primary.ms - compiledMs(primary.result.phaseMs);
+    frame[0].ms = primary.ms - primary.result.phases.compileMs();
     frame[0].rays = buffers.rays.size();
     frame[0].parts = primary.parts;
     settleAfter(c.backend());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <numeric>
+#include <optional>
 
 #include "cpu/backend_options.hpp"
 #include "cpu/traversal.hpp"
@@ -32,6 +33,135 @@ Box regionBox(const Region& r) {
     b.hi = r.hi;
     return b;
 }
+
+// Each worker's partition scratch, in ids, from the largest region's counts (0: the scalar
+// path runs, without scratch).
+std::uint64_t workerScratchIds(const FrameGeometry& g, const DacrtOptions& resolved, const Division& d) {
+    return usesSimd(g, resolved) ? partitionScratchIds(d.mostRegionRays, d.mostRegionTriangles) : 0;
+}
+
+// The workers' buffers: their partition scratch and packets.
+void planWorkers(const FrameGeometry& g, const DacrtOptions& resolved, std::uint64_t scratchIds, unsigned workers,
+                 MemoryPlan& plan) {
+    if (!usesSimd(g, resolved)) return;
+    plan.add("partition scratch (per thread)", scratchIds * 4 * workers);
+    planPacketBuffers(g, resolved, scratchIds, workers, plan);
+}
+
+// One frame of the parallel scheme, stage by stage: the division (with the plan), Step 1
+// over every region, then the transfer rounds. Step 1 finishes the rays that never leave
+// their slab; a transfer finishes the rays that move toward the triangles' region but cannot
+// reach it (nor, then, any region beyond).
+class ParallelFrame {
+public:
+    ParallelFrame(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool)
+        : g_(g), options_(options), pool_(pool), resolved_(options.dacrt.resolvedFor(Backend::Cpu)) {
+        result_.threads = pool.size();
+        result_.regions = options.regions ? options.regions : pool.size();
+        planFrameInputs(g, result_.memory);
+    }
+
+    // False: onPlan stopped the frame at the plan.
+    bool divide(const PlanHook& onPlan) {
+        const auto start = Clock::now();
+        const unsigned regions = result_.regions;
+        const int axis = options_.axis == DivisionAxis::Best ? chooseDivisionAxis(g_, regions) : int(options_.axis) - 1;
+        result_.axis = axis;
+        auto planTracer = [&](const Division& d, MemoryPlan& plan) {
+            scratchIds_ = workerScratchIds(g_, resolved_, d);
+            planWorkers(g_, resolved_, scratchIds_, pool_.size(), plan);
+        };
+        division_ = divideScene(g_, regions, axis, pool_, result_.memory, onPlan, planTracer);
+        if (!division_.complete) return false;
+        startHits(g_, result_.hits);
+        schedule_ = transferSchedule(division_);
+        result_.phases.divide = msSince(start);
+        result_.counters.raysCulled = division_.culledRays;
+        perWorker_.resize(pool_.size());
+        scratch_.resize(scratchIds_ * pool_.size());
+        packets_.emplace(g_, resolved_, scratchIds_, pool_.size());
+        return true;
+    }
+
+    // Biggest regions first, so the dynamic hand-out ends evenly.
+    void traceStep1() {
+        const auto start = Clock::now();
+        const std::vector<Region>& table = division_.regions;
+        const unsigned regions = result_.regions;
+        std::vector<std::uint32_t> order(regions);
+        std::iota(order.begin(), order.end(), 0u);
+        std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+            return std::uint64_t(table[a].rayEnd - table[a].rayBegin) * (table[a].triEnd - table[a].triBegin) >
+                   std::uint64_t(table[b].rayEnd - table[b].rayBegin) * (table[b].triEnd - table[b].triBegin);
+        });
+        result_.step1RegionMs.assign(regions, 0.0);
+        pool_.parallelFor(regions, [&](std::size_t i, unsigned worker) {
+            const auto itemStart = Clock::now();
+            traceItem(order[i], order[i], worker);
+            result_.step1RegionMs[order[i]] = msSince(itemStart);
+        });
+        result_.counters.finishedStep1 = finishedRays();
+        result_.phases.step1 = msSince(start);
+    }
+
+    // One round after another; the pairs of a round in parallel.
+    void traceTransfers() {
+        const auto start = Clock::now();
+        const std::vector<Region>& table = division_.regions;
+        std::uint64_t before = result_.counters.finishedStep1;
+        for (const TransferRound& round : schedule_) {
+            std::vector<TransferPair> live;
+            for (const TransferPair& p : round.pairs)
+                if (table[p.rayRegion].terminated < table[p.rayRegion].rayEnd) live.push_back(p);
+            result_.counters.transferWorkItems += live.size();
+            result_.counters.transferWorkItemsSkipped += round.pairs.size() - live.size();
+            pool_.parallelFor(live.size(), [&](std::size_t i, unsigned worker) {
+                traceItem(live[i].rayRegion, live[i].triRegion, worker);
+            });
+            const std::uint64_t now = finishedRays();
+            result_.counters.roundNames.push_back(round.name);
+            result_.counters.finishedPerRound.push_back(now - before);
+            before = now;
+        }
+        result_.phases.transfer = msSince(start);
+        for (const Counters& c : perWorker_) result_.counters.add(c);
+    }
+
+    TraceResult finish() { return std::move(result_); }
+
+private:
+    // One work item: a region's live rays against a region's triangles, on `worker`'s buffers.
+    void traceItem(std::uint32_t rayRegion, std::uint32_t triRegion, unsigned worker) {
+        Region& rays = division_.regions[rayRegion];
+        const Region& tris = division_.regions[triRegion];
+        DacrtTraversal traversal(g_, options_.dacrt,
+                                 {result_.hits.data(), division_.rayIds.data(), division_.triIds.data(),
+                                  scratchIds_ ? scratch_.data() + worker * scratchIds_ : nullptr,
+                                  packets_->forWorker(worker)},
+                                 perWorker_[worker]);
+        const RetireRule retire{result_.axis, triRegion == rayRegion ? 0 : (triRegion > rayRegion ? 1 : -1)};
+        traversal.trace(regionBox(tris), rays.terminated, rays.rayEnd, tris.triBegin, tris.triEnd, retire);
+    }
+
+    // Rays with their final hit, over every region.
+    std::uint64_t finishedRays() const {
+        std::uint64_t t = 0;
+        for (const Region& r : division_.regions) t += r.terminated - r.rayBegin;
+        return t;
+    }
+
+    const FrameGeometry& g_;
+    const TraceOptions& options_;
+    ThreadPool& pool_;
+    const DacrtOptions resolved_;
+    TraceResult result_;
+    Division division_;
+    std::vector<TransferRound> schedule_;
+    std::uint64_t scratchIds_ = 0;
+    std::vector<Counters> perWorker_;
+    std::vector<std::uint32_t> scratch_;
+    std::optional<PacketStorage> packets_;
+};
 
 }  // namespace
 
@@ -87,99 +217,21 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
         g, options,
         {result.hits.data(), rayIds.data(), triIds.data(), scratchIds ? scratch.data() : nullptr, packets.forWorker(0)},
         result.counters);
-    std::uint32_t terminated = 0;
-    const std::uint32_t crossing = traversal.trace(g.sceneBox, terminated, rayCount, 0, triCount);
+    std::uint32_t finished = 0;  // the pivot: rays before it are finished
+    const std::uint32_t crossing = traversal.trace(g.sceneBox, finished, rayCount, 0, triCount);
     result.counters.raysCulled = rayCount - crossing;
-    result.counters.terminatedStep1 = terminated;
+    result.counters.finishedStep1 = finished;
     return result;
 }
 
 TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool,
                           const PlanHook& onPlan) {
-    TraceResult result;
-    result.threads = pool.size();
-    const unsigned regions = options.regions ? options.regions : pool.size();
-    result.regions = regions;
-    planFrameInputs(g, result.memory);
-
-    auto start = Clock::now();
-    const int axis = options.axis == DivisionAxis::Best ? chooseDivisionAxis(g, regions) : int(options.axis) - 1;
-    result.axis = axis;
-    const DacrtOptions resolved = options.dacrt.resolvedFor(Backend::Cpu);
-    std::uint64_t scratchIds = 0;
-    auto planWorkers = [&](const Division& d, MemoryPlan& plan) {
-        if (!usesSimd(g, resolved)) return;
-        scratchIds = partitionScratchIds(d.mostRegionRays, d.mostRegionTriangles);
-        plan.add("partition scratch (per thread)", scratchIds * 4 * pool.size());
-        planPacketBuffers(g, resolved, scratchIds, pool.size(), plan);
-    };
-    Division division = divideScene(g, regions, axis, pool, result.memory, onPlan, planWorkers);
-    if (!division.complete) return result;
-    startHits(g, result.hits);
-    const std::vector<TransferRound> schedule = transferSchedule(division);
-    result.phaseMs.emplace_back("divide", msSince(start));
-    result.counters.raysCulled = division.culledRays;
-
-    std::vector<Counters> perWorker(pool.size());
-    std::vector<std::uint32_t> scratch(scratchIds * pool.size());
-    PacketStorage packets(g, resolved, scratchIds, pool.size());
-    std::vector<Region>& table = division.regions;
-    // Step 1 finishes rays that never leave their slab; a transfer finishes the rays that
-    // move toward the triangles' region but cannot reach it (nor, then, any region beyond).
-    auto traceItem = [&](std::uint32_t rayRegion, std::uint32_t triRegion, unsigned worker) {
-        Region& rays = table[rayRegion];
-        const Region& tris = table[triRegion];
-        DacrtTraversal traversal(g, options.dacrt,
-                                 {result.hits.data(), division.rayIds.data(), division.triIds.data(),
-                                  scratchIds ? scratch.data() + worker * scratchIds : nullptr,
-                                  packets.forWorker(worker)},
-                                 perWorker[worker]);
-        const RetireRule retire{axis, triRegion == rayRegion ? 0 : (triRegion > rayRegion ? 1 : -1)};
-        traversal.trace(regionBox(tris), rays.terminated, rays.rayEnd, tris.triBegin, tris.triEnd, retire);
-    };
-    auto terminatedTotal = [&] {
-        std::uint64_t t = 0;
-        for (const Region& r : table) t += r.terminated - r.rayBegin;
-        return t;
-    };
-
-    // Step 1: biggest regions first, so the dynamic hand-out ends evenly.
-    start = Clock::now();
-    std::vector<std::uint32_t> order(regions);
-    std::iota(order.begin(), order.end(), 0u);
-    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-        return std::uint64_t(table[a].rayEnd - table[a].rayBegin) * (table[a].triEnd - table[a].triBegin) >
-               std::uint64_t(table[b].rayEnd - table[b].rayBegin) * (table[b].triEnd - table[b].triBegin);
-    });
-    result.step1RegionMs.assign(regions, 0.0);
-    pool.parallelFor(regions, [&](std::size_t i, unsigned worker) {
-        const auto itemStart = Clock::now();
-        traceItem(order[i], order[i], worker);
-        result.step1RegionMs[order[i]] = msSince(itemStart);
-    });
-    result.counters.terminatedStep1 = terminatedTotal();
-    result.phaseMs.emplace_back("step1", msSince(start));
-
-    // Transfer rounds, one after another; the pairs of a round in parallel.
-    start = Clock::now();
-    std::uint64_t before = result.counters.terminatedStep1;
-    for (const TransferRound& round : schedule) {
-        std::vector<TransferPair> live;
-        for (const TransferPair& p : round.pairs)
-            if (table[p.rayRegion].terminated < table[p.rayRegion].rayEnd) live.push_back(p);
-        result.counters.transferWorkItems += live.size();
-        result.counters.transferWorkItemsSkipped += round.pairs.size() - live.size();
-        pool.parallelFor(live.size(), [&](std::size_t i, unsigned worker) {
-            traceItem(live[i].rayRegion, live[i].triRegion, worker);
-        });
-        const std::uint64_t now = terminatedTotal();
-        result.counters.roundNames.push_back(round.name);
-        result.counters.terminatedPerRound.push_back(now - before);
-        before = now;
+    ParallelFrame frame(g, options, pool);
+    if (frame.divide(onPlan)) {
+        frame.traceStep1();
+        frame.traceTransfers();
     }
-    result.phaseMs.emplace_back("transfer", msSince(start));
-    for (const Counters& c : perWorker) result.counters.add(c);
-    return result;
+    return frame.finish();
 }
 
 TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool, const PlanHook& onPlan,

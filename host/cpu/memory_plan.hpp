@@ -25,6 +25,10 @@ struct MemoryPlan {
     void addWork(const std::string& name, std::uint64_t count, const std::string& why = {}) {
         work.push_back({name, count, why});
     }
+    void append(const MemoryPlan& more) {
+        buffers.insert(buffers.end(), more.buffers.begin(), more.buffers.end());
+        work.insert(work.end(), more.work.begin(), more.work.end());
+    }
     std::string describeWork() const;
     std::uint64_t total() const {
         std::uint64_t t = 0;

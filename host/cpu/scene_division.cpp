@@ -52,6 +52,191 @@ int slabOf(float x, const std::vector<float>& boundary) {
     return std::clamp(k, 0, n - 1);
 }
 
+// The regions (equal slabs along the axis) and their boxes widened by the margin.
+struct Slabs {
+    std::vector<float> boundary;
+    std::vector<glm::vec3> wideLo, wideHi;  // the widened region boxes the filters use
+    glm::vec3 sceneLo, sceneHi;             // the scene box widened
+};
+
+Slabs slabRegions(const Box& box, int axis, unsigned n, float m, Division& d) {
+    Slabs s{slabBoundaries(box, axis, n), std::vector<glm::vec3>(n), std::vector<glm::vec3>(n),
+            box.lo - glm::vec3(m), box.hi + glm::vec3(m)};
+    d.regions.resize(n);
+    for (unsigned k = 0; k < n; ++k) {
+        Region& r = d.regions[k];
+        r = Region{};
+        r.lo = box.lo;
+        r.hi = box.hi;
+        r.lo[axis] = s.boundary[k];
+        r.hi[axis] = s.boundary[k + 1];
+        s.wideLo[k] = r.lo - glm::vec3(m);
+        s.wideHi[k] = r.hi + glm::vec3(m);
+    }
+    return s;
+}
+
+// Items are binned in up to 64 chunks of at least 4096, counted chunk by chunk so that the
+// fill is deterministic.
+std::size_t chunksFor(std::size_t items) { return std::max<std::size_t>(1, std::min<std::size_t>(64, items / 4096 + 1)); }
+
+std::pair<std::size_t, std::size_t> chunkRange(std::size_t c, std::size_t total, std::size_t chunks) {
+    return {total * c / chunks, total * (c + 1) / chunks};
+}
+
+// Pass 1 for rays: which region each ray meets first (kCulled: none), counted per chunk and
+// region, with the directions rays leave each region in.
+struct RayBins {
+    std::size_t chunks = 1;
+    std::vector<std::uint32_t> region;
+    std::vector<std::uint32_t> counts;       // chunk c, region k at c * n + k
+    std::vector<std::uint8_t> low, high;     // a ray travels toward lower / higher regions
+};
+
+RayBins binRays(const FrameGeometry& g, const Slabs& s, int axis, ThreadPool& pool) {
+    const std::vector<Ray>& rays = *g.rays;
+    const Box& box = g.sceneBox;
+    const std::size_t n = s.wideLo.size();
+    RayBins bins;
+    bins.chunks = chunksFor(rays.size());
+    bins.region.resize(rays.size());
+    bins.counts.assign(bins.chunks * n, 0);
+    bins.low.assign(bins.chunks * n, 0);
+    bins.high.assign(bins.chunks * n, 0);
+    pool.parallelFor(bins.chunks, [&](std::size_t c, unsigned) {
+        const auto [begin, end] = chunkRange(c, rays.size(), bins.chunks);
+        // Counted locally: neighbouring chunks' counters share cache lines.
+        std::vector<std::uint32_t> counts(n, 0);
+        std::vector<std::uint8_t> low(n, 0), high(n, 0);
+        for (std::size_t i = begin; i < end; ++i) {
+            const Ray& ray = rays[i];
+            bins.region[i] = kCulled;
+            if (!shared::rayMayCrossCell(ray, s.sceneLo, s.sceneHi, kNoHitT)) continue;
+            const float o = ray.origin[axis], dir = ray.dir[axis];
+            const int step = dir < 0.0f ? -1 : 1;
+            // Start one slab behind the origin's so that rounding in the guess never skips
+            // the true first region; walk in the travel direction to the first one crossed.
+            int k = slabOf(o, s.boundary) - step;
+            if (dir > 0.0f && o < box.lo[axis]) k = 0;
+            if (dir < 0.0f && o > box.hi[axis]) k = int(n) - 1;
+            k = std::clamp(k, 0, int(n) - 1);
+            for (; k >= 0 && k < int(n); k += step) {
+                if (shared::rayMayCrossCell(ray, s.wideLo[std::size_t(k)], s.wideHi[std::size_t(k)], kNoHitT)) {
+                    bins.region[i] = std::uint32_t(k);
+                    ++counts[std::size_t(k)];
+                    low[std::size_t(k)] |= dir < 0.0f;
+                    high[std::size_t(k)] |= dir > 0.0f;
+                    break;
+                }
+            }
+        }
+        std::copy(counts.begin(), counts.end(), bins.counts.begin() + std::ptrdiff_t(c * n));
+        std::copy(low.begin(), low.end(), bins.low.begin() + std::ptrdiff_t(c * n));
+        std::copy(high.begin(), high.end(), bins.high.begin() + std::ptrdiff_t(c * n));
+    });
+    return bins;
+}
+
+// Pass 1 for triangles: the range of regions whose widened slab each traced triangle
+// overlaps (i indexes the traced triangles; their ids are g.tracedTriangle(i)).
+struct TriangleBins {
+    std::size_t chunks = 1;
+    std::vector<std::uint32_t> counts;       // chunk c, region k at c * n + k
+    std::vector<std::uint32_t> first, last;  // per traced triangle
+};
+
+TriangleBins binTriangles(const FrameGeometry& g, const Slabs& s, int axis, ThreadPool& pool) {
+    const std::vector<Bounds>& tb = *g.triangleBounds;
+    const std::size_t n = s.wideLo.size();
+    const std::size_t traced = g.tracedTriangleCount();
+    TriangleBins bins;
+    bins.chunks = chunksFor(traced);
+    bins.counts.assign(bins.chunks * n, 0);
+    bins.first.resize(traced);
+    bins.last.resize(traced);
+    pool.parallelFor(bins.chunks, [&](std::size_t c, unsigned) {
+        const auto [begin, end] = chunkRange(c, traced, bins.chunks);
+        std::vector<std::uint32_t> counts(n, 0);
+        for (std::size_t i = begin; i < end; ++i) {
+            const Bounds& b = tb[g.tracedTriangle(i)];
+            const float lo = b.lo[axis], hi = b.hi[axis];
+            int first = std::clamp(slabOf(lo, s.boundary) - 1, 0, int(n) - 1);
+            while (first + 1 < int(n) && lo > s.wideHi[std::size_t(first)][axis]) ++first;
+            while (first > 0 && lo <= s.wideHi[std::size_t(first - 1)][axis]) --first;
+            int last = std::clamp(slabOf(hi, s.boundary) + 1, first, int(n) - 1);
+            while (last > first && hi < s.wideLo[std::size_t(last)][axis]) --last;
+            while (last + 1 < int(n) && hi >= s.wideLo[std::size_t(last + 1)][axis]) ++last;
+            bins.first[i] = std::uint32_t(first);
+            bins.last[i] = std::uint32_t(last);
+            for (int k = first; k <= last; ++k) ++counts[std::size_t(k)];
+        }
+        std::copy(counts.begin(), counts.end(), bins.counts.begin() + std::ptrdiff_t(c * n));
+    });
+    return bins;
+}
+
+// Where each chunk's rays and triangles go in the id arrays of each region.
+struct Offsets {
+    std::vector<std::uint32_t> ray, tri;  // chunk c, region k at c * n + k
+    std::uint64_t rayTotal = 0, triTotal = 0;
+};
+
+// Offsets region by region, chunk by chunk; the regions' ranges, their largest counts and
+// the directions their rays leave in.
+Offsets placeRegions(Division& d, const RayBins& rays, const TriangleBins& triangles) {
+    const std::size_t n = d.regions.size();
+    Offsets o{std::vector<std::uint32_t>(rays.chunks * n), std::vector<std::uint32_t>(triangles.chunks * n)};
+    for (std::size_t k = 0; k < n; ++k) {
+        Region& r = d.regions[k];
+        r.rayBegin = std::uint32_t(o.rayTotal);
+        for (std::size_t c = 0; c < rays.chunks; ++c) {
+            o.ray[c * n + k] = std::uint32_t(o.rayTotal);
+            o.rayTotal += rays.counts[c * n + k];
+        }
+        r.rayEnd = std::uint32_t(o.rayTotal);
+        r.terminated = r.rayBegin;
+        r.triBegin = std::uint32_t(o.triTotal);
+        for (std::size_t c = 0; c < triangles.chunks; ++c) {
+            o.tri[c * n + k] = std::uint32_t(o.triTotal);
+            o.triTotal += triangles.counts[c * n + k];
+        }
+        r.triEnd = std::uint32_t(o.triTotal);
+        if (o.triTotal > 0xFFFFFFFFull) throw std::runtime_error("triangle copies exceed 32-bit ids");
+    }
+    d.raysTowardLow.assign(n, 0);
+    d.raysTowardHigh.assign(n, 0);
+    for (std::size_t c = 0; c < rays.chunks; ++c)
+        for (std::size_t k = 0; k < n; ++k) {
+            d.raysTowardLow[k] |= rays.low[c * n + k];
+            d.raysTowardHigh[k] |= rays.high[c * n + k];
+        }
+    for (const Region& r : d.regions) {
+        d.mostRegionRays = std::max<std::uint64_t>(d.mostRegionRays, r.rayEnd - r.rayBegin);
+        d.mostRegionTriangles = std::max<std::uint64_t>(d.mostRegionTriangles, r.triEnd - r.triBegin);
+    }
+    return o;
+}
+
+// Pass 2: the id arrays filled, each chunk from its offsets.
+void fillIds(const FrameGeometry& g, const RayBins& rays, const TriangleBins& triangles, const Offsets& o,
+             ThreadPool& pool, Division& d) {
+    const std::size_t n = d.regions.size();
+    d.rayIds.resize(o.rayTotal);
+    d.triIds.resize(o.triTotal);
+    pool.parallelFor(rays.chunks, [&](std::size_t c, unsigned) {
+        const auto [begin, end] = chunkRange(c, rays.region.size(), rays.chunks);
+        std::vector<std::uint32_t> offset(o.ray.begin() + std::ptrdiff_t(c * n), o.ray.begin() + std::ptrdiff_t(c * n + n));
+        for (std::size_t i = begin; i < end; ++i)
+            if (rays.region[i] != kCulled) d.rayIds[offset[rays.region[i]]++] = std::uint32_t(i);
+    });
+    pool.parallelFor(triangles.chunks, [&](std::size_t c, unsigned) {
+        const auto [begin, end] = chunkRange(c, triangles.first.size(), triangles.chunks);
+        std::vector<std::uint32_t> offset(o.tri.begin() + std::ptrdiff_t(c * n), o.tri.begin() + std::ptrdiff_t(c * n + n));
+        for (std::size_t i = begin; i < end; ++i)
+            for (std::uint32_t k = triangles.first[i]; k <= triangles.last[i]; ++k) d.triIds[offset[k]++] = g.tracedTriangle(i);
+    });
+}
+
 }  // namespace
 
 int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
@@ -96,161 +281,49 @@ int chooseDivisionAxis(const FrameGeometry& g, unsigned regionCount) {
 
 Division divideScene(const FrameGeometry& g, unsigned n, int axis, ThreadPool& pool, MemoryPlan& plan,
                      const PlanHook& onPlan, const DivisionPlanHook& planTracer) {
-    const std::vector<Ray>& rays = *g.rays;
-    const std::vector<Bounds>& tb = *g.triangleBounds;
-    const Box& box = g.sceneBox;
-    const float m = g.margin;
     Division d;
     d.axis = axis;
-    const std::vector<float> boundary = slabBoundaries(box, axis, n);
-    d.regions.resize(n);
-    std::vector<glm::vec3> wideLo(n), wideHi(n);  // the widened region boxes the filters use
-    for (unsigned k = 0; k < n; ++k) {
-        Region& r = d.regions[k];
-        r = Region{};
-        r.lo = box.lo;
-        r.hi = box.hi;
-        r.lo[axis] = boundary[k];
-        r.hi[axis] = boundary[k + 1];
-        wideLo[k] = r.lo - glm::vec3(m);
-        wideHi[k] = r.hi + glm::vec3(m);
-    }
-    const glm::vec3 sceneLo = box.lo - glm::vec3(m), sceneHi = box.hi + glm::vec3(m);
-
-    // Pass 1: which region each ray meets first, and per-chunk counts.
-    const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(64, rays.size() / 4096 + 1));
-    std::vector<std::uint32_t> rayRegion(rays.size());
-    std::vector<std::uint32_t> rayCounts(chunks * n, 0);
-    std::vector<std::uint8_t> chunkLow(chunks * n, 0), chunkHigh(chunks * n, 0);
-    plan.add("ray region (binning)", std::uint64_t(rays.size()) * 4);
-    auto chunkRange = [&](std::size_t c, std::size_t total) {
-        return std::pair<std::size_t, std::size_t>(total * c / chunks, total * (c + 1) / chunks);
-    };
-    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        const auto [begin, end] = chunkRange(c, rays.size());
-        // Counted locally: neighbouring chunks' counters share cache lines.
-        std::vector<std::uint32_t> counts(n, 0);
-        std::vector<std::uint8_t> low(n, 0), high(n, 0);
-        for (std::size_t i = begin; i < end; ++i) {
-            const Ray& ray = rays[i];
-            rayRegion[i] = kCulled;
-            if (!shared::rayMayCrossCell(ray, sceneLo, sceneHi, kNoHitT)) continue;
-            const float o = ray.origin[axis], dir = ray.dir[axis];
-            const int step = dir < 0.0f ? -1 : 1;
-            // Start one slab behind the origin's so that rounding in the guess never skips
-            // the true first region; walk in the travel direction to the first one crossed.
-            int k = slabOf(o, boundary) - step;
-            if (dir > 0.0f && o < box.lo[axis]) k = 0;
-            if (dir < 0.0f && o > box.hi[axis]) k = int(n) - 1;
-            k = std::clamp(k, 0, int(n) - 1);
-            for (; k >= 0 && k < int(n); k += step) {
-                if (shared::rayMayCrossCell(ray, wideLo[std::size_t(k)], wideHi[std::size_t(k)], kNoHitT)) {
-                    rayRegion[i] = std::uint32_t(k);
-                    ++counts[std::size_t(k)];
-                    low[std::size_t(k)] |= dir < 0.0f;
-                    high[std::size_t(k)] |= dir > 0.0f;
-                    break;
-                }
-            }
-        }
-        std::copy(counts.begin(), counts.end(), rayCounts.begin() + std::ptrdiff_t(c * n));
-        std::copy(low.begin(), low.end(), chunkLow.begin() + std::ptrdiff_t(c * n));
-        std::copy(high.begin(), high.end(), chunkHigh.begin() + std::ptrdiff_t(c * n));
-    });
-
-    // Pass 1 for triangles: the range of regions whose widened slab each traced triangle
-    // overlaps (i indexes the traced triangles; their ids are g.tracedTriangle(i)).
-    const std::size_t traced = g.tracedTriangleCount();
-    const std::size_t triChunks = std::max<std::size_t>(1, std::min<std::size_t>(64, traced / 4096 + 1));
-    std::vector<std::uint32_t> triCounts(triChunks * n, 0);
-    std::vector<std::uint32_t> triFirst(traced), triLast(traced);
-    plan.add("triangle region range (binning)", std::uint64_t(traced) * 8);
-    auto triChunkRange = [&](std::size_t c) {
-        return std::pair<std::size_t, std::size_t>(traced * c / triChunks, traced * (c + 1) / triChunks);
-    };
-    pool.parallelFor(triChunks, [&](std::size_t c, unsigned) {
-        const auto [begin, end] = triChunkRange(c);
-        std::vector<std::uint32_t> counts(n, 0);
-        for (std::size_t i = begin; i < end; ++i) {
-            const Bounds& b = tb[g.tracedTriangle(i)];
-            const float lo = b.lo[axis], hi = b.hi[axis];
-            int first = std::clamp(slabOf(lo, boundary) - 1, 0, int(n) - 1);
-            while (first + 1 < int(n) && lo > wideHi[std::size_t(first)][axis]) ++first;
-            while (first > 0 && lo <= wideHi[std::size_t(first - 1)][axis]) --first;
-            int last = std::clamp(slabOf(hi, boundary) + 1, first, int(n) - 1);
-            while (last > first && hi < wideLo[std::size_t(last)][axis]) --last;
-            while (last + 1 < int(n) && hi >= wideLo[std::size_t(last + 1)][axis]) ++last;
-            triFirst[i] = std::uint32_t(first);
-            triLast[i] = std::uint32_t(last);
-            for (int k = first; k <= last; ++k) ++counts[std::size_t(k)];
-        }
-        std::copy(counts.begin(), counts.end(), triCounts.begin() + std::ptrdiff_t(c * n));
-    });
-
-    // Offsets: region by region, chunk by chunk, so the fill is deterministic.
-    std::vector<std::uint32_t> rayOffset(chunks * n), triOffset(triChunks * n);
-    std::uint64_t rayTotal = 0, triTotal = 0;
-    for (unsigned k = 0; k < n; ++k) {
-        Region& r = d.regions[k];
-        r.rayBegin = std::uint32_t(rayTotal);
-        for (std::size_t c = 0; c < chunks; ++c) {
-            rayOffset[c * n + k] = std::uint32_t(rayTotal);
-            rayTotal += rayCounts[c * n + k];
-        }
-        r.rayEnd = std::uint32_t(rayTotal);
-        r.terminated = r.rayBegin;
-        r.triBegin = std::uint32_t(triTotal);
-        for (std::size_t c = 0; c < triChunks; ++c) {
-            triOffset[c * n + k] = std::uint32_t(triTotal);
-            triTotal += triCounts[c * n + k];
-        }
-        r.triEnd = std::uint32_t(triTotal);
-        if (triTotal > 0xFFFFFFFFull) throw std::runtime_error("triangle copies exceed 32-bit ids");
-    }
-    d.raysTowardLow.assign(n, 0);
-    d.raysTowardHigh.assign(n, 0);
-    for (std::size_t c = 0; c < chunks; ++c)
-        for (unsigned k = 0; k < n; ++k) {
-            d.raysTowardLow[k] |= chunkLow[c * n + k];
-            d.raysTowardHigh[k] |= chunkHigh[c * n + k];
-        }
-    d.culledRays = rays.size() - rayTotal;
-    d.straddlerCopies = triTotal - traced;
-    plan.add("binning counters", std::uint64_t(chunks + triChunks) * n * 8 + std::uint64_t(chunks) * n * 2);
-    plan.add("region table", std::uint64_t(n) * sizeof(Region));
-    plan.add("ray ids", rayTotal * 4);
-    plan.add("triangle ids (with straddlers)", triTotal * 4);
-    for (const Region& r : d.regions) {
-        d.mostRegionRays = std::max<std::uint64_t>(d.mostRegionRays, r.rayEnd - r.rayBegin);
-        d.mostRegionTriangles = std::max<std::uint64_t>(d.mostRegionTriangles, r.triEnd - r.triBegin);
-    }
+    const Slabs slabs = slabRegions(g.sceneBox, axis, n, g.margin, d);
+    const RayBins rays = binRays(g, slabs, axis, pool);
+    const TriangleBins triangles = binTriangles(g, slabs, axis, pool);
+    Offsets offsets = placeRegions(d, rays, triangles);
+    d.culledRays = g.rays->size() - offsets.rayTotal;
+    d.straddlerCopies = offsets.triTotal - triangles.first.size();
     std::uint64_t pairs = 0;
     for (const TransferRound& round : transferSchedule(d)) pairs += round.pairs.size();
-    plan.addWork("rays outside the scene box", d.culledRays, "culled before division");
-    plan.addWork("regions", n, "sub-scenes along " + std::string(1, "xyz"[axis]));
-    plan.addWork("triangle copies in more than one region", d.straddlerCopies);
-    plan.addWork("transfer pairs", pairs,
-                 "of " + std::to_string(std::uint64_t(n) * (n - 1)) + "; the others have no ray that can reach their triangles");
+    plan.append(planDivision(DivisionCounts{.rays = g.rays->size(),
+                                            .tracedTriangles = triangles.first.size(),
+                                            .rayChunks = rays.chunks,
+                                            .triangleChunks = triangles.chunks,
+                                            .regions = n,
+                                            .axis = axis,
+                                            .rayIds = offsets.rayTotal,
+                                            .triangleIds = offsets.triTotal,
+                                            .culledRays = d.culledRays,
+                                            .straddlerCopies = d.straddlerCopies,
+                                            .transferPairs = pairs}));
     if (planTracer) planTracer(d, plan);
     if (onPlan && !onPlan(plan)) return d;
-
-    // Pass 2: fill.
-    d.rayIds.resize(rayTotal);
-    d.triIds.resize(triTotal);
-    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        const auto [begin, end] = chunkRange(c, rays.size());
-        std::vector<std::uint32_t> offset(rayOffset.begin() + std::ptrdiff_t(c * n), rayOffset.begin() + std::ptrdiff_t(c * n + n));
-        for (std::size_t i = begin; i < end; ++i)
-            if (rayRegion[i] != kCulled) d.rayIds[offset[rayRegion[i]]++] = std::uint32_t(i);
-    });
-    pool.parallelFor(triChunks, [&](std::size_t c, unsigned) {
-        const auto [begin, end] = triChunkRange(c);
-        std::vector<std::uint32_t> offset(triOffset.begin() + std::ptrdiff_t(c * n), triOffset.begin() + std::ptrdiff_t(c * n + n));
-        for (std::size_t i = begin; i < end; ++i)
-            for (std::uint32_t k = triFirst[i]; k <= triLast[i]; ++k) d.triIds[offset[k]++] = g.tracedTriangle(i);
-    });
+    fillIds(g, rays, triangles, offsets, pool, d);
     d.complete = true;
     return d;
+}
+
+MemoryPlan planDivision(const DivisionCounts& c) {
+    MemoryPlan plan;
+    const std::uint64_t n = c.regions;
+    plan.add("ray region (binning)", c.rays * 4);
+    plan.add("triangle region range (binning)", c.tracedTriangles * 8);
+    plan.add("binning counters", std::uint64_t(c.rayChunks + c.triangleChunks) * n * 8 + std::uint64_t(c.rayChunks) * n * 2);
+    plan.add("region table", n * sizeof(Region));
+    plan.add("ray ids", c.rayIds * 4);
+    plan.add("triangle ids (with straddlers)", c.triangleIds * 4);
+    plan.addWork("rays outside the scene box", c.culledRays, "culled before division");
+    plan.addWork("regions", n, "sub-scenes along " + std::string(1, "xyz"[c.axis]));
+    plan.addWork("triangle copies in more than one region", c.straddlerCopies);
+    plan.addWork("transfer pairs", c.transferPairs,
+                 "of " + std::to_string(n * (n - 1)) + "; the others have no ray that can reach their triangles");
+    return plan;
 }
 
 std::vector<TransferRound> transferSchedule(const Division& d, bool raysKnown) {

@@ -50,6 +50,23 @@ using DivisionPlanHook = std::function<void(const Division&, MemoryPlan&)>;
 Division divideScene(const FrameGeometry& geometry, unsigned regionCount, int axis, ThreadPool& pool,
                      MemoryPlan& plan, const PlanHook& onPlan = {}, const DivisionPlanHook& planTracer = {});
 
+// What the division's plan is computed from: the counts its first passes measure.
+struct DivisionCounts {
+    std::uint64_t rays = 0;
+    std::uint64_t tracedTriangles = 0;
+    std::size_t rayChunks = 1, triangleChunks = 1;  // the binning's chunks
+    unsigned regions = 1;
+    int axis = 0;
+    std::uint64_t rayIds = 0;          // rays binned (those that meet the scene box)
+    std::uint64_t triangleIds = 0;     // triangle copies, straddlers counted in each region
+    std::uint64_t culledRays = 0;
+    std::uint64_t straddlerCopies = 0;
+    std::uint64_t transferPairs = 0;
+};
+
+// The division's buffers and work lines, from its counts.
+MemoryPlan planDivision(const DivisionCounts& counts);
+
 // Round s pairs region j's live rays with region j - s (first pass) or j + s (second pass),
 // only where region j has rays travelling that way: for rays leaving one camera this is the
 // source's CameraIntersect test, made exact. raysKnown false: the rays are binned later (on the

@@ -8,6 +8,7 @@
 
 #include "core/shader_layout.hpp"
 #include "cpu/memory_plan.hpp"
+#include "cpu/phase_times.hpp"
 
 namespace dacrt {
 
@@ -16,10 +17,12 @@ struct Counters {
     std::uint64_t packetBoxTests = 0;    // packets of rays tested at once against a box
     std::uint64_t rayTriangleTests = 0;
     std::uint64_t leaves = 0;
-    std::uint64_t raysRetired = 0;       // finished by the parallel scheme without a further hit
+    // A ray is finished once it has its final hit (or none): the parallel scheme finishes rays
+    // early, without a further hit, when they cannot reach the next region.
+    std::uint64_t raysFinishedWithoutHit = 0;
     std::uint64_t raysCulled = 0;        // missed the scene box
-    std::uint64_t terminatedStep1 = 0;   // for cpu-seq: every terminated ray
-    std::vector<std::uint64_t> terminatedPerRound;  // transfer rounds in execution order
+    std::uint64_t finishedStep1 = 0;     // for cpu-seq: every finished ray
+    std::vector<std::uint64_t> finishedPerRound;  // transfer rounds in execution order
     std::vector<std::string> roundNames;
     std::uint64_t transferWorkItems = 0;
     std::uint64_t transferWorkItemsSkipped = 0;
@@ -29,7 +32,7 @@ struct Counters {
         packetBoxTests += o.packetBoxTests;
         rayTriangleTests += o.rayTriangleTests;
         leaves += o.leaves;
-        raysRetired += o.raysRetired;
+        raysFinishedWithoutHit += o.raysFinishedWithoutHit;
     }
 };
 
@@ -45,7 +48,7 @@ struct GpuReport {
     std::uint32_t workItemsRun = 0;
     std::uint32_t workItemsEmpty = 0;
     std::uint32_t slices = 0;          // work item slices (more than work items: continuations)
-    std::uint64_t raysFinished = 0;    // rays ended by a hit or retired, over all steps
+    std::uint64_t raysFinished = 0;    // rays finished (with a hit or without), over all steps
     std::uint32_t validationErrors = 0;
 };
 
@@ -53,7 +56,7 @@ struct TraceResult {
     std::vector<Hit> hits;   // one per ray
     Counters counters;
     MemoryPlan memory;
-    std::vector<std::pair<std::string, double>> phaseMs;  // backend-specific parts of the trace
+    PhaseTimes phases;       // the backend's parts of the trace
     std::vector<double> step1RegionMs;   // cpu: each region's Step 1 work item, for load balance
     unsigned threads = 1;
     unsigned regions = 1;

@@ -127,7 +127,7 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
         if (done) {
             std::swap(rayIds_[k], rayIds_[terminated]);
             ++terminated;
-            ++counters_.raysRetired;
+            ++counters_.raysFinishedWithoutHit;
         }
     }
     return crossing;

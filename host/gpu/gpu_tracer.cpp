@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <functional>
 #include <limits>
+#include <optional>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
@@ -32,43 +33,34 @@ struct GpuPassSource {
 
 void GpuPassSourceDeleter::operator()(GpuPassSource* source) const { delete source; }
 
-namespace {
-
-// What the frame's stages hand each other.
-struct GpuFrame {
+// What a frame's (or a secondary pass's) stages hand each other.
+struct GpuTracer::Frame {
     const FrameGeometry& geometry;
-    Division division;
-    std::vector<TransferRound> schedule;
-    gpu::WorkPlan work;
+    TraceResult result;
+    std::uint64_t rays = 0;                 // rays traced (a secondary pass: its slots)
+    MemoryPlan hostPlan;                    // the division's buffers and work lines
+    Division division;                      // a primary frame's (a pass traces its source's)
+    gpu::WorkPlan ownWork;
+    const gpu::WorkPlan* work = &ownWork;   // a secondary pass: its source's
     std::uint32_t workgroupSize = 0;
+    std::uint64_t triIdCount = 0;           // triangle ids over every ray group
     gpu::DacrtBufferPlan buffers{};
-    gpu::ResidentTriangles* resident = nullptr;  // the uploads skip: triangles kept on the device
-    bool trianglesOnDevice = false;              // resident holds this frame's already
+    gpu::ResidentBuffers kept{};            // bound from elsewhere: resident triangles, the primary pass's
+    bool trianglesOnDevice = false;         // resident_ holds this frame's already (uploads skip)
+    bool keepsTriangles = false;            // the uploads skip applies: triangles kept on the device
+    std::unique_ptr<gpu::DacrtBindingSet> set;
+    gpu::ComputePipeline* kernel = nullptr;
+    gpu::ComputePipeline* rayMaker = nullptr;  // a secondary pass's
+    GpuCounters counters{};
 };
+
+namespace {
 
 void describeDevice(const gpu::DeviceInfo& device, TraceResult& result) {
     result.gpu = GpuReport{};
     result.gpu->device = device.name;
     result.gpu->driver = device.driver;
     result.gpu->subgroupSize = device.subgroupSize;
-}
-
-// The same division as the cpu backend, then the work items over the region slots.
-void planWorkItems(GpuFrame& frame, const TraceOptions& options, const GpuTuning& tuning,
-                   const gpu::DeviceInfo& device, ThreadPool& pool, MemoryPlan& hostPlan, TraceResult& result) {
-    const auto start = Clock::now();
-    const unsigned regions = options.regions ? options.regions : gpu::defaultGpuRegions(device);
-    const int axis =
-        options.axis == DivisionAxis::Best ? chooseDivisionAxis(frame.geometry, regions) : int(options.axis) - 1;
-    frame.division = divideScene(frame.geometry, regions, axis, pool, hostPlan);
-    frame.schedule = transferSchedule(frame.division);
-    const std::uint32_t groups = tuning.rayGroups ? tuning.rayGroups : gpu::defaultRayGroups(device, regions);
-    frame.work = gpu::planWorkItems(frame.division, frame.schedule, groups);
-    result.regions = regions;
-    result.axis = axis;
-    result.counters.raysCulled = frame.division.culledRays;
-    result.gpu->rayGroups = groups;
-    result.phaseMs.emplace_back("divide", msSince(start));
 }
 
 std::uint32_t chooseWorkgroupSize(const gpu::WorkPlan& work, const GpuTuning& tuning, const gpu::DeviceInfo& device,
@@ -84,107 +76,6 @@ std::uint32_t chooseWorkgroupSize(const gpu::WorkPlan& work, const GpuTuning& tu
                          std::to_string(widest));
     result.gpu->workgroupSize = size;
     return size;
-}
-
-// Every buffer, host and device, from the counts; checked against the device's limits.
-void planMemory(GpuFrame& frame, const gpu::DeviceInfo& device, const MemoryPlan& hostPlan, const DacrtOptions& options,
-                TraceResult& result) {
-    const std::uint64_t triIdCount = std::uint64_t(frame.division.triIds.size()) * frame.work.groups;
-    frame.buffers = gpu::planDacrtBuffers(gpu::DacrtBufferCounts{
-        .rays = frame.geometry.rays->size(),
-        .triangles = frame.geometry.triangles->size(),
-        .rayIds = frame.division.rayIds.size(),
-        .triangleIds = triIdCount,
-        .regions = frame.work.slots.size(),
-        .workItems = frame.work.items.size(),
-        .maxDepth = options.maxDepth,
-    });
-    for (const auto& [name, bytes] : hostPlan.buffers) result.memory.add("host: " + name, bytes);
-    result.memory.add("host: triangle ids per ray group", triIdCount * 4);
-    gpu::addToMemoryPlan(frame.buffers, device, result.memory);
-    result.memory.work.insert(result.memory.work.end(), hostPlan.work.begin(), hostPlan.work.end());
-    const FrameGeometry& g = frame.geometry;
-    result.memory.addWork("gpu work items", frame.work.items.size(), "Step 1 and transfer pairs, per ray group");
-    const std::uint64_t triangleBytes = std::uint64_t(g.triangles->size()) * (sizeof(Triangle) + sizeof(Bounds));
-    const std::uint64_t uploaded = std::uint64_t(g.rays->size()) * (sizeof(Ray) + sizeof(Hit)) +
-                                   (frame.trianglesOnDevice ? 0 : triangleBytes) +
-                                   std::uint64_t(frame.division.rayIds.size()) * 4 + triIdCount * 4 +
-                                   frame.work.slots.size() * sizeof(Region) + frame.work.items.size() *
-                                   (sizeof(WorkItem) + sizeof(TraversalState)) + sizeof(GpuCounters);
-    result.memory.addWork("bytes uploaded", uploaded, "rays, misses, triangles and bounds, ids, regions, work items");
-    result.memory.addWork("skipped: triangle and bounds upload (bytes)", frame.trianglesOnDevice ? triangleBytes : 0,
-                          frame.resident ? (frame.trianglesOnDevice ? "on the device since an earlier frame" : "uploaded, kept for the next frame")
-                                         : g.trianglesVersion ? "skip off (--no-skip uploads)" : "the triangles' version is unknown");
-    result.memory.addWork("bytes read back", std::uint64_t(g.rays->size()) * sizeof(Hit) + frame.work.slots.size() * sizeof(Region),
-                          "hits and regions");
-}
-
-// Creates the frame's buffers and fills them.
-gpu::DacrtBindingSet uploadFrame(const GpuFrame& frame, const gpu::Context& context, TraceResult& result) {
-    const auto start = Clock::now();
-    gpu::ResidentBuffers resident{};
-    if (frame.resident) {
-        frame.resident->prepare(context, frame.geometry);
-        resident[DACRT_BINDING_TRIANGLES] = &frame.resident->triangles();
-        resident[DACRT_BINDING_TRIANGLE_BOUNDS] = &frame.resident->bounds();
-    }
-    gpu::DacrtBindingSet set(context, frame.buffers, resident);
-    const FrameGeometry& g = frame.geometry;
-    const std::vector<std::uint32_t> slotTriIds = gpu::groupTriangleIds(frame.division, frame.work.groups);
-    std::vector<Hit> misses;
-    misses.reserve(g.rays->size());
-    for (const Ray& ray : *g.rays) misses.push_back(missHit(ray));
-    const GpuCounters zero{};
-    const std::vector<TraversalState> fresh(frame.work.items.size(), TraversalState{});
-    auto upload = [&](std::uint32_t binding, const auto& v) { set[binding].upload(v.data(), v.size() * sizeof(v[0])); };
-    upload(DACRT_BINDING_RAYS, *g.rays);
-    if (!frame.resident) {
-        upload(DACRT_BINDING_TRIANGLES, *g.triangles);
-        upload(DACRT_BINDING_TRIANGLE_BOUNDS, *g.triangleBounds);
-    }
-    upload(DACRT_BINDING_HITS, misses);
-    upload(DACRT_BINDING_RAY_IDS, frame.division.rayIds);
-    upload(DACRT_BINDING_TRI_IDS, slotTriIds);
-    upload(DACRT_BINDING_REGIONS, frame.work.slots);
-    upload(DACRT_BINDING_WORK_ITEMS, frame.work.items);
-    set[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
-    upload(DACRT_BINDING_STATES, fresh);
-    result.phaseMs.emplace_back("upload", msSince(start));
-    return set;
-}
-
-gpu::ComputePipeline& preparePipeline(std::uint32_t workgroupSize, bool sharedStart, bool anyHit, const DacrtOptions& options,
-                                      const gpu::DeviceInfo& device, gpu::PipelineCache& pipelines,
-                                      const gpu::DacrtBindingSet& set, TraceResult& result) {
-    const auto start = Clock::now();
-    const DacrtOptions leafLimits = options.resolvedFor(Backend::Gpu);
-    gpu::ComputePipeline& pipeline = pipelines.kernel(gpu::KernelSpecialization{
-        .workgroupSize = workgroupSize,
-        .rayLimit = leafLimits.rayLimit,
-        .triLimit = leafLimits.triLimit,
-        .maxDepth = options.maxDepth,
-        .loopBudget = gpu::loopBudgetOf(device),
-        .sharedStart = sharedStart,
-        .anyHit = anyHit,
-    });
-    // Compilation only (a first use; later frames find the pipeline in the cache), so that
-    // render and bench can take it out of the frame.
-    result.phaseMs.emplace_back(kPipelinePhase, msSince(start));
-    set.bindTo(pipeline);
-    return pipeline;
-}
-
-DacrtPush framePush(const GpuFrame& frame) {
-    DacrtPush push{};
-    push.rayOrigin = frame.geometry.nearSide;  // the shared origin when raysShareStart
-    push.margin = frame.geometry.margin;
-    push.axis = std::uint32_t(frame.division.axis);
-    push.rayScratchHalf = std::uint32_t(frame.division.rayIds.size());
-    push.triScratchHalf = std::uint32_t(frame.division.triIds.size() * frame.work.groups);
-    push.loopProbe = 2;
-    push.rayTmin = frame.geometry.rays->front().tmin;
-    push.order = frame.geometry.order == ChildOrder::PerRay ? shared::kOrderPerRay : shared::kOrderNearSide;
-    return push;
 }
 
 // A slice cut short by the loop limiter has left its work item in an unknown state, so this
@@ -264,85 +155,6 @@ void dispatchContinuations(const gpu::WorkPlan& work, gpu::Context& context, gpu
     }
 }
 
-void readBack(const gpu::WorkPlan& work, std::size_t rayCount, const gpu::DacrtBindingSet& set, const GpuCounters& counters,
-              const gpu::Context& context, TraceResult& result) {
-    const auto start = Clock::now();
-    result.hits.resize(rayCount);
-    set[DACRT_BINDING_HITS].download(result.hits.data(), result.hits.size() * sizeof(Hit));
-    std::vector<Region> after(work.slots.size());
-    set[DACRT_BINDING_REGIONS].download(after.data(), after.size() * sizeof(Region));
-    result.phaseMs.emplace_back("readback", msSince(start));
-
-    checkLoopLimit(counters, work.items.size(), context.info());
-    result.counters.rayBoxTests = counters.rayBoxTests;
-    result.counters.rayTriangleTests = counters.rayTriangleTests;
-    result.counters.leaves = counters.leaves;
-    result.counters.raysRetired = counters.raysRetired;
-    result.counters.terminatedStep1 = counters.terminatedStep1;
-    result.counters.transferWorkItems = work.transferPairs;
-    GpuReport& report = *result.gpu;
-    report.raysFinished = 0;  // one command buffer: no per-round readback
-    for (const Region& r : after) report.raysFinished += r.terminated - r.rayBegin;
-    report.dispatches = std::uint32_t(report.dispatchMs.size());
-    report.slices = counters.slices;
-    report.workItemsRun = counters.workItemsRun;
-    report.workItemsEmpty = counters.workItemsEmpty;
-    report.validationErrors = context.validationErrors();
-}
-
-}  // namespace
-
-void checkGpuOptions(const TraceOptions& options) { checkTraceOptions(options); }
-
-TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
-                     gpu::Context& context, ThreadPool& pool, const PlanHook& onPlan, gpu::PipelineCache* pipelines,
-                     gpu::ResidentTriangles* resident, GpuPassSourcePtr* keep) {
-    const gpu::DeviceInfo& device = context.info();
-    checkGpuOptions(options);
-    if (!device.subgroupOperations)
-        throw InputError("device '" + device.name +
-                         "' lacks subgroup arithmetic or shuffles in compute shaders, which the gpu backend needs");
-    TraceResult result;
-    result.threads = pool.size();
-    describeDevice(device, result);
-
-    GpuFrame frame{geometry, {}, {}, {}, 0, {}};
-    if (resident && options.skips.uploads && geometry.trianglesVersion != 0) {
-        frame.resident = resident;
-        frame.trianglesOnDevice = resident->holds(geometry);
-    }
-    MemoryPlan hostPlan;
-    planWorkItems(frame, options, tuning, device, pool, hostPlan, result);
-    frame.workgroupSize = chooseWorkgroupSize(frame.work, tuning, device, result);
-    planMemory(frame, device, hostPlan, options.dacrt, result);
-    if (onPlan && !onPlan(result.memory)) return result;
-
-    gpu::DacrtBindingSet set = uploadFrame(frame, context, result);
-    gpu::PipelineCache frameOnly(context);
-    gpu::ComputePipeline& pipeline =
-        preparePipeline(frame.workgroupSize, geometry.raysShareStart, geometry.query == HitQuery::Any, options.dacrt, device,
-                        pipelines ? *pipelines : frameOnly, set, result);
-
-    const auto start = Clock::now();
-    DacrtPush push = framePush(frame);
-    GpuCounters counters = dispatchSchedule(frame.work, context, pipeline, set, push, *result.gpu);
-    dispatchContinuations(frame.work, context, pipeline, set, push, counters, *result.gpu);
-    result.phaseMs.emplace_back("dispatch", msSince(start));
-
-    readBack(frame.work, geometry.rays->size(), set, counters, context, result);
-    if (keep) {
-        *keep = GpuPassSourcePtr(new GpuPassSource{});
-        (*keep)->primaryRays = geometry.rays->size();
-        (*keep)->primary = std::make_unique<gpu::DacrtBindingSet>(std::move(set));
-    }
-    return result;
-}
-
-}  // namespace dacrt
-
-namespace dacrt {
-namespace {
-
 // Secondary rays start on the surfaces, at most kOffsetSteps float32 steps of the triangles'
 // coordinates off them (shaders/secondary_rays.glsl): a bound on their origins for the filter
 // margin, which the host cannot take from rays it never sees.
@@ -350,40 +162,6 @@ float secondaryMargin(const Box& box) {
     glm::vec3 farthest(0.0f);
     for (int a = 0; a < 3; ++a) farthest[a] = std::max(std::abs(box.lo[a]), std::abs(box.hi[a])) * (1.0f + 0x1p-12f);
     return filterMargin(box, farthest);
-}
-
-// The first secondary pass of a frame divides its triangles (rays: none yet) and plans work
-// items for every pair of regions, since rays of every direction may move between any two.
-void divideForSecondaryRays(GpuPassSource& source, const FrameGeometry& frame, const TraceOptions& options,
-                            const GpuTuning& tuning, gpu::Context& context, ThreadPool& pool, TraceResult& result) {
-    const auto start = Clock::now();
-    const gpu::DeviceInfo& device = context.info();
-    const unsigned regions = options.regions ? options.regions : gpu::defaultGpuRegions(device);
-    const glm::vec3 extent = frame.sceneBox.extent();
-    const int longest = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
-    const int axis = options.axis == DivisionAxis::Best ? longest : int(options.axis) - 1;
-    static const std::vector<Ray> noRays;
-    FrameGeometry triangles = frame;
-    triangles.rays = &noRays;
-    triangles.tracedTriangles = nullptr;
-    // The margin the kernel and the device's ray binning filter with: triangles straddle by it.
-    source.margin = secondaryMargin(frame.sceneBox);
-    triangles.margin = source.margin;
-    MemoryPlan unused;
-    source.division = divideScene(triangles, regions, axis, pool, unused);
-    const std::uint32_t groups = tuning.rayGroups ? tuning.rayGroups : gpu::defaultRayGroups(device, regions);
-    source.work = gpu::planWorkItems(source.division, transferSchedule(source.division, false), groups);
-    const std::vector<std::uint32_t> ids = gpu::groupTriangleIds(source.division, groups);
-    const std::uint64_t idBytes = std::max<std::uint64_t>(ids.size(), 1) * 8;
-    if (idBytes > device.maxStorageBufferRange)
-        throw InputError("the device buffer of the secondary passes' triangle ids and scratch needs " +
-                         std::to_string(idBytes) + " bytes, more than the device's maxStorageBufferRange of " +
-                         std::to_string(device.maxStorageBufferRange) + " bytes (over by " +
-                         std::to_string(idBytes - device.maxStorageBufferRange) + "); use fewer regions or ray groups");
-    source.triangleIds = std::make_unique<gpu::Buffer>(context, idBytes, "triangle ids and scratch (secondary passes)");
-    source.triangleIds->upload(ids.data(), ids.size() * sizeof(std::uint32_t));
-    source.divided = true;
-    result.phaseMs.emplace_back("divide", msSince(start));
 }
 
 SecondaryPush secondaryPush(const GpuPassSource& source, const SecondaryPass& pass) {
@@ -432,87 +210,331 @@ Prelude makeRaysOnDevice(gpu::ComputePipeline& pipeline, const SecondaryPush& ba
 
 }  // namespace
 
-TraceResult traceGpuSecondary(GpuPassSource& source, const FrameGeometry& frame, const SecondaryPass& pass,
-                              const TraceOptions& options, const GpuTuning& tuning, gpu::Context& context,
-                              ThreadPool& pool, const PlanHook& onPlan, gpu::PipelineCache* pipelines) {
-    const gpu::DeviceInfo& device = context.info();
+void checkGpuOptions(const TraceOptions& options) { checkTraceOptions(options); }
+
+GpuTracer::GpuTracer(gpu::Context& context, ThreadPool& pool, const TraceOptions& options, const GpuTuning& tuning,
+                     gpu::PipelineCache* pipelines, gpu::ResidentTriangles* resident)
+    : context_(context),
+      pool_(pool),
+      options_(options),
+      tuning_(tuning),
+      ownPipelines_(pipelines ? nullptr : std::make_unique<gpu::PipelineCache>(context)),
+      pipelines_(pipelines ? *pipelines : *ownPipelines_),
+      resident_(resident) {
     checkGpuOptions(options);
+}
+
+GpuTracer::~GpuTracer() = default;
+
+TraceResult GpuTracer::startResult() const {
     TraceResult result;
-    result.threads = pool.size();
-    describeDevice(device, result);
-    if (!source.divided) divideForSecondaryRays(source, frame, options, tuning, context, pool, result);
-    const std::uint64_t slots = secondarySlots(pass, source.primaryRays);
-    result.regions = unsigned(source.division.regions.size());
-    result.axis = source.division.axis;
-    result.gpu->rayGroups = source.work.groups;
+    result.threads = pool_.size();
+    describeDevice(context_.info(), result);
+    return result;
+}
+
+TraceResult GpuTracer::trace(const FrameGeometry& geometry, const PlanHook& onPlan, GpuPassSourcePtr* keep) {
+    const gpu::DeviceInfo& device = context_.info();
+    if (!device.subgroupOperations)
+        throw InputError("device '" + device.name +
+                         "' lacks subgroup arithmetic or shuffles in compute shaders, which the gpu backend needs");
+    Frame frame{geometry, startResult()};
+    frame.rays = geometry.rays->size();
+    if (resident_ && options_.skips.uploads && geometry.trianglesVersion != 0) {
+        frame.keepsTriangles = true;
+        frame.trianglesOnDevice = resident_->holds(geometry);
+    }
+    divide(frame);
+    frame.workgroupSize = chooseWorkgroupSize(*frame.work, tuning_, device, frame.result);
+    planMemory(frame);
+    if (onPlan && !onPlan(frame.result.memory)) return std::move(frame.result);
+
+    upload(frame);
+    compileKernel(frame, geometry.raysShareStart, geometry.query == HitQuery::Any);
+    dispatch(frame);
+    readBack(frame);
+    if (keep) {
+        *keep = GpuPassSourcePtr(new GpuPassSource{});
+        (*keep)->primaryRays = geometry.rays->size();
+        (*keep)->primary = std::move(frame.set);
+    }
+    return std::move(frame.result);
+}
+
+// The same division as the cpu backend, then the work items over the region slots.
+void GpuTracer::divide(Frame& frame) {
+    const auto start = Clock::now();
+    const gpu::DeviceInfo& device = context_.info();
+    const unsigned regions = options_.regions ? options_.regions : gpu::defaultGpuRegions(device);
+    const int axis = options_.axis == DivisionAxis::Best ? chooseDivisionAxis(frame.geometry, regions)
+                                                         : int(options_.axis) - 1;
+    frame.division = divideScene(frame.geometry, regions, axis, pool_, frame.hostPlan);
+    const std::vector<TransferRound> schedule = transferSchedule(frame.division);
+    const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, regions);
+    frame.ownWork = gpu::planWorkItems(frame.division, schedule, groups);
+    frame.triIdCount = std::uint64_t(frame.division.triIds.size()) * frame.work->groups;
+    frame.result.regions = regions;
+    frame.result.axis = axis;
+    frame.result.counters.raysCulled = frame.division.culledRays;
+    frame.result.gpu->rayGroups = groups;
+    frame.result.phases.divide = msSince(start);
+}
+
+// Every buffer, host and device, from the counts; checked against the device's limits.
+void GpuTracer::planMemory(Frame& frame) const {
+    const FrameGeometry& g = frame.geometry;
+    const gpu::WorkPlan& work = *frame.work;
+    frame.buffers = gpu::planDacrtBuffers(gpu::DacrtBufferCounts{
+        .rays = g.rays->size(),
+        .triangles = g.triangles->size(),
+        .rayIds = frame.division.rayIds.size(),
+        .triangleIds = frame.triIdCount,
+        .regions = work.slots.size(),
+        .workItems = work.items.size(),
+        .maxDepth = options_.dacrt.maxDepth,
+    });
+    MemoryPlan& plan = frame.result.memory;
+    for (const auto& [name, bytes] : frame.hostPlan.buffers) plan.add("host: " + name, bytes);
+    plan.add("host: triangle ids per ray group", frame.triIdCount * 4);
+    gpu::addToMemoryPlan(frame.buffers, context_.info(), plan);
+    plan.work.insert(plan.work.end(), frame.hostPlan.work.begin(), frame.hostPlan.work.end());
+    plan.addWork("gpu work items", work.items.size(), "Step 1 and transfer pairs, per ray group");
+    const std::uint64_t triangleBytes = std::uint64_t(g.triangles->size()) * (sizeof(Triangle) + sizeof(Bounds));
+    const std::uint64_t uploaded = std::uint64_t(g.rays->size()) * (sizeof(Ray) + sizeof(Hit)) +
+                                   (frame.trianglesOnDevice ? 0 : triangleBytes) +
+                                   std::uint64_t(frame.division.rayIds.size()) * 4 + frame.triIdCount * 4 +
+                                   work.slots.size() * sizeof(Region) + work.items.size() *
+                                   (sizeof(WorkItem) + sizeof(TraversalState)) + sizeof(GpuCounters);
+    plan.addWork("bytes uploaded", uploaded, "rays, misses, triangles and bounds, ids, regions, work items");
+    plan.addWork("skipped: triangle and bounds upload (bytes)", frame.trianglesOnDevice ? triangleBytes : 0,
+                 frame.keepsTriangles ? (frame.trianglesOnDevice ? "on the device since an earlier frame" : "uploaded, kept for the next frame")
+                                      : g.trianglesVersion ? "skip off (--no-skip uploads)" : "the triangles' version is unknown");
+    plan.addWork("bytes read back", std::uint64_t(g.rays->size()) * sizeof(Hit) + work.slots.size() * sizeof(Region),
+                 "hits and regions");
+}
+
+// Creates the frame's buffers and fills them.
+void GpuTracer::upload(Frame& frame) const {
+    const auto start = Clock::now();
+    if (frame.keepsTriangles) {
+        resident_->prepare(context_, frame.geometry);
+        frame.kept[DACRT_BINDING_TRIANGLES] = &resident_->triangles();
+        frame.kept[DACRT_BINDING_TRIANGLE_BOUNDS] = &resident_->bounds();
+    }
+    frame.set = std::make_unique<gpu::DacrtBindingSet>(context_, frame.buffers, frame.kept);
+    gpu::DacrtBindingSet& set = *frame.set;
+    const FrameGeometry& g = frame.geometry;
+    const gpu::WorkPlan& work = *frame.work;
+    const std::vector<std::uint32_t> slotTriIds = gpu::groupTriangleIds(frame.division, work.groups);
+    std::vector<Hit> misses;
+    misses.reserve(g.rays->size());
+    for (const Ray& ray : *g.rays) misses.push_back(missHit(ray));
+    const GpuCounters zero{};
+    const std::vector<TraversalState> fresh(work.items.size(), TraversalState{});
+    auto upload = [&](std::uint32_t binding, const auto& v) { set[binding].upload(v.data(), v.size() * sizeof(v[0])); };
+    upload(DACRT_BINDING_RAYS, *g.rays);
+    if (!frame.keepsTriangles) {
+        upload(DACRT_BINDING_TRIANGLES, *g.triangles);
+        upload(DACRT_BINDING_TRIANGLE_BOUNDS, *g.triangleBounds);
+    }
+    upload(DACRT_BINDING_HITS, misses);
+    upload(DACRT_BINDING_RAY_IDS, frame.division.rayIds);
+    upload(DACRT_BINDING_TRI_IDS, slotTriIds);
+    upload(DACRT_BINDING_REGIONS, work.slots);
+    upload(DACRT_BINDING_WORK_ITEMS, work.items);
+    set[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
+    upload(DACRT_BINDING_STATES, fresh);
+    frame.result.phases.upload = msSince(start);
+}
+
+void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const {
+    const auto start = Clock::now();
+    const DacrtOptions leafLimits = options_.dacrt.resolvedFor(Backend::Gpu);
+    gpu::ComputePipeline& pipeline = pipelines_.kernel(gpu::KernelSpecialization{
+        .workgroupSize = frame.workgroupSize,
+        .rayLimit = leafLimits.rayLimit,
+        .triLimit = leafLimits.triLimit,
+        .maxDepth = options_.dacrt.maxDepth,
+        .loopBudget = gpu::loopBudgetOf(context_.info()),
+        .sharedStart = sharedStart,
+        .anyHit = anyHit,
+    });
+    // Compilation only (a first use; later frames find the pipeline in the cache), so that
+    // render and bench can take it out of the frame.
+    PhaseTimes::addTo(frame.result.phases.pipelineCompile, msSince(start));
+    frame.set->bindTo(pipeline);
+    frame.kernel = &pipeline;
+}
+
+// Step 1 and the transfer rounds in one command buffer, then continuations until every work
+// item is done.
+void GpuTracer::dispatch(Frame& frame) const {
+    const auto start = Clock::now();
+    DacrtPush push{};
+    push.rayOrigin = frame.geometry.nearSide;  // the shared origin when raysShareStart
+    push.margin = frame.geometry.margin;
+    push.axis = std::uint32_t(frame.division.axis);
+    push.rayScratchHalf = std::uint32_t(frame.division.rayIds.size());
+    push.triScratchHalf = std::uint32_t(frame.triIdCount);
+    push.loopProbe = 2;
+    push.rayTmin = frame.geometry.rays->front().tmin;
+    push.order = frame.geometry.order == ChildOrder::PerRay ? shared::kOrderPerRay : shared::kOrderNearSide;
+    frame.counters = dispatchSchedule(*frame.work, context_, *frame.kernel, *frame.set, push, *frame.result.gpu);
+    dispatchContinuations(*frame.work, context_, *frame.kernel, *frame.set, push, frame.counters, *frame.result.gpu);
+    frame.result.phases.dispatch = msSince(start);
+}
+
+void GpuTracer::readBack(Frame& frame) const {
+    const auto start = Clock::now();
+    TraceResult& result = frame.result;
+    const gpu::WorkPlan& work = *frame.work;
+    const gpu::DacrtBindingSet& set = *frame.set;
+    result.hits.resize(frame.rays);
+    set[DACRT_BINDING_HITS].download(result.hits.data(), result.hits.size() * sizeof(Hit));
+    std::vector<Region> after(work.slots.size());
+    set[DACRT_BINDING_REGIONS].download(after.data(), after.size() * sizeof(Region));
+    result.phases.readback = msSince(start);
+
+    const GpuCounters& counters = frame.counters;
+    checkLoopLimit(counters, work.items.size(), context_.info());
+    result.counters.rayBoxTests = counters.rayBoxTests;
+    result.counters.rayTriangleTests = counters.rayTriangleTests;
+    result.counters.leaves = counters.leaves;
+    result.counters.raysFinishedWithoutHit = counters.raysRetired;
+    result.counters.finishedStep1 = counters.terminatedStep1;
+    result.counters.transferWorkItems = work.transferPairs;
+    GpuReport& report = *result.gpu;
+    report.raysFinished = 0;  // one command buffer: no per-round readback
+    for (const Region& r : after) report.raysFinished += r.terminated - r.rayBegin;
+    report.dispatches = std::uint32_t(report.dispatchMs.size());
+    report.slices = counters.slices;
+    report.workItemsRun = counters.workItemsRun;
+    report.workItemsEmpty = counters.workItemsEmpty;
+    report.validationErrors = context_.validationErrors();
+}
+
+TraceResult GpuTracer::traceSecondary(GpuPassSource& source, const FrameGeometry& geometry, const SecondaryPass& pass,
+                                      const PlanHook& onPlan) {
+    Frame frame{geometry, startResult()};
+    if (!source.divided) divideForSecondaryRays(source, geometry, frame.result);
+    frame.rays = secondarySlots(pass, source.primaryRays);
+    frame.work = &source.work;
+    frame.triIdCount = std::uint64_t(source.division.triIds.size()) * source.work.groups;
+    frame.result.regions = unsigned(source.division.regions.size());
+    frame.result.axis = source.division.axis;
+    frame.result.gpu->rayGroups = source.work.groups;
 
     // Ray counts per slot are the device's to find: the estimate for the workgroup size is an
     // even share.
     gpu::WorkPlan sizing = source.work;
-    sizing.largestSlotRays = std::uint32_t(std::min<std::uint64_t>(slots / std::max<std::size_t>(sizing.slots.size(), 1),
+    sizing.largestSlotRays = std::uint32_t(std::min<std::uint64_t>(frame.rays / std::max<std::size_t>(sizing.slots.size(), 1),
                                                                    std::numeric_limits<std::uint32_t>::max()));
-    const std::uint32_t workgroupSize = chooseWorkgroupSize(sizing, tuning, device, result);
-    const std::uint64_t triIdCount = std::uint64_t(source.division.triIds.size()) * source.work.groups;
-    const gpu::DacrtBufferPlan buffers = gpu::planDacrtBuffers(gpu::DacrtBufferCounts{
-        .rays = slots,
-        .triangles = frame.triangles->size(),
-        .rayIds = slots,
-        .triangleIds = triIdCount,
+    frame.workgroupSize = chooseWorkgroupSize(sizing, tuning_, context_.info(), frame.result);
+    planPass(frame, source, pass);
+    if (onPlan && !onPlan(frame.result.memory)) return std::move(frame.result);
+
+    uploadPass(frame, source);
+    compileKernel(frame, false, true);
+    const auto start = Clock::now();
+    frame.rayMaker = &pipelines_.secondary();
+    frame.set->bindTo(*frame.rayMaker);
+    PhaseTimes::addTo(frame.result.phases.pipelineCompile, msSince(start));
+    dispatchPass(frame, source, pass);
+    readBack(frame);
+    return std::move(frame.result);
+}
+
+// The first secondary pass of a frame divides its triangles (rays: none yet) and plans work
+// items for every pair of regions, since rays of every direction may move between any two.
+void GpuTracer::divideForSecondaryRays(GpuPassSource& source, const FrameGeometry& frame, TraceResult& result) const {
+    const auto start = Clock::now();
+    const gpu::DeviceInfo& device = context_.info();
+    const unsigned regions = options_.regions ? options_.regions : gpu::defaultGpuRegions(device);
+    const glm::vec3 extent = frame.sceneBox.extent();
+    const int longest = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+    const int axis = options_.axis == DivisionAxis::Best ? longest : int(options_.axis) - 1;
+    static const std::vector<Ray> noRays;
+    FrameGeometry triangles = frame;
+    triangles.rays = &noRays;
+    triangles.tracedTriangles = nullptr;
+    // The margin the kernel and the device's ray binning filter with: triangles straddle by it.
+    source.margin = secondaryMargin(frame.sceneBox);
+    triangles.margin = source.margin;
+    MemoryPlan unused;
+    source.division = divideScene(triangles, regions, axis, pool_, unused);
+    const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, regions);
+    source.work = gpu::planWorkItems(source.division, transferSchedule(source.division, false), groups);
+    const std::vector<std::uint32_t> ids = gpu::groupTriangleIds(source.division, groups);
+    const std::uint64_t idBytes = std::max<std::uint64_t>(ids.size(), 1) * 8;
+    if (idBytes > device.maxStorageBufferRange)
+        throw InputError("the device buffer of the secondary passes' triangle ids and scratch needs " +
+                         std::to_string(idBytes) + " bytes, more than the device's maxStorageBufferRange of " +
+                         std::to_string(device.maxStorageBufferRange) + " bytes (over by " +
+                         std::to_string(idBytes - device.maxStorageBufferRange) + "); use fewer regions or ray groups");
+    source.triangleIds = std::make_unique<gpu::Buffer>(context_, idBytes, "triangle ids and scratch (secondary passes)");
+    source.triangleIds->upload(ids.data(), ids.size() * sizeof(std::uint32_t));
+    source.divided = true;
+    result.phases.divide = msSince(start);
+}
+
+// The pass's buffers from its slot count; those it shares with the primary pass counted once,
+// as kept.
+void GpuTracer::planPass(Frame& frame, const GpuPassSource& source, const SecondaryPass& pass) const {
+    frame.buffers = gpu::planDacrtBuffers(gpu::DacrtBufferCounts{
+        .rays = frame.rays,
+        .triangles = frame.geometry.triangles->size(),
+        .rayIds = frame.rays,
+        .triangleIds = frame.triIdCount,
         .regions = source.work.slots.size(),
         .workItems = source.work.items.size(),
-        .maxDepth = options.dacrt.maxDepth,
+        .maxDepth = options_.dacrt.maxDepth,
         .sourceRays = source.primaryRays,
     });
-    // The buffers this pass shares with the primary pass: counted once, as kept.
-    gpu::ResidentBuffers resident{};
     gpu::DacrtBindingSet& primary = *source.primary;
-    resident[DACRT_BINDING_TRIANGLES] = &primary[DACRT_BINDING_TRIANGLES];
-    resident[DACRT_BINDING_TRIANGLE_BOUNDS] = &primary[DACRT_BINDING_TRIANGLE_BOUNDS];
-    resident[DACRT_BINDING_TRI_IDS] = source.triangleIds.get();
-    resident[DACRT_BINDING_SOURCE_RAYS] = &primary[DACRT_BINDING_RAYS];
-    resident[DACRT_BINDING_SOURCE_HITS] = &primary[DACRT_BINDING_HITS];
-    gpu::addToMemoryPlan(buffers, device, result.memory, &resident);
+    frame.kept[DACRT_BINDING_TRIANGLES] = &primary[DACRT_BINDING_TRIANGLES];
+    frame.kept[DACRT_BINDING_TRIANGLE_BOUNDS] = &primary[DACRT_BINDING_TRIANGLE_BOUNDS];
+    frame.kept[DACRT_BINDING_TRI_IDS] = source.triangleIds.get();
+    frame.kept[DACRT_BINDING_SOURCE_RAYS] = &primary[DACRT_BINDING_RAYS];
+    frame.kept[DACRT_BINDING_SOURCE_HITS] = &primary[DACRT_BINDING_HITS];
+    MemoryPlan& plan = frame.result.memory;
+    gpu::addToMemoryPlan(frame.buffers, context_.info(), plan, &frame.kept);
     std::uint64_t kept = source.triangleIds->size();
     for (std::uint32_t k = 0; k < DACRT_BINDING_COUNT; ++k) kept += primary[k].size();
-    result.memory.add("device: kept from the primary pass (its rays, hits, triangles and work buffers)", kept);
-    result.memory.addWork("rays made on the device", slots,
-                          std::to_string(pass.raysPerHit) + " per primary hit, where the surface can send one");
-    result.memory.addWork("gpu work items", source.work.items.size(), "Step 1 and every pair of regions, per ray group");
-    if (onPlan && !onPlan(result.memory)) return result;
+    plan.add("device: kept from the primary pass (its rays, hits, triangles and work buffers)", kept);
+    plan.addWork("rays made on the device", frame.rays,
+                 std::to_string(pass.raysPerHit) + " per primary hit, where the surface can send one");
+    plan.addWork("gpu work items", source.work.items.size(), "Step 1 and every pair of regions, per ray group");
+}
 
-    auto start = Clock::now();
-    gpu::DacrtBindingSet set(context, buffers, resident);
+void GpuTracer::uploadPass(Frame& frame, const GpuPassSource& source) const {
+    const auto start = Clock::now();
+    frame.set = std::make_unique<gpu::DacrtBindingSet>(context_, frame.buffers, frame.kept);
+    gpu::DacrtBindingSet& set = *frame.set;
     const GpuCounters zero{};
     const std::vector<TraversalState> fresh(source.work.items.size(), TraversalState{});
     set[DACRT_BINDING_REGIONS].upload(source.work.slots.data(), source.work.slots.size() * sizeof(Region));
     set[DACRT_BINDING_WORK_ITEMS].upload(source.work.items.data(), source.work.items.size() * sizeof(WorkItem));
     set[DACRT_BINDING_STATES].upload(fresh.data(), fresh.size() * sizeof(TraversalState));
     set[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
-    result.phaseMs.emplace_back("upload", msSince(start));
+    frame.result.phases.upload = msSince(start);
+}
 
-    gpu::PipelineCache frameOnly(context);
-    gpu::PipelineCache& cache = pipelines ? *pipelines : frameOnly;
-    gpu::ComputePipeline& kernel =
-        preparePipeline(workgroupSize, false, true, options.dacrt, device, cache, set, result);
-    start = Clock::now();
-    gpu::ComputePipeline& maker = cache.secondary();
-    set.bindTo(maker);
-    result.phaseMs.emplace_back(kPipelinePhase, msSince(start));
-
-    start = Clock::now();
+// The rays made on the device ahead of Step 1, in the same command buffer, then the rounds
+// and continuations as a primary frame's.
+void GpuTracer::dispatchPass(Frame& frame, const GpuPassSource& source, const SecondaryPass& pass) const {
+    const auto start = Clock::now();
     DacrtPush push{};
     push.margin = source.margin;
     push.axis = std::uint32_t(source.division.axis);
-    push.rayScratchHalf = std::uint32_t(slots);
-    push.triScratchHalf = std::uint32_t(triIdCount);
+    push.rayScratchHalf = std::uint32_t(frame.rays);
+    push.triScratchHalf = std::uint32_t(frame.triIdCount);
     push.loopProbe = 2;
     push.order = shared::kOrderPerRay;  // any hit: every ray visits the low child, then the high
-    const Prelude prelude = makeRaysOnDevice(maker, secondaryPush(source, pass), slots, device.maxComputeWorkGroupCountX);
-    GpuCounters counters = dispatchSchedule(source.work, context, kernel, set, push, *result.gpu, prelude);
-    dispatchContinuations(source.work, context, kernel, set, push, counters, *result.gpu);
-    result.phaseMs.emplace_back("dispatch", msSince(start));
-    readBack(source.work, slots, set, counters, context, result);
-    return result;
+    const Prelude prelude = makeRaysOnDevice(*frame.rayMaker, secondaryPush(source, pass), frame.rays,
+                                             context_.info().maxComputeWorkGroupCountX);
+    frame.counters = dispatchSchedule(source.work, context_, *frame.kernel, *frame.set, push, *frame.result.gpu, prelude);
+    dispatchContinuations(source.work, context_, *frame.kernel, *frame.set, push, frame.counters, *frame.result.gpu);
+    frame.result.phases.dispatch = msSince(start);
 }
 
 }  // namespace dacrt

@@ -16,44 +16,73 @@
 
 namespace dacrt {
 
-// The phase in which pipelines are created and compiled (first use in a process; drivers that
-// cache compiled pipelines make it short afterwards): reported apart from the frame's time.
-inline constexpr const char* kPipelinePhase = "pipeline compile";
-
 struct GpuTuning {
     std::uint32_t workgroupSize = 0;  // 0: the device's default (gpu::defaultWorkgroupSize)
     std::uint32_t rayGroups = 0;      // 0: the device's default (gpu::defaultRayGroups)
 };
 
 // Throws InputError when the options ask for what the kernel does not run: it runs the
-// spatial-median split and the exact defaults. traceGpu checks this, and the device.
+// spatial-median split and the exact defaults. GpuTracer checks this, and the device.
 void checkGpuOptions(const TraceOptions& options);
 
 // What a primary pass leaves on the device for the frame's secondary passes (its rays, hits
-// and triangles: never read back and uploaded again). Opaque; made by traceGpu.
+// and triangles: never read back and uploaded again). Opaque; made by GpuTracer::trace.
 struct GpuPassSource;
 struct GpuPassSourceDeleter {
     void operator()(GpuPassSource* source) const;
 };
 using GpuPassSourcePtr = std::unique_ptr<GpuPassSource, GpuPassSourceDeleter>;
 
-// Traces one frame on the context's device. Pipelines come from `pipelines` when given (kept
-// across frames), else are made for this frame alone.
-// With `resident` (and options.skips.uploads), the triangles and bounds stay on the device
-// between frames of the same FrameGeometry::trianglesVersion. With `keep`, the frame's device
-// buffers are kept there for traceGpuSecondary.
-TraceResult traceGpu(const FrameGeometry& geometry, const TraceOptions& options, const GpuTuning& tuning,
-                     gpu::Context& context, ThreadPool& pool, const PlanHook& onPlan = {},
-                     gpu::PipelineCache* pipelines = nullptr, gpu::ResidentTriangles* resident = nullptr,
-                     GpuPassSourcePtr* keep = nullptr);
+// Traces frames on the context's device with one set of options: each stage of a frame (the
+// division, the plan, the upload, the pipelines, the dispatch rounds, the readback) is a
+// method, run in that order by trace() and traceSecondary().
+class GpuTracer {
+public:
+    // Pipelines come from `pipelines` when given (kept across frames), else are made for this
+    // tracer alone. With `resident` (and options.skips.uploads), the triangles and bounds stay
+    // on the device between frames of the same FrameGeometry::trianglesVersion.
+    // Throws InputError for options the kernel does not run (checkGpuOptions).
+    GpuTracer(gpu::Context& context, ThreadPool& pool, const TraceOptions& options, const GpuTuning& tuning,
+              gpu::PipelineCache* pipelines = nullptr, gpu::ResidentTriangles* resident = nullptr);
+    ~GpuTracer();
 
-// A secondary pass of the frame `source` kept: its rays made from the primary hits and binned
-// to the regions on the device (shaders/secondary.comp), then traced by the same DACRT kernel
-// for any hit. `frame` is the primary frame before its triangle skips (secondary rays may hit
-// any triangle). Returns one hit per slot (SecondaryPass: primary ray x raysPerHit), with
-// kNotTracedPrim where the surface sends no ray, as hitsPerSlot gives on the host.
-TraceResult traceGpuSecondary(GpuPassSource& source, const FrameGeometry& frame, const SecondaryPass& pass,
-                              const TraceOptions& options, const GpuTuning& tuning, gpu::Context& context,
-                              ThreadPool& pool, const PlanHook& onPlan = {}, gpu::PipelineCache* pipelines = nullptr);
+    // Traces one frame. With `keep`, the frame's device buffers are kept there for
+    // traceSecondary.
+    TraceResult trace(const FrameGeometry& geometry, const PlanHook& onPlan = {}, GpuPassSourcePtr* keep = nullptr);
+
+    // A secondary pass of the frame `source` kept: its rays made from the primary hits and binned
+    // to the regions on the device (shaders/secondary.comp), then traced by the same DACRT kernel
+    // for any hit. `frame` is the primary frame before its triangle skips (secondary rays may hit
+    // any triangle). Returns one hit per slot (SecondaryPass: primary ray x raysPerHit), with
+    // kNotTracedPrim where the surface sends no ray, as hitsPerSlot gives on the host.
+    TraceResult traceSecondary(GpuPassSource& source, const FrameGeometry& frame, const SecondaryPass& pass,
+                               const PlanHook& onPlan = {});
+
+private:
+    struct Frame;  // what a frame's (or a pass's) stages hand each other
+
+    // A primary frame's stages.
+    void divide(Frame& frame);
+    void planMemory(Frame& frame) const;
+    void upload(Frame& frame) const;
+    void dispatch(Frame& frame) const;
+    void readBack(Frame& frame) const;
+    // A secondary pass's own stages.
+    void divideForSecondaryRays(GpuPassSource& source, const FrameGeometry& frame, TraceResult& result) const;
+    void planPass(Frame& frame, const GpuPassSource& source, const SecondaryPass& pass) const;
+    void uploadPass(Frame& frame, const GpuPassSource& source) const;
+    void dispatchPass(Frame& frame, const GpuPassSource& source, const SecondaryPass& pass) const;
+    // Shared by both.
+    TraceResult startResult() const;
+    void compileKernel(Frame& frame, bool sharedStart, bool anyHit) const;
+
+    gpu::Context& context_;
+    ThreadPool& pool_;
+    TraceOptions options_;
+    GpuTuning tuning_;
+    std::unique_ptr<gpu::PipelineCache> ownPipelines_;  // without `pipelines`: this tracer's
+    gpu::PipelineCache& pipelines_;
+    gpu::ResidentTriangles* resident_;
+};
 
 }  // namespace dacrt

@@ -69,7 +69,7 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
     const double skipMs = msSince(start);
     auto withSkipLines = [&](TraceResult r) {
         r.memory.work.insert(r.memory.work.begin(), skipPlan.work.begin(), skipPlan.work.end());
-        r.phaseMs.insert(r.phaseMs.begin(), {"skips", skipMs});
+        r.phases.skips = skipMs;
         return r;
     };
     const PlanHook planWithSkips = withWorkLines(onPlan, skipPlan.work, true);
@@ -96,8 +96,9 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
     switch (request.trace.backend) {
         case Backend::Gpu:
             if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
-            return traceGpu(geometry, request.trace, request.gpuTuning, *gpu_, threadPool, onPlan, pipelines_.get(),
-                            resident_.get(), request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
+            return GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get())
+                .trace(geometry, onPlan,
+                       request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
         case Backend::Embree:
             // Embree allocates its BVH itself: there is no plan to show or check.
         {
@@ -127,8 +128,8 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     // On gpu the rays are made where the primary pass left its hits; a frame the skips left
     // empty (no triangle: every primary ray misses) kept nothing there, and makes no ray.
     if (request.trace.backend == Backend::Gpu && passSource_) {
-        out.result = traceGpuSecondary(*passSource_, primary, pass, request.trace, request.gpuTuning, *gpu_, threadPool,
-                                       onPlan, pipelines_.get());
+        out.result = GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get())
+                         .traceSecondary(*passSource_, primary, pass, onPlan);
         for (const Hit& h : out.result.hits) out.rays += h.prim != kNotTracedPrim;
         return out;
     }
@@ -151,7 +152,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
         if (out.result.hits.empty()) return out;  // stopped at the plan
         out.result.hits = hitsPerSlot(rays, out.result.hits);
     }
-    out.result.phaseMs.insert(out.result.phaseMs.begin(), {"make rays", makeMs});
+    out.result.phases.makeRays = makeMs;
     return out;
 }
 

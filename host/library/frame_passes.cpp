@@ -75,7 +75,7 @@ void addBatch(TracedPass& whole, const SecondaryPass& batch, TracedPass&& part, 
         for (std::uint32_t k = 0; k < batch.raysPerHit; ++k)
             whole.result.hits[i * total + batch.firstSample + k] = part.result.hits[i * batch.raysPerHit + k];
     whole.result.counters.add(part.result.counters);
-    whole.result.phaseMs.insert(whole.result.phaseMs.end(), part.result.phaseMs.begin(), part.result.phaseMs.end());
+    whole.result.phases.add(part.result.phases);
     whole.rays += part.rays;
     whole.ms += part.ms;
 }

@@ -419,14 +419,14 @@ TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool, H
         });
     }
     if (!failure.empty()) throw std::runtime_error(failure);
-    result.phaseMs.emplace_back("trace", msSince(start));
+    result.phases.trace = msSince(start);
     return result;
 }
 
 TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool) {
     const EmbreeScene scene(*geometry.triangles, options);
     TraceResult result = scene.trace(*geometry.rays, pool, geometry.query, geometry.imageWidth);
-    result.phaseMs.insert(result.phaseMs.begin(), {"build", scene.buildMs()});
+    result.phases.build = scene.buildMs();
     return result;
 }
 

@@ -71,7 +71,7 @@ public:
     // ray gets Hit{ray.tmin, kUnnamedHitPrim, 0, 0}, t being only a bound the hit lies beyond,
     // an unoccluded one missHit(ray). imageWidth: the rays' image width (0: not an image), for
     // a scene that traces both a camera's rays and secondary rays; unset: the options'.
-    // phaseMs holds {"trace", ms}; counters stay zero (Embree does not report them).
+    // phases holds trace; counters stay zero (Embree does not report them).
     TraceResult trace(const std::vector<Ray>& rays, ThreadPool& pool, HitQuery query = HitQuery::Closest,
                       std::optional<std::uint32_t> imageWidth = std::nullopt) const;
 
@@ -82,7 +82,7 @@ private:
 };
 
 // A dynamic-scene frame: build, then trace the frame's rays for its query, in tiles where the
-// frame says its rays are an image. phaseMs holds {"build", ms} and {"trace", ms}.
+// frame says its rays are an image. phases holds build and trace.
 TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool);
 
 }  // namespace dacrt

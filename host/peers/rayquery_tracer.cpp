@@ -6,7 +6,6 @@
 #include "peers/acceleration_structure.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/dispatch_recorder.hpp"
-#include "gpu/gpu_tracer.hpp"
 
 namespace dacrt {
 namespace {
@@ -81,7 +80,7 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays, HitQuery query) {
         m.hits = std::make_unique<gpu::Buffer>(m.context, rays.size() * sizeof(Hit), "rayquery hits");
     }
     m.rays->upload(rays.data(), rays.size() * sizeof(Ray));
-    result.phaseMs.emplace_back("upload", msSince(start));
+    result.phases.upload = msSince(start);
 
     gpu::ComputePipeline& pipeline = m.pipelines.rayQuery();
     pipeline.bind({m.rays.get(), m.hits.get(), nullptr, &m.vertices});
@@ -128,14 +127,14 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays, HitQuery query) {
     double buildMs = 0.0;
     for (const auto& [name, ms] : timings)
         if (name != "trace") buildMs += ms;
-    if (rebuild || refit) result.phaseMs.emplace_back(refit ? "refit" : "build", buildMs);
-    if (prime) result.phaseMs.emplace_back(kPipelinePhase, compileMs);
-    result.phaseMs.emplace_back("dispatch", msSince(start) - compileMs);
+    if (rebuild || refit) (refit ? result.phases.refit : result.phases.build) = buildMs;
+    if (prime) result.phases.pipelineCompile = compileMs;
+    result.phases.dispatch = msSince(start) - compileMs;
 
     start = Clock::now();
     result.hits.resize(rays.size());
     m.hits->download(result.hits.data(), rays.size() * sizeof(Hit));
-    result.phaseMs.emplace_back("readback", msSince(start));
+    result.phases.readback = msSince(start);
     result.memory.add("device: rayquery vertices", m.vertices.size());
     result.memory.add("device: acceleration structure and scratch", m.structure.bytes());
     result.memory.add("device: rays", m.rays->size());
@@ -163,7 +162,7 @@ TraceResult traceRayQuery(const FrameGeometry& geometry, gpu::Context& context, 
     RayQueryScene scene(context, pipelines, *geometry.triangles, RayQueryBuild::Dynamic);
     const double allocateMs = msSince(start);
     TraceResult result = scene.trace(*geometry.rays, geometry.query);
-    result.phaseMs.insert(result.phaseMs.begin(), {"allocate", allocateMs});
+    result.phases.allocate = allocateMs;
     return result;
 }
 

@@ -39,7 +39,7 @@ public:
     // traced within their segments (ray.tmin <= t <= ray.tmax as Vulkan specifies it, which
     // differs from dacrt's t > tmin only at a triangle through a ray's start; a miss is
     // missHit(ray)): the closest hit, or for HitQuery::Any the first hit the traversal commits
-    // (gl_RayFlagsTerminateOnFirstHitEXT), its t and primitive. phaseMs holds upload, build
+    // (gl_RayFlagsTerminateOnFirstHitEXT), its t and primitive. phases holds upload, build
     // (or refit: the structure's part alone), dispatch (build and trace together, as the
     // device ran them) and readback; the gpu report the timestamps.
     TraceResult trace(const std::vector<Ray>& rays, HitQuery query = HitQuery::Closest);

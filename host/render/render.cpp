@@ -263,10 +263,7 @@ PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t r
 
 // Pipeline compilation within a trace: a cost of the process, not of the frame.
 double compiledMs(const TraceResult& r) {
-    double ms = 0.0;
-    for (const auto& [name, t] : r.phaseMs)
-        if (name == kPipelinePhase) ms += t;
-    return ms;
+    return r.phases.compileMs();
 }
 
 // A traced frame: the primary pass and its secondary passes.

@@ -9,15 +9,15 @@ nlohmann::ordered_json vec(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
 
 nlohmann::ordered_json countersJson(const Counters& c) {
     nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
-    for (std::size_t i = 0; i < c.terminatedPerRound.size(); ++i)
-        rounds.push_back({{"round", c.roundNames[i]}, {"terminated", c.terminatedPerRound[i]}});
+    for (std::size_t i = 0; i < c.finishedPerRound.size(); ++i)
+        rounds.push_back({{"round", c.roundNames[i]}, {"terminated", c.finishedPerRound[i]}});
     return {{"ray_box_tests", c.rayBoxTests},
             {"packet_box_tests", c.packetBoxTests},
             {"ray_triangle_tests", c.rayTriangleTests},
             {"leaves", c.leaves},
-            {"rays_retired_without_hit", c.raysRetired},
+            {"rays_retired_without_hit", c.raysFinishedWithoutHit},
             {"rays_culled", c.raysCulled},
-            {"rays_terminated_step1", c.terminatedStep1},
+            {"rays_terminated_step1", c.finishedStep1},
             {"rays_terminated_per_round", rounds},
             {"transfer_work_items", c.transferWorkItems},
             {"transfer_work_items_skipped", c.transferWorkItemsSkipped}};
@@ -57,14 +57,9 @@ nlohmann::ordered_json passesJson(const RenderedFrame& frame, double primaryMs) 
                       {"rays_per_second", perSecond(frame.rayCount, primaryMs)}});
     if (!frame.passes) return passes;
     for (const TracedPass& t : *frame.passes) {
-        double compile = 0.0;
-        nlohmann::ordered_json phases;
-        for (const auto& [name, ms] : t.result.phaseMs) {  // a batched pass has each phase once per batch
-            const std::string key = jsonKey(name);
-            phases[key] = (phases.contains(key) ? phases[key].get<double>() : 0.0) + ms;
-            if (name == kPipelinePhase) compile += ms;
-        }
-        const double ms = t.ms - compile;
+        nlohmann::ordered_json phases;  // a batched pass's: summed over its batches
+        for (const auto& [name, ms] : t.result.phases.listed()) phases[jsonKey(name)] = ms;
+        const double ms = t.ms - t.result.phases.compileMs();
         std::uint64_t hits = 0;
         for (const Hit& h : t.result.hits) hits += h.prim != kMissPrim && h.prim != kNotTracedPrim;
         nlohmann::ordered_json p = {{"name", t.pass.name},
@@ -145,7 +140,7 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     nlohmann::ordered_json t;
     for (const auto& [name, ms] : frame.timingsMs) t[name] = ms;
     nlohmann::ordered_json phases;
-    for (const auto& [name, ms] : r.phaseMs) phases[jsonKey(name)] = ms;
+    for (const auto& [name, ms] : r.phases.listed()) phases[jsonKey(name)] = ms;
     if (!phases.empty()) t["trace_phases"] = phases;
     if (!r.step1RegionMs.empty()) t["step1_region"] = r.step1RegionMs;
     j["timings_ms"] = t;

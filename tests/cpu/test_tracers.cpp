@@ -185,11 +185,11 @@ TEST(ParallelScheme, CountersAndPlanAreConsistent) {
     const Scene s = test::shapesScene();
     const Frame frame(test::shapesScene(), defaultCamera(s, 64, 48), 64, 48);
     const TraceResult r = frame.trace(Backend::Cpu, 4, 2);
-    std::uint64_t afterRounds = r.counters.terminatedStep1;
-    for (std::uint64_t n : r.counters.terminatedPerRound) afterRounds += n;
+    std::uint64_t afterRounds = r.counters.finishedStep1;
+    for (std::uint64_t n : r.counters.finishedPerRound) afterRounds += n;
     EXPECT_LE(afterRounds + r.counters.raysCulled, frame.rays.size());
     EXPECT_LE(hitCount(r.hits), frame.rays.size() - r.counters.raysCulled);
-    EXPECT_GT(r.counters.terminatedStep1, 0u);
+    EXPECT_GT(r.counters.finishedStep1, 0u);
     EXPECT_GT(r.counters.rayTriangleTests, 0u);
     EXPECT_EQ(r.memory.total(), [&] {
         std::uint64_t t = 0;

@@ -125,7 +125,7 @@ std::uint32_t runBlock(gpu::Context& context, BlockInputs& in, WorkgroupTestPush
     return counters.testResult;
 }
 
-// Workgroup sizes in subgroups: the kernel's workgroups are whole subgroups (traceGpu
+// Workgroup sizes in subgroups: the kernel's workgroups are whole subgroups (GpuTracer
 // refuses others, and full subgroups are requested where the device can promise them).
 class GpuBlocks : public ::testing::TestWithParam<std::uint32_t> {};
 

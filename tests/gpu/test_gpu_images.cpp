@@ -32,7 +32,7 @@ std::uint64_t expectGpuMatchesCpu(gpu::Context& context, const Frame& frame, std
         o.backend = Backend::Gpu;
         o.regions = regions;
         ThreadPool pool(2);
-        const TraceResult r = traceGpu(frame.geometry, o, GpuTuning{workgroupSize, rayGroups}, context, pool);
+        const TraceResult r = GpuTracer(context, pool, o, GpuTuning{workgroupSize, rayGroups}).trace(frame.geometry);
         EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << regions << " regions, " << r.gpu->rayGroups << " ray groups";
         EXPECT_EQ(r.gpu->dispatches, r.gpu->dispatchMs.size());
         if (rayGroups) {
@@ -90,7 +90,7 @@ TEST(GpuImages, RaysFromSurfacesInEveryDirection) {
             for (unsigned regions : {1u, 3u})
                 for (std::uint32_t groups : {1u, 2u}) {
                     ThreadPool pool(2);
-                    const TraceResult r = traceGpu(pass.geometry, gpuOptions(regions), GpuTuning{0, groups}, *context, pool);
+                    const TraceResult r = GpuTracer(*context, pool, gpuOptions(regions), GpuTuning{0, groups}).trace(pass.geometry);
                     EXPECT_TRUE(query == HitQuery::Closest ? identicalHits(reference.hits, r.hits)
                                                            : identicalVisibility(reference.hits, r.hits))
                         << regions << " regions, " << groups << " ray groups";
@@ -114,15 +114,14 @@ TEST(GpuImages, SecondaryPassesMadeOnTheDeviceMatchTheHost) {
             const TraceOptions o = gpuOptions(regions);
             ThreadPool pool(2);
             GpuPassSourcePtr source;
-            const TraceResult primary = traceGpu(frame.geometry, o, GpuTuning{0, groups}, *context, pool, {}, nullptr,
-                                                 nullptr, &source);
+            GpuTracer tracer(*context, pool, o, GpuTuning{0, groups});
+            const TraceResult primary = tracer.trace(frame.geometry, {}, &source);
             ASSERT_TRUE(source);
             for (const SecondaryPass& p : {occlusionPass(3, 0.8f), pointShadowPass({0.3f, 1.6f, 0.4f}), directional}) {
                 SCOPED_TRACE(p.name + ", " + std::to_string(regions) + " regions, " + std::to_string(groups) + " groups");
                 const PassFrame host(frame, primary.hits, p);
                 const std::vector<Hit> expected = hitsPerSlot(host.rays, host.trace(Backend::CpuSeq).hits);
-                const TraceResult device =
-                    traceGpuSecondary(*source, frame.geometry, p, o, GpuTuning{0, groups}, *context, pool);
+                const TraceResult device = tracer.traceSecondary(*source, frame.geometry, p);
                 ASSERT_EQ(device.hits.size(), expected.size());
                 std::size_t notTraced = 0, occluded = 0;
                 for (std::size_t i = 0; i < expected.size(); ++i) {
@@ -189,7 +188,7 @@ TEST(GpuImages, SlicedWorkItemsMatchTheUnslicedOnes) {
     o.backend = Backend::Gpu;
     o.regions = 1;
     ThreadPool pool(1);
-    const TraceResult r = traceGpu(frame.geometry, o, GpuTuning{context->info().subgroupSize}, *context, pool);
+    const TraceResult r = GpuTracer(*context, pool, o, GpuTuning{context->info().subgroupSize}).trace(frame.geometry);
     EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, r.hits));
     if (gpu::loopBudgetOf(context->info()) > 0) {
         EXPECT_GT(r.gpu->slices, 1u) << "expected the work item to need several slices";
@@ -222,7 +221,7 @@ TEST(GpuImages, ABufferOverTheDeviceLimitIsAClearError) {
     o.regions = 2;
     ThreadPool pool(2);
     try {
-        traceGpu(frame.geometry, o, GpuTuning{}, *context, pool);
+        GpuTracer(*context, pool, o, GpuTuning{}).trace(frame.geometry);
         FAIL() << "a " << frame.rays.size() * sizeof(Ray) << "-byte ray buffer was accepted";
     } catch (const InputError& e) {
         const std::string what = e.what();
@@ -248,8 +247,8 @@ TEST(GpuImages, TrianglesStayOnTheDeviceAcrossFramesUntilTheyChange) {
             if (w.name.find("skipped: triangle and bounds upload") == 0) return w.count;
         return std::uint64_t(~0ull);
     };
-    const TraceResult first = traceGpu(frame.geometry, o, GpuTuning{}, *context, pool, {}, nullptr, &resident);
-    const TraceResult second = traceGpu(frame.geometry, o, GpuTuning{}, *context, pool, {}, nullptr, &resident);
+    const TraceResult first = GpuTracer(*context, pool, o, GpuTuning{}, nullptr, &resident).trace(frame.geometry);
+    const TraceResult second = GpuTracer(*context, pool, o, GpuTuning{}, nullptr, &resident).trace(frame.geometry);
     EXPECT_EQ(skippedBytes(first), 0u);
     EXPECT_EQ(skippedBytes(second), frame.scene.triangles.size() * (sizeof(Triangle) + sizeof(Bounds)));
     EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, first.hits));
@@ -262,12 +261,12 @@ TEST(GpuImages, TrianglesStayOnTheDeviceAcrossFramesUntilTheyChange) {
     frame.bounds = allTriangleBounds(frame.scene.triangles);
     frame.geometry = frameGeometry(frame.scene.triangles, frame.bounds, frame.rays, sceneBounds(frame.scene.triangles), 48);
     frame.geometry.trianglesVersion = frame.scene.trianglesVersion;
-    const TraceResult moved = traceGpu(frame.geometry, o, GpuTuning{}, *context, pool, {}, nullptr, &resident);
+    const TraceResult moved = GpuTracer(*context, pool, o, GpuTuning{}, nullptr, &resident).trace(frame.geometry);
     EXPECT_EQ(skippedBytes(moved), 0u);
     EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, moved.hits));
     EXPECT_FALSE(identicalHits(first.hits, moved.hits)) << "the scene moved";
     o.skips.uploads = false;  // off: every frame uploads, nothing is kept
-    const TraceResult off = traceGpu(frame.geometry, o, GpuTuning{}, *context, pool, {}, nullptr, &resident);
+    const TraceResult off = GpuTracer(*context, pool, o, GpuTuning{}, nullptr, &resident).trace(frame.geometry);
     EXPECT_EQ(skippedBytes(off), 0u);
     EXPECT_TRUE(identicalHits(moved.hits, off.hits));
     EXPECT_TRUE(noValidationErrors(*context));
