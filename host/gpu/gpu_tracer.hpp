@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <memory>
 
+#include <dacrt/backend_tuning.hpp>
+
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/memory_plan.hpp"
@@ -19,11 +21,6 @@ namespace dacrt {
 // The phase in which pipelines are created and compiled (first use in a process; drivers that
 // cache compiled pipelines make it short afterwards): reported apart from the frame's time.
 inline constexpr const char* kPipelinePhase = "pipeline compile";
-
-struct GpuTuning {
-    std::uint32_t workgroupSize = 0;  // 0: the device's default (gpu::defaultWorkgroupSize)
-    std::uint32_t rayGroups = 0;      // 0: the device's default (gpu::defaultRayGroups)
-};
 
 // Throws InputError when the options ask for what the kernel does not run: it runs the
 // spatial-median split and the exact defaults. traceGpu checks this, and the device.
