@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <dacrt/scene_options.hpp>
 #include <glm/glm.hpp>
 
 #include "core/enum_names.hpp"
@@ -78,9 +79,8 @@ struct Light {
     std::uint32_t node = 0;
 };
 
-// Which back faces no ray hits (Triangle::cullBackFace): the materials' (glTF's rule, the
-// default), none, or every triangle's.
-enum class CullMode { Material, None, BackFaces };
+// CullMode (which back faces no ray hits) is defined in the public <dacrt/scene_options.hpp>;
+// its names as the command line gives them:
 template <>
 struct EnumNames<CullMode> {
     static constexpr std::array<std::pair<CullMode, std::string_view>, 3> table{

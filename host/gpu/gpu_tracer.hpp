@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <memory>
 
+#include <dacrt/backend_tuning.hpp>
+
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/memory_plan.hpp"
@@ -16,10 +18,6 @@
 
 namespace dacrt {
 
-struct GpuTuning {
-    std::uint32_t workgroupSize = 0;  // 0: the device's default (gpu::defaultWorkgroupSize)
-    std::uint32_t rayGroups = 0;      // 0: the device's default (gpu::defaultRayGroups)
-};
 
 // Throws InputError when the options ask for what the kernel does not run: it runs the
 // spatial-median split and the exact defaults. GpuTracer checks this, and the device.

@@ -1,0 +1,34 @@
+#pragma once
+// The library's side of the public TraceScene and RayBatch (include/dacrt/): the arrays every
+// backend reads, prepared once.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <dacrt/rays.hpp>
+#include <dacrt/scene.hpp>
+
+#include "core/camera.hpp"
+#include "core/scene.hpp"
+
+namespace dacrt {
+
+struct TraceScene::Impl {
+    Scene scene;  // checked (validateScene), its face rule applied
+    std::vector<Bounds> triangleBounds;
+    Box box;
+    // fromArrays where triangles with no area were dropped: the caller's number of each traced
+    // triangle. Empty: the traced triangles' indices are the ids.
+    std::vector<std::uint32_t> callerIds;
+
+    explicit Impl(Scene checked)
+        : scene(std::move(checked)), triangleBounds(allTriangleBounds(scene.triangles)), box(sceneBounds(scene.triangles)) {}
+};
+
+struct RayBatch::Impl {
+    std::vector<Ray> rays;
+    std::uint32_t imageWidth = 0;        // a camera's: its pixels in a row (0: not an image)
+    std::optional<ViewFrustum> frustum;  // a perspective camera's
+};
+
+}  // namespace dacrt

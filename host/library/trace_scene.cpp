@@ -1,0 +1,112 @@
+// The public TraceScene: a glTF file's scene as `dacrt render` loads it, or triangles from the
+// caller's arrays, checked with messages that name the caller's element.
+#include <cmath>
+#include <sstream>
+
+#include <dacrt/errors.hpp>
+#include <dacrt/results.hpp>
+
+#include "core/gltf_loader.hpp"
+#include "core/triangle_rules.hpp"
+#include "library/api_state.hpp"
+
+namespace dacrt {
+
+namespace {
+
+const char* const kAxisNames[3] = {"x", "y", "z"};
+
+void checkArraySizes(std::size_t positions, std::size_t indices, std::size_t flags) {
+    if (positions % 3 != 0)
+        throw InputError("positions: " + std::to_string(positions) +
+                         " floats are not whole vertices (three floats, x, y and z, per vertex)");
+    if (indices % 3 != 0)
+        throw InputError("indices: " + std::to_string(indices) +
+                         " indices are not whole triangles (three vertex indices per triangle)");
+    if (indices / 3 >= std::uint64_t(kUnnamedPrimitive))
+        throw InputError("indices: too many triangles for 32-bit primitive ids");
+    if (flags != 0 && flags != indices / 3)
+        throw InputError("singleSided: " + std::to_string(flags) + " flags for " + std::to_string(indices / 3) +
+                         " triangles (one per triangle, or none: every triangle two-sided)");
+}
+
+void checkPositions(std::span<const float> positions) {
+    for (std::size_t k = 0; k < positions.size(); ++k) {
+        const float c = positions[k];
+        if (std::isfinite(c) && std::abs(c) <= kMaxCoordinate) continue;
+        std::ostringstream msg;
+        msg << "positions[" << k << "] (vertex " << k / 3 << ", " << kAxisNames[k % 3] << ") is " << c;
+        if (std::isfinite(c)) msg << ": coordinates must lie within +-" << kMaxCoordinate
+                                  << " so that every intersection intermediate stays finite";
+        else msg << ": coordinates must be finite";
+        throw InputError(msg.str());
+    }
+}
+
+void checkIndices(std::span<const std::uint32_t> indices, std::size_t vertices) {
+    for (std::size_t k = 0; k < indices.size(); ++k)
+        if (indices[k] >= vertices)
+            throw InputError("indices[" + std::to_string(k) + "] (triangle " + std::to_string(k / 3) + ") is " +
+                             std::to_string(indices[k]) + ", but positions hold " + std::to_string(vertices) +
+                             " vertices");
+}
+
+glm::vec3 vertex(std::span<const float> positions, std::uint32_t index) {
+    return {positions[3 * std::size_t(index)], positions[3 * std::size_t(index) + 1],
+            positions[3 * std::size_t(index) + 2]};
+}
+
+}  // namespace
+
+TraceScene::TraceScene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+TraceScene::TraceScene(TraceScene&&) noexcept = default;
+TraceScene& TraceScene::operator=(TraceScene&&) noexcept = default;
+TraceScene::~TraceScene() = default;
+
+TraceScene TraceScene::load(const std::string& path, const SceneLoadOptions& options) {
+    Scene scene = loadGltf(path, {}, GltfSelection{.scene = options.scene, .animation = options.animation, .time = options.time});
+    selectCamera(scene, options.camera);
+    applyCullMode(scene, options.cull);
+    return TraceScene(std::make_unique<Impl>(std::move(scene)));
+}
+
+TraceScene TraceScene::fromArrays(std::span<const float> positions, std::span<const std::uint32_t> indices,
+                                  std::span<const std::uint8_t> singleSided) {
+    checkArraySizes(positions.size(), indices.size(), singleSided.size());
+    checkPositions(positions);
+    checkIndices(indices, positions.size() / 3);
+    Scene scene;
+    scene.name = "scene from arrays";
+    std::vector<std::uint32_t> callerIds;
+    for (std::uint32_t k = 0; k < indices.size() / 3; ++k) {
+        Triangle t{};
+        t.v0 = vertex(positions, indices[3 * k]);
+        t.v1 = vertex(positions, indices[3 * k + 1]);
+        t.v2 = vertex(positions, indices[3 * k + 2]);
+        t.cullBackFace = !singleSided.empty() && singleSided[k] != 0 ? 1u : 0u;
+        // The loader's rule: no ray can hit a triangle with no area (docs/gltf-input.md).
+        if (shared::triangleHasNoArea(t.v0, t.v1, t.v2)) {
+            ++scene.degenerateTrianglesDropped;
+            continue;
+        }
+        scene.triangles.push_back(t);
+        scene.sources.push_back(TriangleSource{.triangle = k});
+        callerIds.push_back(k);
+    }
+    validateScene(scene);
+    touchTriangles(scene);
+    auto impl = std::make_unique<Impl>(std::move(scene));
+    if (impl->scene.degenerateTrianglesDropped != 0) impl->callerIds = std::move(callerIds);
+    return TraceScene(std::move(impl));
+}
+
+std::size_t TraceScene::triangleCount() const { return impl_->scene.triangles.size(); }
+
+std::uint64_t TraceScene::trianglesDropped() const { return impl_->scene.degenerateTrianglesDropped; }
+
+SceneBounds TraceScene::bounds() const {
+    const Box& box = impl_->box;
+    return SceneBounds{{box.lo.x, box.lo.y, box.lo.z}, {box.hi.x, box.hi.y, box.hi.z}};
+}
+
+}  // namespace dacrt

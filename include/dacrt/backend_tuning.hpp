@@ -1,0 +1,40 @@
+#pragma once
+// The tuning of the backends that take their own options: the gpu's dispatch shape and
+// Embree's build. Plain data, shared by the public API and the backends themselves.
+#include <cstdint>
+
+namespace dacrt {
+
+struct GpuTuning {
+    std::uint32_t workgroupSize = 0;  // 0: the device's default (gpu::defaultWorkgroupSize)
+    std::uint32_t rayGroups = 0;      // 0: the device's default (gpu::defaultRayGroups)
+};
+
+// How the BVH follows the frames, as Embree's users configure each case.
+// Dynamic: RTC_SCENE_FLAG_DYNAMIC with RTC_BUILD_QUALITY_LOW, a new BVH every frame (a scene
+// whose topology changes). Refit: one scene kept across frames, its geometry at
+// RTC_BUILD_QUALITY_REFIT, the vertex buffer updated and recommitted each frame (valid while
+// only vertices move). Static: RTC_BUILD_QUALITY_HIGH, built once, frames pay the trace only.
+enum class EmbreeBuild { Dynamic, Refit, Static };
+
+struct EmbreeOptions {
+    // RTC_SCENE_FLAG_ROBUST: no leaks through shared edges. On by default, unlike Embree
+    // itself: without it Embree leaks real pixels on the Bunny's orbit (docs/benchmarks.md).
+    bool robust = true;
+    unsigned threads = 0;  // threads of Embree's BVH build; 0: every core
+    EmbreeBuild build = EmbreeBuild::Dynamic;
+    // 16-wide packets (rtcIntersect16, rtcOccluded16): on 4x4 pixel tiles with the coherent
+    // flag where the rays are an image, else on runs of 16 consecutive rays; false: one
+    // rtcIntersect1 or rtcOccluded1 per ray.
+    bool packets = true;
+    // The rays' image width, for the tiles, where a trace names none; 0: not an image
+    // (secondary rays).
+    std::uint32_t imageWidth = 0;
+    // The face rule as intersection and occlusion filters where some triangles are
+    // single-sided (the rule every backend applies); false: both faces hit, Embree's fastest,
+    // which gives the same image wherever no back face is visible (closed meshes seen from
+    // outside).
+    bool faceFilter = true;
+};
+
+}  // namespace dacrt

@@ -1,0 +1,38 @@
+#pragma once
+// dacrt: divide-and-conquer ray tracing, with no acceleration structure, on the CPU (SIMD,
+// every core) and on a Vulkan device; Embree and the device's ray queries as peers.
+//
+//     #include <dacrt/dacrt.hpp>
+//
+//     std::vector<float> positions = {-1, -1, -1, 1, -1, -1, 0, 1, -1};   // x, y, z per vertex
+//     std::vector<std::uint32_t> indices = {0, 1, 2};                      // three per triangle
+//     dacrt::TraceScene scene = dacrt::TraceScene::fromArrays(positions, indices);
+//     std::vector<float> origin = {0, 0, 0}, direction = {0, 0, -1};
+//     dacrt::RayBatch rays = dacrt::RayBatch::fromArrays(origin, direction);
+//     dacrt::Tracer tracer({.trace = {.backend = dacrt::Backend::Cpu}});
+//     dacrt::TraceOutput out = tracer.trace(scene, rays);
+//     if (out.hits[0].hit()) std::printf("triangle %u at t = %g\n", out.hits[0].primitive, out.hits[0].t);
+//
+// The parts, one header each:
+//   scene.hpp           TraceScene: triangles from a glTF file (scene_options.hpp: which scene,
+//                       when, which camera, which face rule) or from arrays with a single-sided
+//                       flag per triangle
+//   rays.hpp            RayBatch: a camera's rays (as `dacrt render` makes them) or any rays
+//                       with their segments (tmin < t <= tmax)
+//   tracer.hpp          Tracer: a backend with its options (options.hpp, backend_tuning.hpp);
+//                       trace() gives each ray's closest hit, occluded() whether anything lies
+//                       on it, plan() the memory and work a trace needs, without tracing
+//   results.hpp         RayHit (primitive id, t, u, v), TraceTimings, TraceCounters, FramePlan
+//   errors.hpp          InputError (bad input, with a message naming it), InternalError
+//
+// brute, cpu-seq, cpu and gpu return the same primitive id and t, bit for bit, for every ray
+// (docs/correctness.md); embree and rayquery are peers with their own answers. A Tracer opens its threads and device once: keep it for many traces.
+// A TraceScene, RayBatch or Tracer may be used from one thread at a time.
+#include <dacrt/backend_tuning.hpp>
+#include <dacrt/errors.hpp>
+#include <dacrt/options.hpp>
+#include <dacrt/rays.hpp>
+#include <dacrt/results.hpp>
+#include <dacrt/scene.hpp>
+#include <dacrt/scene_options.hpp>
+#include <dacrt/tracer.hpp>

@@ -1,0 +1,89 @@
+#pragma once
+// What a caller chooses for a trace: the backend, the DACRT options and the frame's skips.
+// Plain data, shared by the library's public API and its internals (host/cpu/options.hpp adds
+// the names the command line gives them).
+#include <cstdint>
+
+namespace dacrt {
+
+enum class Backend { Brute, CpuSeq, Cpu, Gpu, Embree, RayQuery };
+// gpu and rayquery run on a Vulkan device.
+constexpr bool runsOnVulkan(Backend b) { return b == Backend::Gpu || b == Backend::RayQuery; }
+// embree and rayquery are the peers: they build their own hierarchy and take no DACRT options.
+constexpr bool isPeer(Backend b) { return b == Backend::Embree || b == Backend::RayQuery; }
+enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
+enum class DivisionAxis { Best, X, Y, Z };
+// Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks
+// through shared edges; Moller-Trumbore is the classic faster test without that guarantee.
+enum class Intersector { Watertight, MollerTrumbore };
+// Which triangles a DACRT node keeps for a child cell. Bounds (the default) and Sat are
+// conservative; Mora is deliberately inexact (docs/benchmarks.md measures its price).
+enum class TriangleFilter { Bounds, Sat, Mora };
+// Arithmetic of the leaf's ray/triangle test: the filters stay float32 in both cases (their
+// margin also covers the smaller float64 rounding).
+enum class Precision { F32, F64 };
+
+// Leaf limits of each backend when DacrtOptions leaves them 0, chosen by measurement
+// (docs/benchmarks.md): a leaf costs the CPU one test per pair, and the SIMD leaf of the
+// default options tests a vector of triangles at once, so it takes more triangles (and,
+// with packets above it, more rays) before a split pays; on lavapipe a partition costs
+// several times a leaf's test per element (docs/gpu.md), so the gpu stops splitting
+// earlier still.
+constexpr std::uint32_t kCpuLeafLimit = 8;
+constexpr std::uint32_t kCpuSimdRayLimit = 16;
+constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
+constexpr std::uint32_t kGpuLeafLimit = 64;
+constexpr std::uint32_t kPacketFlushDefault = 16;
+
+struct DacrtOptions {
+    std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default
+    std::uint32_t triLimit = 0;    // a node with fewer triangles is a leaf; 0: the backend's default
+    std::uint32_t maxDepth = 48;   // guards against coincident triangles that never separate
+    SplitMethod split = SplitMethod::SpatialMedian;
+    Intersector intersector = Intersector::Watertight;
+    TriangleFilter triangleFilter = TriangleFilter::Bounds;
+    Precision precision = Precision::F32;
+    // Ray packets (docs/cpu-reference.md): primary rays filtered 8x8 pixels at a time high in
+    // the recursion, one by one below; the SIMD path of rays that share their start only.
+    bool packets = true;
+    std::uint32_t packetFlush = 0;  // a node with fewer packets goes on ray by ray; 0: the default
+
+    // These options with the leaf limits of `backend` filled in where they are 0.
+    DacrtOptions resolvedFor(Backend backend) const {
+        DacrtOptions o = *this;
+        const std::uint32_t limit = backend == Backend::Gpu ? kGpuLeafLimit : kCpuLeafLimit;
+        const bool simd = backend != Backend::Gpu && exactDefaults();
+        if (o.rayLimit == 0) o.rayLimit = simd ? kCpuSimdRayLimit : limit;
+        if (o.triLimit == 0) o.triLimit = simd ? kCpuSimdTriangleLimit : limit;
+        if (o.packetFlush == 0) o.packetFlush = kPacketFlushDefault;
+        return o;
+    }
+
+    bool exactDefaults() const {
+        return intersector == Intersector::Watertight && triangleFilter == TriangleFilter::Bounds &&
+               precision == Precision::F32;
+    }
+};
+
+// The frame's skips (docs/skips.md), each exact by construction, each on unless turned off
+// (--no-skip): they change speed only.
+enum class Skip { BackFaces, Frustum, Uploads, SubScenes };
+struct SkipSwitches {
+    bool backFaces = true;  // single-sided triangles facing away from the rays' shared origin
+    bool frustum = true;    // triangles outside the camera's view frustum
+    bool uploads = true;    // gpu: triangle buffers kept on the device while the triangles do not change
+    bool subScenes = true;  // cpu: one sequential DACRT instead of sub-scenes for frames too small to pay
+                            // for a division (kSequentialBelowRays), unless --regions is given
+    bool operator==(const SkipSwitches&) const = default;
+};
+
+struct TraceOptions {
+    Backend backend = Backend::Cpu;
+    SkipSwitches skips;
+    unsigned regions = 0;   // cpu: sub-scenes; 0 means one per thread (docs/cpu-reference.md)
+    unsigned threads = 0;   // 0 means every core
+    DivisionAxis axis = DivisionAxis::Best;
+    DacrtOptions dacrt;
+};
+
+}  // namespace dacrt

@@ -1,0 +1,58 @@
+#pragma once
+// A scene to trace: triangles loaded from a glTF file or given as arrays, each with its face
+// rule, checked once and kept with the bounds every trace reads.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include <dacrt/scene_options.hpp>
+
+namespace dacrt {
+
+class RayBatch;
+class Tracer;
+
+struct SceneBounds {
+    std::array<float, 3> lo{};
+    std::array<float, 3> hi{};
+};
+
+class TraceScene {
+public:
+    // The file's scene (.gltf or .glb) flattened into world-space triangles at the options'
+    // instant, with the face rule of `options.cull`. A triangle's primitive id in the hits is
+    // its index in that flattening (nodes, meshes, primitives in file order). Throws
+    // InputError naming the file and the problem.
+    static TraceScene load(const std::string& path, const SceneLoadOptions& options = {});
+
+    // Triangles from arrays: `positions` holds x, y, z per vertex, `indices` three vertex
+    // indices per triangle, `singleSided` (empty, or one per triangle) nonzero where a ray
+    // that meets the triangle's back face does not hit it; empty: every triangle two-sided.
+    // Triangles with no area are dropped (no ray can hit them); the hits keep the caller's
+    // numbering (triangle k of `indices` is primitive k). Throws InputError on sizes that do
+    // not match, an index out of range, a coordinate not finite or beyond +-1e9, or no
+    // triangle that can be hit.
+    static TraceScene fromArrays(std::span<const float> positions, std::span<const std::uint32_t> indices,
+                                 std::span<const std::uint8_t> singleSided = {});
+
+    TraceScene(TraceScene&&) noexcept;
+    TraceScene& operator=(TraceScene&&) noexcept;
+    ~TraceScene();
+
+    std::size_t triangleCount() const;          // triangles traced (those with area)
+    std::uint64_t trianglesDropped() const;     // triangles with no area, dropped
+    SceneBounds bounds() const;                 // of the traced triangles, exact
+
+    struct Impl;  // the library's own
+
+private:
+    explicit TraceScene(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+    friend class RayBatch;
+    friend class Tracer;
+};
+
+}  // namespace dacrt

@@ -1,0 +1,58 @@
+#pragma once
+// A tracer: one backend with its options, its threads and (gpu, rayquery) its Vulkan device,
+// opened once and kept for every trace.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <dacrt/backend_tuning.hpp>
+#include <dacrt/options.hpp>
+#include <dacrt/rays.hpp>
+#include <dacrt/results.hpp>
+#include <dacrt/scene.hpp>
+
+namespace dacrt {
+
+struct TracerOptions {
+    TraceOptions trace;     // the backend, its threads and sub-scenes, the DACRT options, the skips
+    GpuTuning gpu;          // gpu only
+    EmbreeOptions embree;   // embree only (its build threads are the trace's)
+    std::string device;     // gpu, rayquery: a device index or part of its name; empty: the best
+    bool validate = false;  // gpu, rayquery: under the Vulkan validation layers (validationErrors())
+};
+
+class Tracer {
+public:
+    // Checks the options against the backend and opens its device (gpu, rayquery). Throws
+    // InputError on an option the backend does not take (the message names it as the command
+    // line does) or a device that is missing or does not match.
+    explicit Tracer(const TracerOptions& options = {});
+    Tracer(Tracer&&) noexcept;
+    Tracer& operator=(Tracer&&) noexcept;
+    ~Tracer();
+
+    // Each ray's closest hit within its segment.
+    TraceOutput trace(const TraceScene& scene, const RayBatch& rays);
+
+    // Whether each ray hits anything within its segment (shadow and occlusion rays): the
+    // visibility is exact; the hit is any of those in the segment, and Embree names none of
+    // them (kUnnamedPrimitive, t the ray's tmin).
+    TraceOutput occluded(const TraceScene& scene, const RayBatch& rays);
+
+    // The memory and work plan trace() would follow, without tracing: no ray meets a
+    // triangle. The plan depends on more than the counts: the skips and the division into
+    // sub-scenes decide it, so their passes over the scene and rays run (as for `dacrt render
+    // --plan`). Throws InputError for embree, which allocates its hierarchy itself and has no
+    // plan.
+    FramePlan plan(const TraceScene& scene, const RayBatch& rays);
+
+    const TracerOptions& options() const;
+    // Vulkan validation errors so far (with options.validate; 0 otherwise).
+    std::uint32_t validationErrors() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dacrt

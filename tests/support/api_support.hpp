@@ -1,0 +1,85 @@
+#pragma once
+// The public API's tests (tests/library): random scenes and rays as arrays, and hits compared
+// bit for bit.
+#include <bit>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <dacrt/dacrt.hpp>
+
+#include "core/random.hpp"
+
+namespace dacrt::test {
+
+struct SceneArrays {
+    std::vector<float> positions;
+    std::vector<std::uint32_t> indices;
+    std::vector<std::uint8_t> singleSided;
+};
+
+// `count` triangles of random size and place in [-1, 1]^3, a third of them single-sided.
+inline SceneArrays randomSceneArrays(std::uint64_t seed, std::uint32_t count) {
+    Random random(seed);
+    SceneArrays a;
+    for (std::uint32_t k = 0; k < count; ++k) {
+        const glm::vec3 centre = random.vec3(-1.0f, 1.0f);
+        for (int corner = 0; corner < 3; ++corner) {
+            const glm::vec3 p = centre + random.vec3(-0.2f, 0.2f);
+            a.positions.insert(a.positions.end(), {p.x, p.y, p.z});
+            a.indices.push_back(3 * k + std::uint32_t(corner));
+        }
+        a.singleSided.push_back(k % 3 == 0);
+    }
+    return a;
+}
+
+struct RayArrays {
+    std::vector<float> origins;
+    std::vector<float> directions;
+    std::vector<float> tmax;  // from 0.5 to 4: some segments end before the scene
+};
+
+// `count` rays from points around the scene towards points inside it.
+inline RayArrays randomRayArrays(std::uint64_t seed, std::uint32_t count) {
+    Random random(seed);
+    RayArrays a;
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const glm::vec3 origin = glm::vec3(2.5 * random.onSphere());
+        const glm::vec3 direction = random.vec3(-0.8f, 0.8f) - origin;
+        a.origins.insert(a.origins.end(), {origin.x, origin.y, origin.z});
+        a.directions.insert(a.directions.end(), {direction.x, direction.y, direction.z});
+        a.tmax.push_back(random.uniformFloat(0.5f, 4.0f));
+    }
+    return a;
+}
+
+// Equal primitive ids and t, u, v bit for bit; the first difference otherwise.
+inline ::testing::AssertionResult sameHits(const std::vector<RayHit>& a, const std::vector<RayHit>& b) {
+    if (a.size() != b.size()) return ::testing::AssertionFailure() << a.size() << " hits against " << b.size();
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        auto bits = [](float f) { return std::bit_cast<std::uint32_t>(f); };
+        if (a[i].primitive != b[i].primitive || bits(a[i].t) != bits(b[i].t) || bits(a[i].u) != bits(b[i].u) ||
+            bits(a[i].v) != bits(b[i].v))
+            return ::testing::AssertionFailure() << "ray " << i << ": primitive " << a[i].primitive << " t " << a[i].t
+                                                 << " against primitive " << b[i].primitive << " t " << b[i].t;
+    }
+    return ::testing::AssertionSuccess();
+}
+
+inline std::size_t hitCount(const std::vector<RayHit>& hits) {
+    std::size_t n = 0;
+    for (const RayHit& h : hits) n += h.hit();
+    return n;
+}
+
+inline TracerOptions onBackend(Backend backend, unsigned threads = 0) {
+    TracerOptions o;
+    o.trace.backend = backend;
+    o.trace.threads = backend == Backend::CpuSeq ? 0 : threads;
+    return o;
+}
+
+}  // namespace dacrt::test
