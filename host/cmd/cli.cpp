@@ -15,15 +15,14 @@
 #include "app/exit_codes.hpp"
 #include "render/frame_range.hpp"
 #include "app/output_paths.hpp"
+#include "cmd/devices.hpp"
 #include "cmd/info.hpp"
 #include "render/render.hpp"
 #include "stress/stress.hpp"
 #include "core/atomic_file.hpp"
-#include "core/cpu_model.hpp"
 #include "core/errors.hpp"
 #include "cpu/backend_options.hpp"
 #include "cpu/simd_kernels.hpp"
-#include "gpu/context.hpp"
 #include "gpu/vulkan_error.hpp"
 #include "oracle/compare.hpp"
 
@@ -293,16 +292,7 @@ Subcommand addInfoCommand(CLI::App& app) {
 
 Subcommand addDevicesCommand(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("devices", "list the Vulkan devices and the limits that matter here");
-    return {cmd, [] {
-                std::string simdTargets;
-                for (const std::string& t : simd::availableTargets()) simdTargets += " " + t;
-                std::cout << "cpu: " << cpuModelName() << "; SIMD kernels run " << simd::activeTarget()
-                          << " (this binary can run:" << simdTargets << "; DACRT_SIMD_TARGET chooses)\n";
-                const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
-                if (devices.empty()) std::cout << "no Vulkan devices\n";
-                for (const gpu::DeviceInfo& d : devices) std::cout << d.describe();
-                return int(kExitSuccess);
-            }};
+    return {cmd, [] { return runDevices(); }};
 }
 
 Subcommand addCompareCommand(CLI::App& app) {

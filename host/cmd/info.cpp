@@ -1,19 +1,23 @@
 #include "cmd/info.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
+#include <dacrt/scene_info.hpp>
+
 #include "app/exit_codes.hpp"
-#include "core/gltf_loader.hpp"
 
 namespace dacrt {
 namespace {
 
-std::string vec(const glm::dvec3& v) {
+std::string vec(const std::array<double, 3>& v) {
     char s[96];
-    std::snprintf(s, sizeof s, "(%.6g, %.6g, %.6g)", v.x, v.y, v.z);
+    std::snprintf(s, sizeof s, "(%.6g, %.6g, %.6g)", v[0], v[1], v[2]);
     return s;
 }
+
+std::string vec(const std::array<float, 3>& v) { return vec(std::array<double, 3>{v[0], v[1], v[2]}); }
 
 std::string number(double x) {
     char s[32];
@@ -32,51 +36,55 @@ std::string join(const std::vector<std::string>& items) {
     return out.empty() ? "none" : out;
 }
 
+std::string cameraLine(const PlacedCamera& c) {
+    char lens[64];
+    if (c.perspective) std::snprintf(lens, sizeof lens, "perspective, yfov %.4g degrees", c.yfovRadians * 180.0 / M_PI);
+    else std::snprintf(lens, sizeof lens, "orthographic, ymag %.6g", c.ymag);
+    return std::to_string(c.index) + (c.name.empty() ? "" : " '" + c.name + "'") + ": " + lens + ", node " +
+           std::to_string(c.node) + ", eye " + vec(c.eye) + ", forward " + vec(c.forward);
+}
+
+std::string lightLine(const PlacedLight& l) {
+    return (l.name.empty() ? std::string("(unnamed)") : "'" + l.name + "'") + ": " + l.type + ", intensity " +
+           number(l.intensity) + ", colour " + vec(l.color) + (l.type == "directional" ? "" : ", at " + vec(l.position)) +
+           (l.type == "point" ? "" : ", towards " + vec(l.direction));
+}
+
+std::string animationLine(std::size_t index, const AnimationSpan& a) {
+    return std::to_string(index) + (a.name.empty() ? "" : " '" + a.name + "'") + ": " + number(a.start) + " s to " +
+           number(a.end) + " s, " + std::to_string(a.channels) + " channel(s)";
+}
+
+template <typename Item, typename Line>
+std::vector<std::string> linesOf(const std::vector<Item>& items, Line line) {
+    std::vector<std::string> out;
+    for (const Item& i : items) out.push_back(line(i));
+    return out;
+}
+
 }  // namespace
 
 int runInfo(const InfoOptions& options) {
-    const GltfDocument file = GltfDocument::open(options.scenePath);
-    const Scene scene = file.scene(GltfSelection{.scene = options.sceneChoice, .animation = "", .time = 0.0});
-    const GltfInventory& inv = scene.inventory;
-    const Box box = sceneBounds(scene.triangles);
+    const SceneFileInfo info = describeSceneFile(options.scenePath, options.sceneChoice);
     std::cout << "file " << options.scenePath << "\n";
-    section("scenes", inv.scenes);
-    std::cout << "loaded scene: " << scene.triangleCount() << " triangles (" << singleSidedTriangles(scene.triangles)
-              << " single-sided, " << scene.degenerateTrianglesDropped << " without area dropped), bounds "
-              << vec(glm::dvec3(box.lo)) << " to " << vec(glm::dvec3(box.hi)) << "\n";
-    std::cout << "  shading: " << (scene.corners.normals.empty() ? "geometric normals" : "NORMAL")
-              << (scene.corners.texCoords.empty() ? "" : ", texture coordinates")
-              << (scene.corners.colors.empty() ? "" : ", COLOR_0") << "\n";
-    std::vector<std::string> cameras;
-    for (const SceneCamera& c : scene.cameras) {
-        char lens[64];
-        if (c.projection == Projection::Perspective) std::snprintf(lens, sizeof lens, "perspective, yfov %.4g degrees", c.yfovRadians * 180.0 / M_PI);
-        else std::snprintf(lens, sizeof lens, "orthographic, ymag %.6g", c.ymag);
-        cameras.push_back(std::to_string(c.cameraIndex) + (c.name.empty() ? "" : " '" + c.name + "'") + ": " + lens +
-                          ", node " + std::to_string(c.node) + ", eye " + vec(c.eye) + ", forward " + vec(c.forward));
-    }
-    section("cameras placed by the scene (--camera)", cameras);
-    std::vector<std::string> lights;
-    for (const Light& l : scene.lights)
-        lights.push_back((l.name.empty() ? std::string("(unnamed)") : "'" + l.name + "'") + ": " + std::string(toString(l.type)) +
-                         ", intensity " + number(l.intensity) + ", colour " + vec(glm::dvec3(l.color)) +
-                         (l.type == LightType::Directional ? "" : ", at " + vec(l.position)) +
-                         (l.type == LightType::Point ? "" : ", towards " + vec(l.direction)));
-    section("lights placed by the scene (KHR_lights_punctual)", lights);
+    section("scenes", info.scenes);
+    std::cout << "loaded scene: " << info.triangles << " triangles (" << info.singleSidedTriangles << " single-sided, "
+              << info.trianglesDropped << " without area dropped), bounds " << vec(info.bounds.lo) << " to "
+              << vec(info.bounds.hi) << "\n";
+    std::cout << "  shading: " << (info.normals ? "NORMAL" : "geometric normals") << (info.texCoords ? ", texture coordinates" : "")
+              << (info.colors ? ", COLOR_0" : "") << "\n";
+    section("cameras placed by the scene (--camera)", linesOf(info.cameras, cameraLine));
+    section("lights placed by the scene (KHR_lights_punctual)", linesOf(info.lights, lightLine));
     std::vector<std::string> animations;
-    for (std::size_t i = 0; i < file.animations().size(); ++i) {
-        const GltfAnimationInfo& a = file.animations()[i];
-        animations.push_back(std::to_string(i) + (a.name.empty() ? "" : " '" + a.name + "'") + ": " + number(a.start) + " s to " +
-                             number(a.end) + " s, " + std::to_string(a.channels) + " channel(s)");
-    }
+    for (std::size_t i = 0; i < info.animations.size(); ++i) animations.push_back(animationLine(i, info.animations[i]));
     section("animations (--animation; all play together by default; the scene above is at 0 s)", animations);
-    section("meshes", inv.meshes);
-    section("skins", inv.skins);
-    section("materials", inv.materials);
-    section("textures decoded", inv.textures);
-    std::cout << "extensions used: " << join(inv.extensionsUsed) << "\n"
-              << "extensions required: " << join(inv.extensionsRequired) << "\n";
-    section("warnings", scene.warnings);
+    section("meshes", info.meshes);
+    section("skins", info.skins);
+    section("materials", info.materials);
+    section("textures decoded", info.textures);
+    std::cout << "extensions used: " << join(info.extensionsUsed) << "\n"
+              << "extensions required: " << join(info.extensionsRequired) << "\n";
+    section("warnings", info.warnings);
     return int(kExitSuccess);
 }
 

@@ -7,30 +7,14 @@
 
 #include <vulkan/vulkan.h>
 
+#include <dacrt/devices.hpp>
+
 namespace dacrt::gpu {
 
-struct DeviceInfo {
-    std::uint32_t index = 0;
-    std::string name;
+// A device's properties and limits (the public <dacrt/devices.hpp> names them) with its type
+// as Vulkan gives it.
+struct DeviceInfo : VulkanDeviceProperties {
     VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
-    std::string driver;         // driver name and info
-    std::string apiVersion;
-    std::vector<std::string> heaps;  // "N MiB (device-local)"
-    std::uint64_t maxStorageBufferRange = 0;
-    std::uint64_t maxMemoryAllocationSize = 0;
-    std::uint32_t maxComputeSharedMemorySize = 0;
-    std::uint32_t maxComputeWorkGroupInvocations = 0;
-    std::uint32_t maxComputeWorkGroupSizeX = 0;
-    std::uint32_t maxComputeWorkGroupCountX = 0;
-    std::uint32_t maxPerStageStorageBuffers = 0;
-    std::uint32_t subgroupSize = 0;
-    bool subgroupOperations = false;  // compute-stage arithmetic and shuffle operations (the kernel's)
-    bool fullSubgroups = false;       // VK_EXT_subgroup_size_control's computeFullSubgroups
-    bool timestamps = false;
-    // VK_KHR_acceleration_structure, VK_KHR_ray_query and buffer device addresses, with their
-    // features, on Vulkan 1.2 or later: what the rayquery backend needs. Otherwise, what lacks.
-    bool rayQuery = false;
-    std::string rayQueryMissing;
     bool isCpu() const { return type == VK_PHYSICAL_DEVICE_TYPE_CPU; }  // lavapipe, SwiftShader
     std::string typeName() const;  // as vulkan.hpp names it: DiscreteGpu, Cpu, ...
     std::string describe() const;

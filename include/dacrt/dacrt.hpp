@@ -24,15 +24,21 @@
 //                       on it, plan() the memory and work a trace needs, without tracing
 //   results.hpp         RayHit (primitive id, t, u, v), TraceTimings, TraceCounters, FramePlan
 //   errors.hpp          InputError (bad input, with a message naming it), InternalError
+//   scene_info.hpp      describeSceneFile: what a glTF file holds (scenes, cameras, lights,
+//                       animations, meshes, materials, extensions), as `dacrt info` prints it
+//   devices.hpp         listDevices: the processor with its SIMD kernels and every Vulkan
+//                       device with its limits, as `dacrt devices` prints them
 //
 // brute, cpu-seq, cpu and gpu return the same primitive id and t, bit for bit, for every ray
 // (docs/correctness.md); embree and rayquery are peers with their own answers. A Tracer opens its threads and device once: keep it for many traces.
 // A TraceScene, RayBatch or Tracer may be used from one thread at a time.
 #include <dacrt/backend_tuning.hpp>
+#include <dacrt/devices.hpp>
 #include <dacrt/errors.hpp>
 #include <dacrt/options.hpp>
 #include <dacrt/rays.hpp>
 #include <dacrt/results.hpp>
 #include <dacrt/scene.hpp>
+#include <dacrt/scene_info.hpp>
 #include <dacrt/scene_options.hpp>
 #include <dacrt/tracer.hpp>
