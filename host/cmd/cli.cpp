@@ -340,6 +340,7 @@ Subcommand addCompareCommand(CLI::App& app) {
 Subcommand addStressCommand(CLI::App& app) {
     struct State {
         StressCommand stress;
+        DeviceChoice devices;
         std::string size = "large";
         bool defaultsOnly = false, noDeterminism = false;
     };
@@ -357,8 +358,10 @@ Subcommand addStressCommand(CLI::App& app) {
     cmd->add_flag("--defaults-only", s->defaultsOnly, "run only each backend's default configuration");
     cmd->add_flag("--no-determinism", s->noDeterminism, "skip the determinism checks");
     cmd->add_option("--json", stress.jsonPath, "write the table and checks as JSON");
-    addDeviceOptions(cmd, stress.devices);
+    addDeviceOptions(cmd, s->devices);
     return {cmd, [s] {
+                s->stress.device = s->devices.device;
+                s->stress.validate = s->devices.validate;
                 s->stress.size = s->size == "small" ? StressSize::Small : StressSize::Large;
                 s->stress.withOptions = !s->defaultsOnly;
                 s->stress.determinism = !s->noDeterminism;

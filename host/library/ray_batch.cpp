@@ -1,12 +1,15 @@
 // The public RayBatch: a camera's primary rays as `dacrt render` makes them, or the caller's
-// rays made canonical by makeRay, with messages that name the caller's element.
+// rays made canonical by makeRay (or, with their length as given, by segmentRay), with messages that name the caller's element.
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <string_view>
 
 #include <dacrt/errors.hpp>
 
+#include "cpu/secondary_rays.hpp"
 #include "library/api_state.hpp"
 
 namespace dacrt {
@@ -44,19 +47,39 @@ float segmentEnd(std::span<const float> tmax, std::size_t i, float tmin) {
     return end;
 }
 
+std::string text(const glm::vec3& v) {
+    std::ostringstream s;
+    s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+    return s.str();
+}
+
+// The direction traced as given (DirectionLength::AsGiven), in segmentRay's range: its
+// largest component from 2^-64 (smaller ones flush to zero) to 2^62.
+Ray segmentAt(const glm::vec3& origin, const glm::vec3& direction, float start, float end) {
+    const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    const float largest = std::max({std::abs(direction.x), std::abs(direction.y), std::abs(direction.z)});
+    if (!finite(origin) || !finite(direction) || !(largest >= 0x1p-64f && largest <= 0x1p62f))
+        throw InputError("ray: origin " + text(origin) + " must be finite, and the direction " + text(direction) +
+                         " finite with its largest component within 2^-64 .. 2^62, to be traced as given");
+    Ray ray = shared::segmentRay(origin, direction, end);
+    ray.tmin = start;
+    return ray;
+}
+
 Ray rayAt(std::span<const float> origins, std::span<const float> directions, std::span<const float> tmin,
-          std::span<const float> tmax, std::size_t i) {
+          std::span<const float> tmax, DirectionLength length, std::size_t i) {
     const float start = tmin.empty() ? 0.0f : tmin[i];
     if (!(start >= 0.0f) || !std::isfinite(start))
         throw InputError("tmin[" + std::to_string(i) + "] is " + std::to_string(start) + ": it must be finite and >= 0");
     const glm::vec3 origin(origins[3 * i], origins[3 * i + 1], origins[3 * i + 2]);
-    const glm::dvec3 direction(directions[3 * i], directions[3 * i + 1], directions[3 * i + 2]);
+    const glm::vec3 direction(directions[3 * i], directions[3 * i + 1], directions[3 * i + 2]);
     try {
-        Ray ray = makeRay(origin, direction, start);
+        if (length == DirectionLength::AsGiven) return segmentAt(origin, direction, start, segmentEnd(tmax, i, start));
+        Ray ray = makeRay(origin, glm::dvec3(direction), start);
         ray.tmax = segmentEnd(tmax, i, start);
         return ray;
     } catch (const InputError& e) {
-        // makeRay's message names no ray ("ray: origin ..."): here it names the caller's.
+        // The ray makers' messages name no ray ("ray: origin ..."): here it names the caller's.
         const std::string what = e.what();
         const std::string_view unnamed = "ray: ";
         throw InputError("ray " + std::to_string(i) + ": " + (what.starts_with(unnamed) ? what.substr(unnamed.size()) : what));
@@ -86,11 +109,11 @@ RayBatch RayBatch::fromCamera(const TraceScene& scene, const CameraSpec& camera,
 }
 
 RayBatch RayBatch::fromArrays(std::span<const float> origins, std::span<const float> directions,
-                              std::span<const float> tmin, std::span<const float> tmax) {
+                              std::span<const float> tmin, std::span<const float> tmax, DirectionLength length) {
     checkRayArraySizes(origins.size(), directions.size(), tmin.size(), tmax.size());
     auto impl = std::make_unique<Impl>();
     impl->rays.reserve(origins.size() / 3);
-    for (std::size_t i = 0; i < origins.size() / 3; ++i) impl->rays.push_back(rayAt(origins, directions, tmin, tmax, i));
+    for (std::size_t i = 0; i < origins.size() / 3; ++i) impl->rays.push_back(rayAt(origins, directions, tmin, tmax, length, i));
     return RayBatch(std::move(impl));
 }
 

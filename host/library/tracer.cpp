@@ -85,7 +85,23 @@ FramePlan Tracer::plan(const TraceScene& scene, const RayBatch& rays) {
     return framePlanOf(*planned);
 }
 
+void Tracer::setOptions(const TracerOptions& options) {
+    if (options.device != impl_->options.device || options.validate != impl_->options.validate)
+        throw InputError("the Vulkan device and its validation are chosen when a Tracer is made: make another Tracer "
+                         "for another choice");
+    if (runsOnVulkan(options.trace.backend) && !impl_->dispatcher.gpuContext())
+        throw InputError(toString(options.trace.backend) +
+                         " runs on a Vulkan device, which this Tracer did not open: make it with gpu or rayquery");
+    impl_->request = Impl::checkedRequest(options);
+    impl_->options = options;
+}
+
 const TracerOptions& Tracer::options() const { return impl_->options; }
+
+std::string Tracer::device() const {
+    const gpu::Context* gpu = impl_->dispatcher.gpuContext();
+    return gpu ? gpu->info().name + " (" + gpu->info().driver + ")" : std::string();
+}
 
 std::uint32_t Tracer::validationErrors() const { return impl_->dispatcher.validationErrors(); }
 

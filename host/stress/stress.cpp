@@ -1,32 +1,26 @@
 #include "stress/stress.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
-#include <iostream>
 #include <map>
-#include <memory>
-#include <thread>
 
-#include <nlohmann/json.hpp>
-
-#include "cpu/cpu_tracers.hpp"
-#include "core/errors.hpp"
-#include "gpu/gpu_tracer.hpp"
-#include "core/timing.hpp"
-#include "gpu/context.hpp"
+#include "cpu/options.hpp"  // the command line's names of backends and options: the configurations'
 
 namespace dacrt {
 namespace {
 
-bool sameBits(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit)) == 0; }
+bool sameBits(const RayHit& a, const RayHit& b) {
+    return a.primitive == b.primitive && std::bit_cast<std::uint32_t>(a.t) == std::bit_cast<std::uint32_t>(b.t) &&
+           std::bit_cast<std::uint32_t>(a.u) == std::bit_cast<std::uint32_t>(b.u) &&
+           std::bit_cast<std::uint32_t>(a.v) == std::bit_cast<std::uint32_t>(b.v);
+}
 
-std::string describeHit(const Hit& h) {
-    if (h.prim == kMissPrim) return "miss";
+std::string describeHit(const RayHit& h) {
+    if (!h.hit()) return "miss";
     char text[64];
-    std::snprintf(text, sizeof text, "prim %u t %.9g", h.prim, double(h.t));
+    std::snprintf(text, sizeof text, "prim %u t %.9g", h.primitive, double(h.t));
     return text;
 }
 
@@ -48,12 +42,12 @@ StressConfig config(const std::string& name, bool isDefault, Backend backend) {
     StressConfig c;
     c.name = name;
     c.isDefault = isDefault;
-    c.request.trace.backend = backend;
+    c.trace.backend = backend;
     return c;
 }
 
 // First differing index of two hit arrays, or -1.
-long firstDifference(const std::vector<Hit>& a, const std::vector<Hit>& b) {
+long firstDifference(const std::vector<RayHit>& a, const std::vector<RayHit>& b) {
     if (a.size() != b.size()) return 0;
     for (std::size_t i = 0; i < a.size(); ++i)
         if (!sameBits(a[i], b[i])) return long(i);
@@ -92,7 +86,7 @@ std::vector<StressConfig> stressConfigs(const std::vector<Backend>& backends, bo
         if (b == Backend::CpuSeq || b == Backend::Cpu) {
             for (SplitMethod s : {SplitMethod::CentroidMean, SplitMethod::SampledMean}) {
                 StressConfig c = config(base + " --split " + toString(s), false, b);
-                c.request.trace.dacrt.split = s;
+                c.trace.dacrt.split = s;
                 out.push_back(c);
             }
         }
@@ -100,45 +94,77 @@ std::vector<StressConfig> stressConfigs(const std::vector<Backend>& backends, bo
         // for the small watertight family on lavapipe (a workgroup-wide step per tiny node).
         for (std::uint32_t limit : {b == Backend::Gpu ? 4u : 1u, 256u}) {
             StressConfig c = config(base + " --ray-limit " + std::to_string(limit) + " --tri-limit " + std::to_string(limit), false, b);
-            c.request.trace.dacrt.rayLimit = c.request.trace.dacrt.triLimit = limit;
+            c.trace.dacrt.rayLimit = c.trace.dacrt.triLimit = limit;
             out.push_back(c);
         }
         if (b == Backend::CpuSeq) continue;  // one region, no division
         for (unsigned regions : {1u, 3u, 64u}) {
             StressConfig c = config(base + " --regions " + std::to_string(regions), false, b);
-            c.request.trace.regions = regions;
+            c.trace.regions = regions;
             out.push_back(c);
         }
         for (DivisionAxis a : {DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z}) {
             StressConfig c = config(base + " --axis " + toString(a), false, b);
-            c.request.trace.axis = a;
+            c.trace.axis = a;
             out.push_back(c);
         }
         if (b == Backend::Gpu) {
             StressConfig c = config(base + " --workgroup-size 32", false, b);
-            c.request.gpuTuning.workgroupSize = 32;
+            c.gpu.workgroupSize = 32;
             out.push_back(c);
         }
     }
     return out;
 }
 
-FrameGeometry stressGeometry(const StressCase& c, std::vector<Bounds>& bounds) {
-    bounds = allTriangleBounds(c.triangles);
-    FrameGeometry g = frameGeometry(c.triangles, bounds, c.rays, sceneBounds(c.triangles));
-    g.query = c.query;
-    return g;
+namespace {
+
+// The case's triangles as arrays, vertex by vertex: triangle k is primitive k of the hits,
+// also where the scene drops triangles with no area (the degenerate family has them).
+TraceScene sceneOf(const StressCase& c) {
+    std::vector<float> positions;
+    std::vector<std::uint32_t> indices;
+    std::vector<std::uint8_t> singleSided;
+    positions.reserve(9 * c.triangles.size());
+    for (const Triangle& t : c.triangles) {
+        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) {
+            indices.push_back(std::uint32_t(positions.size() / 3));
+            positions.insert(positions.end(), {v.x, v.y, v.z});
+        }
+        singleSided.push_back(t.cullBackFace != 0u ? 1 : 0);
+    }
+    return TraceScene::fromArrays(positions, indices, singleSided);
 }
 
-std::vector<Hit> traceStressCase(const StressCase& c, const StressConfig& config, BackendDispatcher& backends) {
-    std::vector<Bounds> bounds;
-    const FrameGeometry g = stressGeometry(c, bounds);
-    if (config.request.trace.backend == Backend::Gpu && !backends.gpuContext())
-        throw InputError("stress: the gpu backend needs a Vulkan device");
-    return backends.trace(g, config.request).hits;
+// The case's rays as arrays, their directions as made (canonical already: makeRay's or
+// segmentRay's), so that the batch traces each bit for bit.
+RayBatch raysOf(const StressCase& c) {
+    std::vector<float> origins, directions, tmin, tmax;
+    origins.reserve(3 * c.rays.size());
+    directions.reserve(3 * c.rays.size());
+    for (const Ray& r : c.rays) {
+        origins.insert(origins.end(), {r.origin.x, r.origin.y, r.origin.z});
+        directions.insert(directions.end(), {r.dir.x, r.dir.y, r.dir.z});
+        tmin.push_back(r.tmin);
+        tmax.push_back(r.tmax);
+    }
+    return RayBatch::fromArrays(origins, directions, tmin, tmax, DirectionLength::AsGiven);
 }
 
-StressTally tallyStressCase(const StressCase& c, const std::vector<Hit>& hits, const std::vector<Hit>* reference) {
+}  // namespace
+
+std::vector<RayHit> traceStressCase(const StressCase& c, const StressConfig& config, Tracer& tracer) {
+    TracerOptions options = tracer.options();  // its device and validation stay
+    options.trace = config.trace;
+    options.gpu = config.gpu;
+    options.embree = {};
+    tracer.setOptions(options);
+    const TraceScene scene = sceneOf(c);
+    const RayBatch rays = raysOf(c);
+    return (c.query == HitQuery::Any ? tracer.occluded(scene, rays) : tracer.trace(scene, rays)).hits;
+}
+
+StressTally tallyStressCase(const StressCase& c, const std::vector<RayHit>& hits, const std::vector<RayHit>* reference) {
     StressTally t;
     t.cases = 1;
     t.rays = c.rays.size();
@@ -151,19 +177,19 @@ StressTally tallyStressCase(const StressCase& c, const std::vector<Hit>& hits, c
             i < c.startOf.size() && c.startOf[i] != kNoSurfaceStart ? &c.starts[c.startOf[i]] : nullptr;
         if (c.mustHit[i]) {
             ++t.mustHit;
-            if (hits[i].prim == kMissPrim) {
+            if (!hits[i].hit()) {
                 ++t.leaks;
                 example("ray " + std::to_string(i) + " leaks " + describeRay(c.rays[i], start));
             }
         }
-        // An any-hit answer need not name its triangle (kUnnamedHitPrim); one that names a
+        // An any-hit answer need not name its triangle (kUnnamedPrimitive); one that names a
         // ruled-out triangle is a self-intersection all the same.
-        if (start && std::binary_search(start->ruledOut.begin(), start->ruledOut.end(), hits[i].prim)) {
+        if (start && std::binary_search(start->ruledOut.begin(), start->ruledOut.end(), hits[i].primitive)) {
             ++t.selfIntersections;
             example("ray " + std::to_string(i) + " hits " + describeHit(hits[i]) + ", ruled out, " +
                     describeRay(c.rays[i], start));
         }
-        if (reference && (anyHit ? (hits[i].prim == kMissPrim) != ((*reference)[i].prim == kMissPrim)
+        if (reference && (anyHit ? hits[i].hit() != (*reference)[i].hit()
                                  : !sameBits(hits[i], (*reference)[i]))) {
             ++t.mismatches;
             example("ray " + std::to_string(i) + ": " + describeHit(hits[i]) + ", brute force " +
@@ -174,23 +200,22 @@ StressTally tallyStressCase(const StressCase& c, const std::vector<Hit>& hits, c
     for (const std::vector<std::uint32_t>& group : c.coincidentGroups)
         for (std::uint32_t id : group) lowestOfGroup[id] = *std::min_element(group.begin(), group.end());
     for (std::size_t i = 0; i < hits.size() && !lowestOfGroup.empty(); ++i) {
-        const auto it = lowestOfGroup.find(hits[i].prim);
-        if (it != lowestOfGroup.end() && it->second != hits[i].prim) {
+        const auto it = lowestOfGroup.find(hits[i].primitive);
+        if (it != lowestOfGroup.end() && it->second != hits[i].primitive) {
             ++t.tieViolations;
-            example("ray " + std::to_string(i) + " hit coincident copy " + std::to_string(hits[i].prim) +
+            example("ray " + std::to_string(i) + " hit coincident copy " + std::to_string(hits[i].primitive) +
                     " instead of " + std::to_string(it->second));
         }
     }
     return t;
 }
 
-std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& backends, BackendDispatcher& dispatcher,
-                                                 StressSize size) {
+std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& backends, Tracer& tracer, StressSize size) {
     const StressCase scene = determinismCase(size);
     std::vector<DeterminismResult> out;
     StressConfig brute = defaultStressConfig(Backend::Brute);
-    brute.request.trace.threads = 2;
-    const std::vector<Hit> reference = traceStressCase(scene, brute, dispatcher);
+    brute.trace.threads = 2;
+    const std::vector<RayHit> reference = traceStressCase(scene, brute, tracer);
 
     auto check = [&](const std::string& name, const std::vector<std::pair<std::string, StressConfig>>& runs,
                      const std::vector<unsigned>& threadCounts) {
@@ -199,8 +224,8 @@ std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& bac
         for (const auto& [label, cfg] : runs) {
             for (unsigned threads : threadCounts.empty() ? std::vector<unsigned>{0} : threadCounts) {
                 StressConfig c = cfg;
-                if (threads) c.request.trace.threads = threads;
-                const std::vector<Hit> hits = traceStressCase(scene, c, dispatcher);
+                if (threads) c.trace.threads = threads;
+                const std::vector<RayHit> hits = traceStressCase(scene, c, tracer);
                 const long at = firstDifference(hits, reference);
                 if (at >= 0 && r.holds) {
                     r.holds = false;
@@ -215,7 +240,7 @@ std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& bac
 
     for (Backend b : backends) {
         const std::string base = toString(b);
-        if (b == Backend::Gpu && !dispatcher.gpuContext()) continue;
+        if (b == Backend::Gpu && tracer.device().empty()) continue;
         std::vector<std::pair<std::string, StressConfig>> repeats;
         for (int k = 0; k < 10; ++k) repeats.emplace_back("run " + std::to_string(k), defaultStressConfig(b));
         check(base + ": 10 runs", repeats, {});
@@ -227,7 +252,7 @@ std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& bac
             std::vector<std::pair<std::string, StressConfig>> regions;
             for (unsigned n = 1; n <= 64; ++n) {
                 StressConfig c = defaultStressConfig(b);
-                c.request.trace.regions = n;
+                c.trace.regions = n;
                 regions.emplace_back("--regions " + std::to_string(n), c);
             }
             check(base + ": regions 1 to 64", regions, {});

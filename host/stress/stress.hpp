@@ -1,12 +1,13 @@
 #pragma once
-// Runs the stress cases through the backends: leaks, self-intersections, disagreements with
-// brute force and tie-rule violations per configuration; the determinism checks; the `dacrt
-// stress` command.
+// Runs the stress cases through the backends of the public Tracer (include/dacrt/): leaks,
+// self-intersections, disagreements with brute force and tie-rule violations per
+// configuration; the determinism checks; the `dacrt stress` command.
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "library/backend_dispatcher.hpp"
+#include <dacrt/tracer.hpp>
+
 #include "stress/stress_cases.hpp"
 
 namespace dacrt {
@@ -14,7 +15,8 @@ namespace dacrt {
 struct StressConfig {
     std::string name;  // as the render command line would say it
     bool isDefault = false;
-    BackendRequest request;
+    TraceOptions trace;
+    GpuTuning gpu;
 };
 
 // A backend's default configuration, named as the backend.
@@ -44,14 +46,14 @@ struct StressTally {
     }
 };
 
-// A case's frame; `bounds` receives the triangle bounds and must outlive the frame.
-FrameGeometry stressGeometry(const StressCase& c, std::vector<Bounds>& bounds);
-
-std::vector<Hit> traceStressCase(const StressCase& c, const StressConfig& config, BackendDispatcher& backends);
+// The case's closest hits (any hits for HitQuery::Any) with the configuration's options, on
+// the tracer's threads and device: its triangles and rays as the public API's arrays, each
+// ray bit for bit the case's (DirectionLength::AsGiven).
+std::vector<RayHit> traceStressCase(const StressCase& c, const StressConfig& config, Tracer& tracer);
 
 // One backend's hits of one case against the case's marks and (unless null) the brute-force
 // hits of the same rays.
-StressTally tallyStressCase(const StressCase& c, const std::vector<Hit>& hits, const std::vector<Hit>* reference);
+StressTally tallyStressCase(const StressCase& c, const std::vector<RayHit>& hits, const std::vector<RayHit>* reference);
 
 struct DeterminismResult {
     std::string name;
@@ -60,9 +62,9 @@ struct DeterminismResult {
 };
 
 // The same hits bit for bit across 10 runs, across thread counts and across region counts
-// 1 to 64, for each given backend, all equal to brute force.
-std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& backends, BackendDispatcher& dispatcher,
-                                                 StressSize size);
+// 1 to 64, for each given backend, all equal to brute force. gpu is left out where the tracer
+// opened no device.
+std::vector<DeterminismResult> determinismChecks(const std::vector<Backend>& backends, Tracer& tracer, StressSize size);
 
 struct StressCommand {
     std::vector<std::string> families;  // empty: all
@@ -71,7 +73,8 @@ struct StressCommand {
     bool withOptions = true;
     bool determinism = true;
     std::uint64_t seed = 1;
-    DeviceChoice devices;  // gpu
+    std::string device;     // gpu, rayquery: --device
+    bool validate = false;  // gpu, rayquery: --validate
     std::string jsonPath;
 };
 

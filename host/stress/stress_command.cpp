@@ -1,5 +1,6 @@
 // The `dacrt stress` command: cases, the brute-force reference, every configuration, the
 // determinism checks, then the table, the JSON and the verdict.
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -9,10 +10,9 @@
 #include "app/exit_codes.hpp"
 #include "app/output_paths.hpp"
 #include "app/progress.hpp"
-#include "stress/stress.hpp"
 #include "core/atomic_file.hpp"
-#include "core/errors.hpp"
 #include "core/timing.hpp"
+#include "stress/stress.hpp"
 
 namespace dacrt {
 namespace {
@@ -25,7 +25,7 @@ struct StressRow {
 };
 
 struct BruteReference {
-    std::vector<std::vector<Hit>> hits;  // per case
+    std::vector<std::vector<RayHit>> hits;  // per case
     std::vector<double> ms;
 };
 
@@ -40,13 +40,13 @@ std::vector<StressCase> generateCases(const StressCommand& command, const std::v
 }
 
 // Brute force is the reference every other configuration is compared with, bit for bit.
-BruteReference traceReference(const std::vector<StressCase>& cases, BackendDispatcher& dispatcher, Progress& progress) {
+BruteReference traceReference(const std::vector<StressCase>& cases, Tracer& tracer, Progress& progress) {
     BruteReference ref;
     const StressConfig brute = defaultStressConfig(Backend::Brute);
     double ms = 0.0;
     for (const StressCase& c : cases) {
         const auto start = Clock::now();
-        ref.hits.push_back(traceStressCase(c, brute, dispatcher));
+        ref.hits.push_back(traceStressCase(c, brute, tracer));
         ref.ms.push_back(msSince(start));
         ms += ref.ms.back();
         progress.step("brute " + c.name);
@@ -55,13 +55,13 @@ BruteReference traceReference(const std::vector<StressCase>& cases, BackendDispa
     return ref;
 }
 
-StressTally runCase(const StressCase& c, const StressConfig& config, const std::vector<Hit>& reference,
-                    double referenceMs, BackendDispatcher& dispatcher) {
-    const bool isBrute = config.request.trace.backend == Backend::Brute;
+StressTally runCase(const StressCase& c, const StressConfig& config, const std::vector<RayHit>& reference,
+                    double referenceMs, Tracer& tracer) {
+    const bool isBrute = config.trace.backend == Backend::Brute;
     const auto start = Clock::now();
     StressTally t;
     try {
-        const std::vector<Hit> hits = isBrute ? reference : traceStressCase(c, config, dispatcher);
+        const std::vector<RayHit> hits = isBrute ? reference : traceStressCase(c, config, tracer);
         t = tallyStressCase(c, hits, isBrute ? nullptr : &reference);
     } catch (const std::exception& e) {
         // A refusal is a result too: counted and shown, and the run goes on.
@@ -77,13 +77,13 @@ StressTally runCase(const StressCase& c, const StressConfig& config, const std::
 
 std::vector<StressRow> runConfigurations(const std::vector<StressConfig>& configs, const std::vector<std::string>& families,
                                          const std::vector<StressCase>& cases, const BruteReference& reference,
-                                         BackendDispatcher& dispatcher, Progress& progress) {
+                                         Tracer& tracer, Progress& progress) {
     std::vector<StressRow> rows;
     for (const StressConfig& config : configs) {
         std::map<std::string, StressTally> byFamily;
         double ms = 0.0;
         for (std::size_t i = 0; i < cases.size(); ++i) {
-            const StressTally t = runCase(cases[i], config, reference.hits[i], reference.ms[i], dispatcher);
+            const StressTally t = runCase(cases[i], config, reference.hits[i], reference.ms[i], tracer);
             ms += t.traceMs;  // for brute force, the reference's own time
             byFamily[cases[i].family].add(t);
             progress.step(config.name + " " + cases[i].name);
@@ -97,7 +97,7 @@ std::vector<StressRow> runConfigurations(const std::vector<StressConfig>& config
 // Prints the table, the failures' examples and the determinism checks; returns whether every
 // default configuration is clean and every check holds.
 bool printReport(const std::vector<StressRow>& rows, const std::vector<DeterminismResult>& determinism,
-                 const StressCommand& command, const BackendDispatcher& dispatcher) {
+                 const StressCommand& command, const Tracer& tracer) {
     bool ok = true;
     std::printf("%-38s %-12s %6s %9s %9s %6s %6s %9s %5s %6s %9s  %s\n", "configuration", "family", "cases", "rays",
                 "must-hit", "leaks", "self", "!= brute", "ties", "errors", "ms", "slowest case (ms)");
@@ -119,21 +119,20 @@ bool printReport(const std::vector<StressRow>& rows, const std::vector<Determini
         if (!d.holds) ok = false;
         std::printf("  %-34s %s  %s\n", d.name.c_str(), d.holds ? "holds" : "FAILS", d.detail.c_str());
     }
-    if (dispatcher.gpuContext() && command.devices.validate) {
-        std::printf("validation errors: %u\n", dispatcher.validationErrors());
-        if (dispatcher.validationErrors() > 0) ok = false;
+    if (!tracer.device().empty() && command.validate) {
+        std::printf("validation errors: %u\n", tracer.validationErrors());
+        if (tracer.validationErrors() > 0) ok = false;
     }
     return ok;
 }
 
 void writeJson(const std::string& path, const std::vector<StressRow>& rows,
                const std::vector<DeterminismResult>& determinism, const StressCommand& command,
-               const BackendDispatcher& dispatcher) {
+               const Tracer& tracer) {
     nlohmann::ordered_json j;
     j["seed"] = command.seed;
     j["size"] = command.size == StressSize::Large ? "large" : "small";
-    if (const gpu::Context* gpu = dispatcher.gpuContext())
-        j["device"] = gpu->info().name + " (" + gpu->info().driver + ")";
+    if (!tracer.device().empty()) j["device"] = tracer.device();
     for (const StressRow& r : rows)
         j["rows"].push_back({{"configuration", r.config}, {"default", r.isDefault}, {"family", r.family},
                              {"cases", r.tally.cases}, {"rays", r.tally.rays}, {"must_hit", r.tally.mustHit},
@@ -147,6 +146,21 @@ void writeJson(const std::string& path, const std::vector<StressRow>& rows,
     writeFileAtomically(path, j.dump(2) + "\n");
 }
 
+// One tracer for every configuration, so that each switches to its options on the same
+// threads, device and pipelines: made with the first backend that runs on the Vulkan device
+// where one does (the device opens now, before any long work); without one, --device and
+// --validate have nothing to choose and are left out, as stress always has.
+Tracer openTracer(const StressCommand& command, const std::vector<Backend>& backends) {
+    const auto vulkan = std::find_if(backends.begin(), backends.end(), runsOnVulkan);
+    TracerOptions options;
+    options.trace.backend = vulkan != backends.end() ? *vulkan : backends.front();
+    if (vulkan != backends.end()) {
+        options.device = command.device;
+        options.validate = command.validate;
+    }
+    return Tracer(options);
+}
+
 }  // namespace
 
 int runStressCommand(const StressCommand& command) {
@@ -156,21 +170,21 @@ int runStressCommand(const StressCommand& command) {
                                               : command.backends;
     checkOutputs({{"--json", command.jsonPath, OutputFormat::Text}}, {});
     const std::vector<StressCase> cases = generateCases(command, families);
-    BackendDispatcher dispatcher(command.devices, backends);
+    Tracer tracer = openTracer(command, backends);
     const std::vector<StressConfig> configs = stressConfigs(backends, command.withOptions);
     std::vector<StressRow> rows;
     {
         // A bar over every (configuration, case) pair and the reference, on a terminal; a line
         // per stage otherwise.
         Progress progress("dacrt stress", cases.size() * (configs.size() + 1));
-        const BruteReference reference = traceReference(cases, dispatcher, progress);
-        rows = runConfigurations(configs, families, cases, reference, dispatcher, progress);
+        const BruteReference reference = traceReference(cases, tracer, progress);
+        rows = runConfigurations(configs, families, cases, reference, tracer, progress);
     }
     std::vector<DeterminismResult> determinism;
-    if (command.determinism) determinism = determinismChecks(backends, dispatcher, command.size);
+    if (command.determinism) determinism = determinismChecks(backends, tracer, command.size);
 
-    const bool ok = printReport(rows, determinism, command, dispatcher);
-    if (!command.jsonPath.empty()) writeJson(command.jsonPath, rows, determinism, command, dispatcher);
+    const bool ok = printReport(rows, determinism, command, tracer);
+    if (!command.jsonPath.empty()) writeJson(command.jsonPath, rows, determinism, command, tracer);
     std::printf("%s\n", ok ? "stress: every default configuration is clean and every determinism check holds"
                            : "stress: FAILED (see the rows marked above)");
     if (!command.jsonPath.empty()) std::printf("stress: wrote %s\n", command.jsonPath.c_str());

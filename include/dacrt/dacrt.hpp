@@ -18,7 +18,8 @@
 //                       when, which camera, which face rule) or from arrays with a single-sided
 //                       flag per triangle
 //   rays.hpp            RayBatch: a camera's rays (as `dacrt render` makes them) or any rays
-//                       with their segments (tmin < t <= tmax)
+//                       with their segments (tmin < t <= tmax), t a distance or in units of
+//                       the direction as given (DirectionLength)
 //   tracer.hpp          Tracer: a backend with its options (options.hpp, backend_tuning.hpp);
 //                       trace() gives each ray's closest hit, occluded() whether anything lies
 //                       on it, plan() the memory and work a trace needs, without tracing
@@ -30,7 +31,9 @@
 //                       device with its limits, as `dacrt devices` prints them
 //
 // brute, cpu-seq, cpu and gpu return the same primitive id and t, bit for bit, for every ray
-// (docs/correctness.md); embree and rayquery are peers with their own answers. A Tracer opens its threads and device once: keep it for many traces.
+// (docs/correctness.md); embree and rayquery are peers with their own answers. A Tracer opens
+// its threads and device once: keep it for many traces (setOptions switches its options or
+// backend between them).
 // A TraceScene, RayBatch or Tracer may be used from one thread at a time.
 #include <dacrt/backend_tuning.hpp>
 #include <dacrt/devices.hpp>

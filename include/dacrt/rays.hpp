@@ -19,6 +19,18 @@ struct CameraSpec {
     std::optional<double> fovDegrees;  // vertical
 };
 
+// What t measures along a ray given as arrays.
+enum class DirectionLength {
+    // The direction is normalized (in double precision, then rounded to float): t is a
+    // distance, whatever length the caller's direction had.
+    Normalize,
+    // The direction is traced as given: t is measured in units of its length, as in Embree's
+    // rays. A segment from o to a point p is the direction p - o with tmax 1 (a shadow ray
+    // towards a point light, whose end then needs no square root); a direction the caller
+    // made unit in float32 stays bit for bit the one traced.
+    AsGiven,
+};
+
 class RayBatch {
 public:
     // One ray per pixel centre, row-major from the top-left pixel, exactly as `dacrt render`
@@ -26,13 +38,16 @@ public:
     // width and height lie in 1..16384. Throws InputError on bad values.
     static RayBatch fromCamera(const TraceScene& scene, const CameraSpec& camera, int width, int height);
 
-    // Rays from arrays of x, y, z: `origins` and `directions` (of any non-zero length: t is
-    // measured in units of the normalized direction) three floats per ray; `tmin` and `tmax`
-    // empty or one per ray: a hit has tmin < t <= tmax (defaults 0 and unbounded). Throws
-    // InputError on sizes that do not match, a zero or non-finite direction, a non-finite
-    // origin, or a segment with tmin < 0 or tmax < tmin.
+    // Rays from arrays of x, y, z: `origins` and `directions` three floats per ray; `tmin`
+    // and `tmax` empty or one per ray: a hit has tmin < t <= tmax (defaults 0 and unbounded;
+    // +infinity is unbounded too). `length` says what t measures (DirectionLength). Each
+    // component of the traced direction below 2^-64 in magnitude is taken as 0. Throws InputError on sizes
+    // that do not match, a non-finite origin or direction, a zero direction (with AsGiven: one
+    // whose largest component lies outside 2^-64 .. 2^62), or a segment with tmin < 0 or
+    // tmax < tmin.
     static RayBatch fromArrays(std::span<const float> origins, std::span<const float> directions,
-                               std::span<const float> tmin = {}, std::span<const float> tmax = {});
+                               std::span<const float> tmin = {}, std::span<const float> tmax = {},
+                               DirectionLength length = DirectionLength::Normalize);
 
     RayBatch(RayBatch&&) noexcept;
     RayBatch& operator=(RayBatch&&) noexcept;

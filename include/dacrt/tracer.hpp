@@ -46,7 +46,15 @@ public:
     // plan.
     FramePlan plan(const TraceScene& scene, const RayBatch& rays);
 
+    // Later traces use these options, on the threads and device already open: a sweep over
+    // DACRT options or backends pays for the device and its pipelines once. Throws InputError
+    // as the constructor does, on another device or validation choice than the open one, and
+    // on gpu or rayquery for a tracer made without them (which opened no device).
+    void setOptions(const TracerOptions& options);
+
     const TracerOptions& options() const;
+    // gpu, rayquery: the Vulkan device opened, "name (driver)"; empty where none is open.
+    std::string device() const;
     // Vulkan validation errors so far (with options.validate; 0 otherwise).
     std::uint32_t validationErrors() const;
 

@@ -16,9 +16,8 @@
 
 #include "support/cli_support.hpp"
 #include "core/errors.hpp"
-#include "support/dispatcher_support.hpp"
+#include "support/tracer_support.hpp"
 #include "support/reference_support.hpp"
-#include "support/gpu_support.hpp"
 #include "core/procedural.hpp"
 #include "stress/stress.hpp"
 #include "support/frames.hpp"
@@ -32,7 +31,7 @@ constexpr std::uint64_t kSeed = 1;
 
 struct FamilyData {
     std::vector<StressCase> cases;
-    std::vector<std::vector<Hit>> brute;
+    std::vector<std::vector<RayHit>> brute;
 };
 
 // Cases and their brute-force hits, made once per family for the whole binary.
@@ -43,17 +42,17 @@ const FamilyData& family(const std::string& name) {
         slot = std::make_unique<FamilyData>();
         slot->cases = stressCases({name}, StressSize::Small, kSeed);
         StressConfig brute = defaultStressConfig(Backend::Brute);
-        brute.request.trace.threads = 2;
-        for (const StressCase& c : slot->cases) slot->brute.push_back(traceStressCase(c, brute, test::testDispatcher()));
+        brute.trace.threads = 2;
+        for (const StressCase& c : slot->cases) slot->brute.push_back(traceStressCase(c, brute, test::testTracer()));
     }
     return *slot;
 }
 
-// Skips a gpu test where there is no Vulkan device.
-#define DACRT_REQUIRE_GPU_DISPATCHER(backend, gpu)                                                  \
+// Skips a gpu test where there is no Vulkan device; `gpu`: whether the test runs on one.
+#define DACRT_REQUIRE_GPU_TRACER(backend, gpu)                                                      \
     std::string gpu##Why;                                                                         \
-    BackendDispatcher& dispatcher = test::testDispatcher(&gpu##Why);                              \
-    gpu::Context* gpu = (backend) == Backend::Gpu ? dispatcher.gpuContext() : nullptr;            \
+    Tracer& tracer = test::testTracer(&gpu##Why);                                                 \
+    const bool gpu = (backend) == Backend::Gpu && !tracer.device().empty();                       \
     if ((backend) == Backend::Gpu && !gpu) GTEST_SKIP() << "no Vulkan device with validation layers: " << gpu##Why
 
 std::string describe(const StressTally& t) {
@@ -96,17 +95,17 @@ class Stress : public ::testing::TestWithParam<Param> {};
 // leak or differ. (One test per backend and family, so that brute force runs once.)
 TEST_P(Stress, NoLeaksAndBruteForceBitForBit) {
     const Param& p = GetParam();
-    DACRT_REQUIRE_GPU_DISPATCHER(p.backend, gpu);
+    DACRT_REQUIRE_GPU_TRACER(p.backend, gpu);
     const FamilyData& data = family(p.family);
     int configurations = 0;
     for (StressConfig config : stressConfigs({p.backend}, true)) {
-        if (!config.request.trace.threads && p.backend != Backend::CpuSeq) config.request.trace.threads = 2;
+        if (!config.trace.threads && p.backend != Backend::CpuSeq) config.trace.threads = 2;
         StressTally total;
         // Defaults see every case; each non-default option value every fourth (the suite's
         // time limit), which `dacrt stress` lifts.
         const std::size_t stride = config.isDefault ? 1 : 4;
         for (std::size_t i = 0; i < data.cases.size(); i += stride) {
-            const std::vector<Hit> hits = traceStressCase(data.cases[i], config, dispatcher);
+            const std::vector<RayHit> hits = traceStressCase(data.cases[i], config, tracer);
             total.add(tallyStressCase(data.cases[i], hits, p.backend == Backend::Brute ? nullptr : &data.brute[i]));
         }
         EXPECT_TRUE(total.clean()) << config.name << " on " << p.family << ": " << describe(total);
@@ -115,7 +114,7 @@ TEST_P(Stress, NoLeaksAndBruteForceBitForBit) {
     }
     EXPECT_GE(configurations, 1);
     if (gpu) {
-        EXPECT_TRUE(test::noValidationErrors(*gpu));
+        EXPECT_EQ(tracer.validationErrors(), 0u);
     }
 }
 
@@ -154,9 +153,9 @@ TEST(StressCases, LeakCountingCatchesAHole) {
     StressCase holed = *sphere;
     holed.triangles[0].v1 = holed.triangles[0].v0;  // zero area: never hit
     const StressConfig brute = defaultStressConfig(Backend::Brute);
-    const StressTally t = tallyStressCase(holed, traceStressCase(holed, brute, test::testDispatcher()), nullptr);
+    const StressTally t = tallyStressCase(holed, traceStressCase(holed, brute, test::testTracer()), nullptr);
     EXPECT_GT(t.leaks, 0u);
-    EXPECT_EQ(tallyStressCase(*sphere, traceStressCase(*sphere, brute, test::testDispatcher()), nullptr).leaks, 0u);
+    EXPECT_EQ(tallyStressCase(*sphere, traceStressCase(*sphere, brute, test::testTracer()), nullptr).leaks, 0u);
 }
 
 TEST(StressCases, CoincidentGroupsAreAnsweredByTheirLowestId) {
@@ -164,7 +163,7 @@ TEST(StressCases, CoincidentGroupsAreAnsweredByTheirLowestId) {
     std::size_t hitsOnGroups = 0;
     for (std::size_t i = 0; i < data.cases.size(); ++i) {
         for (const std::vector<std::uint32_t>& g : data.cases[i].coincidentGroups)
-            for (const Hit& h : data.brute[i]) hitsOnGroups += h.prim == g.front();
+            for (const RayHit& h : data.brute[i]) hitsOnGroups += h.primitive == g.front();
     }
     EXPECT_GT(hitsOnGroups, 100u);  // the groups are actually hit, so the tie rule is exercised
 }
@@ -220,7 +219,7 @@ TEST(StressCases, SelfIntersectionCountingCatchesOriginsBehindTheSurface) {
         const auto it =
             std::find_if(data.cases.begin(), data.cases.end(), [&](const StressCase& c) { return c.name == name; });
         ASSERT_NE(it, data.cases.end()) << name;
-        const StressTally clean = tallyStressCase(*it, traceStressCase(*it, brute, test::testDispatcher()), nullptr);
+        const StressTally clean = tallyStressCase(*it, traceStressCase(*it, brute, test::testTracer()), nullptr);
         EXPECT_EQ(clean.selfIntersections, 0u) << name << ": " << describe(clean);
         EXPECT_EQ(clean.leaks, 0u) << name << ": " << describe(clean);
         StressCase behind = *it;
@@ -231,7 +230,7 @@ TEST(StressCases, SelfIntersectionCountingCatchesOriginsBehindTheSurface) {
             behind.rays[i] = shared::segmentRay(origin, r.dir, r.tmax);
         }
         const StressTally moved =
-            tallyStressCase(behind, traceStressCase(behind, brute, test::testDispatcher()), nullptr);
+            tallyStressCase(behind, traceStressCase(behind, brute, test::testTracer()), nullptr);
         EXPECT_GT(moved.selfIntersections, behind.rays.size() / 4) << name << ": " << describe(moved);
     }
 }
@@ -245,8 +244,8 @@ TEST(StressCases, AnyHitCasesCompareVisibilityAndNamedTriangles) {
     c.mustHit = {0, 0, 1};
     c.starts = {{"start", {1, 0, 0}, {1}}};
     c.startOf = {0, 0, kNoSurfaceStart};
-    const std::vector<Hit> hits = {{1.0f, 2u, 0, 0}, {2.0f, 1u, 0, 0}, {3.0f, kUnnamedHitPrim, 0, 0}};
-    const std::vector<Hit> brute = {{0.5f, 0u, 0, 0}, {2.0f, 1u, 0, 0}, {3.0f, kMissPrim, 0, 0}};
+    const std::vector<RayHit> hits = {{2u, 1.0f, 0, 0}, {1u, 2.0f, 0, 0}, {kUnnamedPrimitive, 3.0f, 0, 0}};
+    const std::vector<RayHit> brute = {{0u, 0.5f, 0, 0}, {1u, 2.0f, 0, 0}, {kNoPrimitive, 3.0f, 0, 0}};
     c.query = HitQuery::Any;
     StressTally t = tallyStressCase(c, hits, &brute);
     EXPECT_EQ(t.mismatches, 1u);         // ray 2: a hit where brute force sees none
@@ -279,12 +278,12 @@ TEST(StressCases, TheReferenceMatchesFloat64BruteForceOnThem) {
 class StressDeterminism : public ::testing::TestWithParam<Backend> {};
 
 TEST_P(StressDeterminism, SameHitsAcrossRunsThreadsAndRegions) {
-    DACRT_REQUIRE_GPU_DISPATCHER(GetParam(), gpu);
-    const std::vector<DeterminismResult> results = determinismChecks({GetParam()}, dispatcher, StressSize::Small);
+    DACRT_REQUIRE_GPU_TRACER(GetParam(), gpu);
+    const std::vector<DeterminismResult> results = determinismChecks({GetParam()}, tracer, StressSize::Small);
     EXPECT_FALSE(results.empty());
     for (const DeterminismResult& r : results) EXPECT_TRUE(r.holds) << r.name << ": " << r.detail;
     if (gpu) {
-        EXPECT_TRUE(test::noValidationErrors(*gpu));
+        EXPECT_EQ(tracer.validationErrors(), 0u);
     }
 }
 

@@ -13,6 +13,7 @@
 
 #include "core/camera.hpp"
 #include "core/gltf_loader.hpp"
+#include "cpu/predicates.hpp"
 #include "library/backend_dispatcher.hpp"
 #include "support/api_support.hpp"
 #include "support/fixtures.hpp"
@@ -107,6 +108,43 @@ TEST(ApiRays, RefusesBadRaysNamingTheRay) {
     expectInputError([&] { RayBatch::fromCamera(scene, {.fovDegrees = 200.0}, 8, 8); }, "field of view");
 }
 
+// AsGiven: t in units of the caller's direction (a segment to a point ends at 1), and a ray
+// made canonical already (makeRay's) traced bit for bit as made.
+TEST(ApiRays, DirectionsAsGivenMeasureTInTheirUnits) {
+    const TraceScene scene = TraceScene::fromArrays(std::vector<float>{-1, -1, -1, 1, -1, -1, 0, 1, -1},
+                                                    std::vector<std::uint32_t>{0, 1, 2});
+    const std::vector<float> o = {0, 0, 0, 0, 0, 0, 0, 0, 0}, d = {0, 0, -4, 0, 0, -0.5f, 0, 0, -4};
+    const std::vector<float> tmin = {0, 0, 0}, tmax = {1, 1, 0.2f};  // the third ends before the triangle
+    const RayBatch given = RayBatch::fromArrays(o, d, tmin, tmax, DirectionLength::AsGiven);
+    const RayBatch unit = RayBatch::fromArrays(o, d, tmin, tmax);
+    for (Backend b : {Backend::Brute, Backend::CpuSeq, Backend::Cpu, Backend::Embree}) {
+        Tracer tracer(onBackend(b, 2));
+        const TraceOutput out = tracer.trace(scene, given);
+        EXPECT_EQ(out.hits[0].t, 0.25f) << int(b);
+        EXPECT_FALSE(out.hits[1].hit()) << int(b);  // the segment ends at z = -0.5
+        EXPECT_FALSE(out.hits[2].hit()) << int(b);
+        EXPECT_EQ(tracer.trace(scene, unit).hits[0].t, 1.0f) << int(b);
+        EXPECT_TRUE(tracer.occluded(scene, given).hits[0].hit()) << int(b);
+    }
+
+    const Ray made = makeRay({0.1f, 0.2f, 0.3f}, glm::dvec3(0.3, -0.7, -1.1));
+    const std::vector<float> mo = {made.origin.x, made.origin.y, made.origin.z}, md = {made.dir.x, made.dir.y, made.dir.z};
+    const TraceScene big = TraceScene::fromArrays(std::vector<float>{-9, -9, -5, 9, -9, -5, 0, 9, -5},
+                                                  std::vector<std::uint32_t>{0, 1, 2});
+    const RayHit asMade = Tracer(onBackend(Backend::Brute)).trace(big, RayBatch::fromArrays(mo, md, {}, {}, DirectionLength::AsGiven)).hits[0];
+    const shared::TriangleHit expected = shared::intersectWatertight(made, {-9, -9, -5}, {9, -9, -5}, {0, 9, -5}, false);
+    ASSERT_TRUE(expected.hit);
+    EXPECT_EQ(asMade.t, expected.t);
+    EXPECT_EQ(asMade.u, expected.u);
+
+    expectInputError([&] { RayBatch::fromArrays(o, std::vector<float>{0, 0, 1e-30f, 0, 0, 1, 0, 0, 1}, {}, {},
+                                                DirectionLength::AsGiven); },
+                     "ray 0: origin");
+    expectInputError([&] { RayBatch::fromArrays(o, std::vector<float>{0, 0, 1, 0, 0, 1e30f, 0, 0, 1}, {}, {},
+                                                DirectionLength::AsGiven); },
+                     "2^-64 .. 2^62");
+}
+
 TEST(ApiScene, DroppedTrianglesKeepTheCallersNumbering) {
     // Triangle 1 has no area; a ray at triangle 2 must report 2.
     const std::vector<float> p = {0, 0, -1, 1, 0, -1, 0, 1, -1, 0, 0, -2, 1, 1, -2, 2, 2, -2, 5, 0, -3, 6, 0, -3, 5, 1, -3};
@@ -128,12 +166,27 @@ TEST(ApiScene, DroppedTrianglesKeepTheCallersNumbering) {
     }
 }
 
+// A random scene, rays into it and their brute-force hits.
+struct RandomFrame {
+    TraceScene scene;
+    RayBatch rays;
+    TraceOutput brute;
+};
+
+RandomFrame randomFrame(std::uint64_t seed, std::uint32_t triangles, std::uint32_t rays) {
+    const test::SceneArrays s = test::randomSceneArrays(seed, triangles);
+    const test::RayArrays r = test::randomRayArrays(seed + 1, rays);
+    RandomFrame f{TraceScene::fromArrays(s.positions, s.indices, s.singleSided),
+                  RayBatch::fromArrays(r.origins, r.directions), {}};
+    f.brute = Tracer(onBackend(Backend::Brute, 2)).trace(f.scene, f.rays);
+    return f;
+}
+
 TEST(ApiTracer, CpuBackendsGiveIdenticalHitsAndEmbreeAgrees) {
-    const test::SceneArrays s = test::randomSceneArrays(7, 2000);
-    const test::RayArrays r = test::randomRayArrays(8, 8000);
-    const TraceScene scene = TraceScene::fromArrays(s.positions, s.indices, s.singleSided);
-    const RayBatch rays = RayBatch::fromArrays(r.origins, r.directions);
-    const TraceOutput brute = Tracer(onBackend(Backend::Brute, 2)).trace(scene, rays);
+    const RandomFrame frame = randomFrame(7, 2000, 8000);
+    const TraceScene& scene = frame.scene;
+    const RayBatch& rays = frame.rays;
+    const TraceOutput& brute = frame.brute;
     EXPECT_GT(hitCount(brute.hits), rays.size() / 4);
     EXPECT_LT(hitCount(brute.hits), rays.size());
     EXPECT_TRUE(sameHits(Tracer(onBackend(Backend::CpuSeq)).trace(scene, rays).hits, brute.hits));
@@ -246,6 +299,29 @@ TEST(ApiTracer, ReportsTypedTimingsAndCounters) {
     EXPECT_GT(embree.timings.buildMs + embree.timings.traceMs, 0.0);
     EXPECT_EQ(embree.timings.divideMs, 0.0);
     EXPECT_EQ(embree.counters.rayTriangleTests, 0u);
+}
+
+// One tracer switched between backends and options gives each one's hits; what it cannot
+// switch (the device, a Vulkan backend without one) is refused.
+TEST(ApiTracer, SetOptionsSwitchesBackendsAndOptions) {
+    const RandomFrame frame = randomFrame(5, 500, 2000);
+    Tracer tracer(onBackend(Backend::Brute, 2));
+    TracerOptions cpu = onBackend(Backend::Cpu, 2);
+    cpu.trace.regions = 3;
+    tracer.setOptions(cpu);
+    EXPECT_EQ(tracer.options().trace.regions, 3u);
+    const TraceOutput out = tracer.trace(frame.scene, frame.rays);
+    EXPECT_TRUE(sameHits(out.hits, frame.brute.hits));
+    EXPECT_EQ(out.counters.regions, 3u);
+    TracerOptions embree = onBackend(Backend::Embree);
+    embree.trace.regions = 3;
+    expectInputError([&] { tracer.setOptions(embree); }, "--regions is not an option of --backend embree");
+    EXPECT_EQ(tracer.options().trace.backend, Backend::Cpu);  // a refused choice changes nothing
+    expectInputError([&] { tracer.setOptions(onBackend(Backend::Gpu)); }, "gpu runs on a Vulkan device");
+    TracerOptions device = cpu;
+    device.validate = true;
+    expectInputError([&] { tracer.setOptions(device); }, "chosen when a Tracer is made");
+    EXPECT_TRUE(tracer.device().empty());
 }
 
 TEST(ApiTracer, RefusesOptionsItsBackendDoesNotTake) {
