@@ -2,6 +2,7 @@
 // The library's side of the public TraceScene and RayBatch (include/dacrt/): the arrays every
 // backend reads, prepared once.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -23,12 +24,17 @@ struct TraceScene::Impl {
 
     explicit Impl(Scene checked)
         : scene(std::move(checked)), triangleBounds(allTriangleBounds(scene.triangles)), box(sceneBounds(scene.triangles)) {}
+
+    // The public scene around a prepared one (the library's own inputs, render_inputs.hpp).
+    static TraceScene wrap(std::unique_ptr<Impl> impl) { return TraceScene(std::move(impl)); }
 };
 
 struct RayBatch::Impl {
     std::vector<Ray> rays;
     std::uint32_t imageWidth = 0;        // a camera's: its pixels in a row (0: not an image)
     std::optional<ViewFrustum> frustum;  // a perspective camera's
+
+    static RayBatch wrap(std::unique_ptr<Impl> impl) { return RayBatch(std::move(impl)); }
 };
 
 }  // namespace dacrt

@@ -1,12 +1,14 @@
 #pragma once
 // A frame's secondary passes: which the lights and --ao ask for, traced after the primary
-// pass by the same backend, and the lighting the shade stage takes from them.
+// pass by the same backend, and their public description (include/dacrt/frame.hpp).
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include <dacrt/frame.hpp>
+
+#include "core/lights.hpp"
 #include "library/backend_dispatcher.hpp"
-#include "core/shading.hpp"
 #include "cpu/secondary_rays.hpp"
 
 namespace dacrt {
@@ -41,8 +43,11 @@ std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& p
                                              const std::vector<Hit>& primaryHits, BackendDispatcher& backends,
                                              const BackendRequest& request, const PlanHook& onPlan);
 
-// The shade stage's view of the traced passes (which must outlive it).
-Lighting lightingOf(const std::vector<Light>& lights, const std::vector<TracedPass>& traced);
+// The passes as the public API describes them (Tracer::traceFrame), and back.
+std::vector<FramePass> framePasses(const std::vector<Light>& lights, const PassOptions& options, const Box& sceneBox,
+                                   std::uint32_t seed);
+SecondaryPass secondaryPassOf(const FramePass& pass);
+FramePass framePassOf(const SecondaryPass& pass);
 
 // What a pass will allocate at most, from the counts alone (--plan: the primary hits that
 // decide how many rays each pass makes are not traced then).

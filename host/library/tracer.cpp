@@ -10,6 +10,7 @@
 #include "library/api_results.hpp"
 #include "library/api_state.hpp"
 #include "library/backend_dispatcher.hpp"
+#include "library/frame_passes.hpp"
 
 namespace dacrt {
 
@@ -56,6 +57,19 @@ TraceOutput traced(BackendDispatcher& dispatcher, const BackendRequest& request,
     return traceOutputOf(result, s.callerIds, msSince(start));
 }
 
+// The caller's plan callback as the backends call it.
+PlanHook planHookOf(const PlanCallback& onPlan) {
+    if (!onPlan) return {};
+    return [&onPlan](const MemoryPlan& plan) { return onPlan(framePlanOf(plan)); };
+}
+
+std::vector<PassOutput> passOutputsOf(std::vector<TracedPass> traced, const TraceScene::Impl& s) {
+    std::vector<PassOutput> out;
+    for (TracedPass& t : traced)
+        out.push_back({framePassOf(t.pass), traceOutputOf(t.result, s.callerIds, t.ms), t.rays, t.ms});
+    return out;
+}
+
 }  // namespace
 
 Tracer::Tracer(const TracerOptions& options) : impl_(std::make_unique<Impl>(options)) {}
@@ -69,6 +83,27 @@ TraceOutput Tracer::trace(const TraceScene& scene, const RayBatch& rays) {
 
 TraceOutput Tracer::occluded(const TraceScene& scene, const RayBatch& rays) {
     return traced(impl_->dispatcher, impl_->request, *scene.impl_, *rays.impl_, HitQuery::Any);
+}
+
+FrameOutput Tracer::traceFrame(const TraceScene& scene, const RayBatch& cameraRays, const std::vector<FramePass>& passes,
+                               const PlanCallback& onPlan, const ProgressCallback& onProgress) {
+    FrameOutput out;
+    if (cameraRays.impl_->rays.empty()) return out;
+    const TraceScene::Impl& s = *scene.impl_;
+    const FrameGeometry g = frameOf(s, *cameraRays.impl_, HitQuery::Closest);
+    BackendRequest request = impl_->request;
+    request.keepForPasses = !passes.empty();  // gpu: the passes start from the device's hits
+    const PlanHook hook = planHookOf(onPlan);
+    const auto start = Clock::now();
+    const TraceResult primary = impl_->dispatcher.trace(g, request, hook, onProgress);
+    out.stoppedAtPlan = primary.hits.empty();
+    if (out.stoppedAtPlan) return out;
+    out.primary = traceOutputOf(primary, s.callerIds, msSince(start));
+    std::vector<SecondaryPass> secondary;
+    for (const FramePass& pass : passes) secondary.push_back(secondaryPassOf(pass));
+    out.passes = passOutputsOf(traceSecondaryPasses(secondary, g, primary.hits, impl_->dispatcher, request, hook), s);
+    out.stoppedAtPlan = out.passes.size() < passes.size();
+    return out;
 }
 
 FramePlan Tracer::plan(const TraceScene& scene, const RayBatch& rays) {
@@ -104,5 +139,10 @@ std::string Tracer::device() const {
 }
 
 std::uint32_t Tracer::validationErrors() const { return impl_->dispatcher.validationErrors(); }
+
+std::vector<std::string> Tracer::validationMessages() const {
+    const gpu::Context* gpu = impl_->dispatcher.gpuContext();
+    return gpu ? gpu->validationMessages() : std::vector<std::string>();
+}
 
 }  // namespace dacrt
