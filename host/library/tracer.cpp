@@ -18,6 +18,9 @@ struct Tracer::Impl {
     TracerOptions options;
     BackendRequest request;
     BackendDispatcher dispatcher;
+    // The triangles' bounds of the frame being traced (dacrt's backends), their memory reused
+    // from trace to trace.
+    std::vector<Bounds> bounds;
 
     explicit Impl(const TracerOptions& o)
         : options(o),
@@ -39,21 +42,37 @@ struct Tracer::Impl {
 namespace {
 
 // The frame of a batch: a camera's keeps its image width and view frustum (the frustum skip);
-// any-hit rays are traced as a secondary pass's are.
-FrameGeometry frameOf(const TraceScene::Impl& s, const RayBatch::Impl& r, HitQuery query) {
-    FrameGeometry g = query == HitQuery::Any
-                          ? secondaryFrame(s.scene.triangles, s.triangleBounds, r.rays, s.box)
-                          : frameGeometry(s.scene.triangles, s.triangleBounds, r.rays, s.box, r.imageWidth);
+// any-hit rays are traced as a secondary pass's are. dacrt's backends read the triangles'
+// bounds, made here on the trace's threads: dacrt keeps no structure between traces, so each
+// one pays for what a frame of a dynamic scene needs (the peers, which build their own, do not).
+// boundsMs: the time they took (0 for a peer).
+FrameGeometry frameOf(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch::Impl& r, HitQuery query,
+                      double& boundsMs) {
+    const auto start = Clock::now();
+    Box box = s.box;
+    if (isPeer(t.request.trace.backend)) t.bounds.clear();
+    else triangleBoundsInParallel(s.scene.triangles, t.dispatcher.pool(BackendDispatcher::threadsOf(t.request.trace)),
+                                  t.bounds, box);
+    boundsMs = isPeer(t.request.trace.backend) ? 0.0 : msSince(start);
+    FrameGeometry g = query == HitQuery::Any ? secondaryFrame(s.scene.triangles, t.bounds, r.rays, box)
+                                             : frameGeometry(s.scene.triangles, t.bounds, r.rays, box, r.imageWidth);
     if (query == HitQuery::Closest) g.frustum = r.frustum;
     g.trianglesVersion = s.scene.trianglesVersion;
     return g;
 }
 
-TraceOutput traced(BackendDispatcher& dispatcher, const BackendRequest& request, const TraceScene::Impl& s,
-                   const RayBatch::Impl& r, HitQuery query) {
+// The bounds' time as the trace's first phase.
+TraceResult withBoundsPhase(TraceResult result, double boundsMs) {
+    if (boundsMs > 0.0) result.phases.bounds = boundsMs;
+    return result;
+}
+
+TraceOutput traced(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch::Impl& r, HitQuery query) {
     if (r.rays.empty()) return {};  // nothing to trace (a frame reads its first ray)
     const auto start = Clock::now();
-    const TraceResult result = dispatcher.trace(frameOf(s, r, query), request);
+    double boundsMs = 0.0;
+    const FrameGeometry g = frameOf(t, s, r, query, boundsMs);
+    const TraceResult result = withBoundsPhase(t.dispatcher.trace(g, t.request), boundsMs);
     return traceOutputOf(result, s.callerIds, msSince(start));
 }
 
@@ -72,17 +91,24 @@ std::vector<PassOutput> passOutputsOf(std::vector<TracedPass> traced, const Trac
 
 }  // namespace
 
+void checkTracerOptions(const TracerOptions& options) {
+    Tracer::Impl::checkedRequest(options);
+    Tracer::Impl::checkedDevices(options);
+}
+
+unsigned traceThreads(const TraceOptions& options) { return BackendDispatcher::threadsOf(options); }
+
 Tracer::Tracer(const TracerOptions& options) : impl_(std::make_unique<Impl>(options)) {}
 Tracer::Tracer(Tracer&&) noexcept = default;
 Tracer& Tracer::operator=(Tracer&&) noexcept = default;
 Tracer::~Tracer() = default;
 
 TraceOutput Tracer::trace(const TraceScene& scene, const RayBatch& rays) {
-    return traced(impl_->dispatcher, impl_->request, *scene.impl_, *rays.impl_, HitQuery::Closest);
+    return traced(*impl_, *scene.impl_, *rays.impl_, HitQuery::Closest);
 }
 
 TraceOutput Tracer::occluded(const TraceScene& scene, const RayBatch& rays) {
-    return traced(impl_->dispatcher, impl_->request, *scene.impl_, *rays.impl_, HitQuery::Any);
+    return traced(*impl_, *scene.impl_, *rays.impl_, HitQuery::Any);
 }
 
 FrameOutput Tracer::traceFrame(const TraceScene& scene, const RayBatch& cameraRays, const std::vector<FramePass>& passes,
@@ -90,12 +116,13 @@ FrameOutput Tracer::traceFrame(const TraceScene& scene, const RayBatch& cameraRa
     FrameOutput out;
     if (cameraRays.impl_->rays.empty()) return out;
     const TraceScene::Impl& s = *scene.impl_;
-    const FrameGeometry g = frameOf(s, *cameraRays.impl_, HitQuery::Closest);
+    const auto start = Clock::now();
+    double boundsMs = 0.0;
+    const FrameGeometry g = frameOf(*impl_, s, *cameraRays.impl_, HitQuery::Closest, boundsMs);
     BackendRequest request = impl_->request;
     request.keepForPasses = !passes.empty();  // gpu: the passes start from the device's hits
     const PlanHook hook = planHookOf(onPlan);
-    const auto start = Clock::now();
-    const TraceResult primary = impl_->dispatcher.trace(g, request, hook, onProgress);
+    const TraceResult primary = withBoundsPhase(impl_->dispatcher.trace(g, request, hook, onProgress), boundsMs);
     out.stoppedAtPlan = primary.hits.empty();
     if (out.stoppedAtPlan) return out;
     out.primary = traceOutputOf(primary, s.callerIds, msSince(start));
@@ -115,7 +142,9 @@ FramePlan Tracer::plan(const TraceScene& scene, const RayBatch& rays) {
         planned = p;
         return false;  // stop before anything is traced
     };
-    impl_->dispatcher.trace(frameOf(*scene.impl_, *rays.impl_, HitQuery::Closest), impl_->request, stopAtPlan);
+    double boundsMs = 0.0;
+    impl_->dispatcher.trace(frameOf(*impl_, *scene.impl_, *rays.impl_, HitQuery::Closest, boundsMs), impl_->request,
+                            stopAtPlan);
     if (!planned) throw InternalError("the backend traced without showing its plan first");
     return framePlanOf(*planned);
 }

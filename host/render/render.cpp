@@ -84,10 +84,9 @@ void checkOutputNames(const RenderOptions& o) {
 void checkRenderOptions(const RenderOptions& o) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw InputError("--size: width and height must lie in 1..16384");
-    if (o.request.trace.backend == Backend::Embree && o.planOnly)
+    if (o.tracer.trace.backend == Backend::Embree && o.planOnly)
         throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
-    checkBackendRequest(o.request);
-    checkDeviceChoice(o.devices, {o.request.trace.backend});
+    checkTracerOptions(o.tracer);
     checkPassOptions(o.passes);
     checkFrameOptions(o);
     checkOutputNames(o);
@@ -197,9 +196,9 @@ LoadedDocument loadDocument(const RenderOptions& o) {
 // What every camera of the instant shares: the scene at that instant, its bounds, the cameras
 // and the lights (fixed in the world: a key light follows the first camera only).
 struct PreparedScene {
-    Scene scene;
-    std::optional<TraceScene> traced;  // the scene's triangles, as the tracer takes them
-    Box box;
+    TraceScene traced;   // the posed scene, moved into the tracer's input (no copy)
+    const Scene& scene;  // read through it by the shading and the stats
+    const Box& box;      // its triangles'
     std::vector<Camera> cameras;
     std::vector<Light> lights;
     bool headlight = false;
@@ -220,11 +219,12 @@ Scene evaluateAnimation(const RenderOptions& o, const GltfDocument& document, co
     return scene;
 }
 
-PreparedScene prepareFrame(const RenderOptions& o, Scene scene) {
-    PreparedScene p;
-    p.scene = std::move(scene);
-    p.traced.emplace(traceSceneOf(p.scene));
-    p.box = sceneBounds(p.scene.triangles);
+PreparedScene prepareFrame(const RenderOptions& o, Scene posed) {
+    const Box box = sceneBounds(posed.triangles);
+    TraceScene traced = adoptScene(std::move(posed), box);
+    const Scene& scene = sceneOf(traced);  // the TraceScene holds it on the heap: moving it keeps these
+    const Box& tracedBox = boxOf(traced);
+    PreparedScene p{std::move(traced), scene, tracedBox};
     p.cameras = makeCameras(p.scene, p.box, o.camera, double(o.width) / double(o.height));
     p.lights = frameLights(p.scene, p.cameras.front(), p.box, o.passes.lights, p.headlight);
     return p;
@@ -237,7 +237,7 @@ PreparedScene prepareFrame(const RenderOptions& o, Scene scene) {
 PlanCallback planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t rays, int cameraIndex) {
     return [&o, &p, rays, cameraIndex](const FramePlan& plan) {
         if (o.planOnly) {
-            const std::string frame = toString(o.request.trace.backend) + ", " + std::to_string(p.scene.triangleCount()) +
+            const std::string frame = toString(o.tracer.trace.backend) + ", " + std::to_string(p.scene.triangleCount()) +
                                       " triangles, " + std::to_string(rays) + " rays" +
                                       (p.cameras.size() > 1 ? ", camera " + std::to_string(cameraIndex) : std::string());
             std::cout << "work plan (" << frame << "):\n"
@@ -259,7 +259,8 @@ PlanCallback planCheck(const RenderOptions& o, const PreparedScene& p, std::size
 // A traced frame: the primary pass and its secondary passes, with their hits as the shade
 // stage reads them.
 struct TracedFrame {
-    std::vector<Ray> rays;
+    RayBatch batch;                  // the primary rays, as the tracer takes them
+    const std::vector<Ray>* rays;    // read through it by the shading
     FrameOutput output;
     std::vector<Hit> hits;                   // the primary pass's
     std::vector<std::vector<Hit>> passHits;  // each secondary pass's, in its order
@@ -277,10 +278,11 @@ std::vector<Hit> shadingHits(const std::vector<RayHit>& hits) {
 TracedFrame traceFrame(const RenderOptions& o, const PreparedScene& p, const Camera& camera, glm::dvec2 offset,
                        std::uint32_t seed, Tracer& tracer, const PlanCallback& onPlan,
                        const ProgressCallback& onProgress) {
-    TracedFrame f;
-    f.rays = primaryRays(camera, o.width, o.height, offset);
-    const RayBatch batch = cameraRayBatch(f.rays, std::uint32_t(o.width), viewFrustum(camera, o.width, o.height));
-    f.output = tracer.traceFrame(*p.traced, batch, framePasses(p.lights, o.passes, p.box, seed), onPlan, onProgress);
+    TracedFrame f{adoptCameraRays(primaryRays(camera, o.width, o.height, offset), std::uint32_t(o.width),
+                                  viewFrustum(camera, o.width, o.height)),
+                  nullptr};
+    f.rays = &raysOf(f.batch);
+    f.output = tracer.traceFrame(p.traced, f.batch, framePasses(p.lights, o.passes, p.box, seed), onPlan, onProgress);
     f.hits = shadingHits(f.output.primary.hits);
     for (const PassOutput& pass : f.output.passes) f.passHits.push_back(shadingHits(pass.output.hits));
     return f;
@@ -320,7 +322,7 @@ std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScen
             const TracedFrame f = traceFrame(o, p, camera, {(i + 0.5) / k, (j + 0.5) / k}, seed, tracer, {}, {});
             Lighting sample = lightingOf(p.lights, f);
             sample.exposure = lighting.exposure;
-            accumulateShading(p.scene, HitImage{o.width, o.height, &f.rays, &f.hits}, 1.0f / float(k * k), sum,
+            accumulateShading(p.scene, HitImage{o.width, o.height, f.rays, &f.hits}, 1.0f / float(k * k), sum,
                               &sample);
         }
     samplesMs = msSince(start);
@@ -369,6 +371,10 @@ void writeStats(const RenderOptions& o, const std::string& path, const RenderedF
     written.push_back(path);
 }
 
+// What a ray/triangle test costs one thread, measured on the project's 2-core VM (2026-12-01:
+// the Bunny at 80x60, 3.7 s on 2 threads with one busy core elsewhere); for estimates only.
+constexpr double kBruteNanosecondsPerTest = 15.0;
+
 // Brute force's cost grows with triangles times rays: say so before a long frame.
 void announceBruteForce(std::size_t triangles, std::size_t rays, unsigned threads) {
     const double seconds = double(triangles) * double(rays) * kBruteNanosecondsPerTest * 1e-9 / double(threads);
@@ -381,7 +387,7 @@ void announceBruteForce(std::size_t triangles, std::size_t rays, unsigned thread
 // depends on the primary hits, which --plan does not trace).
 void printPassBounds(const RenderOptions& o, const PreparedScene& p, std::size_t primaryRays) {
     for (const FramePass& pass : framePasses(p.lights, o.passes, p.box, 0)) {
-        const FramePlan bound = passPlanBound(pass, primaryRays, o.request.trace.backend);
+        const FramePlan bound = passPlanBound(pass, primaryRays, o.tracer.trace.backend);
         std::cout << "pass '" << pass.name << "', after the primary pass: work plan:\n"
                   << describeWork(bound) << "memory plan (at most; plus the buffers of a pass over every triangle):\n"
                   << describeMemory(bound);
@@ -424,11 +430,11 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
     const Camera& camera = p.cameras[std::size_t(k)];
     const auto cameraStart = Clock::now();
     const std::size_t pixels = std::size_t(o.width) * std::size_t(o.height);
-    const bool brute = o.request.trace.backend == Backend::Brute;
+    const bool brute = o.tracer.trace.backend == Backend::Brute;
     std::size_t frameRays = pixels;
     for (const FramePass& pass : framePasses(p.lights, o.passes, p.box, 0)) frameRays += pixels * pass.raysPerHit;
     if (brute && !o.planOnly && !tally.bruteAnnounced) {
-        announceBruteForce(p.scene.triangleCount(), frameRays, BackendDispatcher::threadsOf(o.request.trace));
+        announceBruteForce(p.scene.triangleCount(), frameRays, traceThreads(o.tracer.trace));
         tally.bruteAnnounced = true;
     }
     Progress progress("dacrt render", 1);
@@ -448,7 +454,7 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
     }
     t.trace = msSince(traceStart) - compileMs - t.secondary;  // the primary pass
 
-    const HitImage image{o.width, o.height, &frame.rays, &frame.hits};
+    const HitImage image{o.width, o.height, frame.rays, &frame.hits};
     Lighting lighting = lightingOf(p.lights, frame);
     lighting.exposure = autoExposure(p.scene, image, lighting.lights);
     double samplesMs = 0.0;
@@ -459,7 +465,7 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
     writeImages(files, p, image, lighting, shaded, tally.written);
     t.write = msSince(writeStart);
     tally.cameraTraceMs.push_back(t.trace);
-    tally.raysPerFrame = frame.rays.size();
+    tally.raysPerFrame = frame.rays->size();
     // The instant's shared stages (load: the first instant's) count in its first camera's total.
     t.total = (k == 0 ? sharedMs : 0.0) + msSince(cameraStart);
 
@@ -468,13 +474,13 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
              {"shader_compile", compileMs}, {"trace", t.trace}, {"secondary_passes", t.secondary},
              {"antialiasing_samples", samplesMs}, {"write", t.write}, {"total", t.total}})
         timings.emplace_back(name, ms);
-    writeStats(o, files.stats, RenderedFrame{p.scene, camera, k, instant, frame.rays.size(), frame.output.primary,
+    writeStats(o, files.stats, RenderedFrame{p.scene, camera, k, instant, frame.rays->size(), frame.output.primary,
                                              timings, &frame.output.passes, p.lights, lighting.exposure},
                tally.written);
     t.write = msSince(writeStart);  // the stats file too; --stats records the images' write
 
-    std::cerr << "dacrt: " << instantLabel(o, instant) << toString(o.request.trace.backend) << " camera " << k << ": "
-              << p.scene.triangleCount() << " triangles, " << frame.rays.size() << " rays";
+    std::cerr << "dacrt: " << instantLabel(o, instant) << toString(o.tracer.trace.backend) << " camera " << k << ": "
+              << p.scene.triangleCount() << " triangles, " << frame.rays->size() << " rays";
     for (const PassOutput& pass : frame.output.passes) std::cerr << " + " << pass.rays << " " << pass.pass.name;
     std::cerr << ", trace " << t.trace << " ms";
     if (!frame.output.passes.empty()) std::cerr << " + " << t.secondary << " ms";
@@ -518,7 +524,7 @@ void renderInstant(const RenderOptions& o, const LoadedDocument& d, const FrameI
 // Under --validate: every validation message; true when there were errors (the command then
 // fails with its validation exit code).
 bool reportValidationErrors(const RenderOptions& o, const Tracer& tracer) {
-    if (!o.devices.validate || tracer.validationErrors() == 0) return false;
+    if (!o.tracer.validate || tracer.validationErrors() == 0) return false;
     for (const std::string& m : tracer.validationMessages()) std::cerr << "dacrt: validation " << m << "\n";
     std::cerr << "dacrt: error: " << tracer.validationErrors() << " Vulkan validation errors\n";
     return true;
@@ -563,7 +569,7 @@ void reportRender(const RenderOptions& o, const RenderTally& tally) {
             return;
         }
         std::cerr << "dacrt: traced " << tally.raysPerFrame * traceMs.size() << " rays with "
-                  << toString(o.request.trace.backend)
+                  << toString(o.tracer.trace.backend)
                   << " and wrote nothing: name a shaded image with -o OUT.png, AOVs with --aov OUT.exr, "
                      "stats with --stats OUT.json\n";
         return;
@@ -598,8 +604,7 @@ int runRender(const RenderOptions& o) {
     announceSchedule(o, schedule);
     if (schedule.instants.empty()) return kExitSuccess;
     removeStaleTemporariesOf(o, schedule);
-    Tracer tracer({.trace = o.request.trace, .gpu = o.request.gpuTuning, .embree = o.request.embree,
-                   .device = o.devices.device, .validate = o.devices.validate});
+    Tracer tracer(o.tracer);
 
     RenderTally tally;
     for (const FrameInstant& instant : schedule.instants) {

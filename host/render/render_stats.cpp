@@ -111,7 +111,7 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     const Scene& scene = frame.scene;
     const Camera& camera = frame.camera;
     const TraceOutput& r = frame.result;
-    const TraceOptions& trace = o.request.trace;
+    const TraceOptions& trace = o.tracer.trace;
     nlohmann::ordered_json j;
     j["backend"] = toString(trace.backend);
     j["scene"] = o.scenePath;
@@ -144,8 +144,8 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
                     {"skip_uploads", trace.skips.uploads},
                     {"skip_subscenes", trace.skips.subScenes}};
     if (trace.backend == Backend::Embree)
-        j["options"] = {{"robust", o.request.embree.robust}, {"build", toString(o.request.embree.build)},
-                        {"packets", o.request.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
+        j["options"] = {{"robust", o.tracer.embree.robust}, {"build", toString(o.tracer.embree.build)},
+                        {"packets", o.tracer.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
     nlohmann::ordered_json t;
     for (const auto& [name, ms] : frame.timingsMs) t[name] = ms;
     const nlohmann::ordered_json phases = phasesJson(r.timings);

@@ -23,6 +23,10 @@ struct TracerOptions {
     bool validate = false;  // gpu, rayquery: under the Vulkan validation layers (validationErrors())
 };
 
+// The checks the Tracer's constructor makes, without opening a device: a command checks its
+// options before loading anything. Throws InputError as the constructor does.
+void checkTracerOptions(const TracerOptions& options);
+
 class Tracer {
 public:
     // Checks the options against the backend and opens its device (gpu, rayquery). Throws
@@ -67,8 +71,9 @@ public:
     // Their messages, as the validation layers gave them.
     std::vector<std::string> validationMessages() const;
 
+    struct Impl;  // the library's own
+
 private:
-    struct Impl;
     std::unique_ptr<Impl> impl_;
 };
 
