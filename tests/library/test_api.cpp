@@ -22,10 +22,9 @@ namespace dacrt {
 namespace {
 
 using test::hitCount;
+using test::kRoomScene;
 using test::onBackend;
 using test::sameHits;
-
-const std::string kRoomScene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
 
 // Throws InputError whose message contains `part`.
 void expectInputError(const std::function<void()>& call, const std::string& part) {
