@@ -21,7 +21,8 @@ void waitForStopSignal(sigset_t signals) {
     }
     std::string removed;
     for (const std::string& path : removeUnfinishedTemporariesForExit()) removed += (removed.empty() ? " " : ", ") + path;
-    std::cerr << "\ndacrt: stopped by " << (signal == SIGTERM ? "SIGTERM" : "SIGINT") << " (exit " << 128 + signal
+    const char* name = signal == SIGTERM ? "SIGTERM" : signal == SIGHUP ? "SIGHUP" : "SIGINT";
+    std::cerr << "\ndacrt: stopped by " << name << " (exit " << 128 + signal
               << ")"
               << (removed.empty() ? std::string("; no file was being written") : "; removed the unfinished" + removed)
               << "\n"
@@ -38,7 +39,13 @@ void stopCleanlyOnSignals() {
         sigemptyset(&signals);
         sigaddset(&signals, SIGTERM);
         sigaddset(&signals, SIGINT);
+        sigaddset(&signals, SIGHUP);  // the terminal closed, or a job scheduler's stop
         pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+        // A FIFO output whose reader went away: the write fails with EPIPE and the command
+        // reports it, removing the frame's other outputs, instead of dying without a word.
+        std::signal(SIGPIPE, SIG_IGN);
+        // The same for a file size limit (ulimit -f): the write fails with EFBIG and is reported.
+        std::signal(SIGXFSZ, SIG_IGN);
         std::thread(waitForStopSignal, signals).detach();
     });
 }

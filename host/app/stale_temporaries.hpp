@@ -1,5 +1,5 @@
 #pragma once
-// Temporaries a killed run left behind: AtomicFile writes ".STEM.partial-PID-N.EXT" beside
+// Temporaries a killed run left behind: OutputBatch writes ".STEM.partial-PID-N.EXT" beside
 // STEM.EXT, and a run ended by SIGKILL (or a crash) cannot remove its own. A re-run removes
 // those of its own output names whose process is gone from this machine.
 #include <string>

@@ -327,7 +327,7 @@ Subcommand addCompareCommand(CLI::App& app) {
                 const Aov b = readAov(s->b);
                 const CompareReport report = compareAovs(a, b, s->options);
                 if (!s->diff.empty()) {
-                    writeThrough(s->diff, [&](const std::string& to) { writeRgb8(to, a.width, a.height, differenceImage(a, report)); });
+                    writeFileAtomically(s->diff, encodeRgb8(encodingNameFor(s->diff, OutputFormat::Image), a.width, a.height, differenceImage(a, report)));
                 }
                 std::cout << (s->json ? report.json() + "\n" : report.text()) << std::flush;
                 if (!s->diff.empty()) std::cerr << "dacrt: wrote " << s->diff << "\n";

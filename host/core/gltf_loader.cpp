@@ -24,6 +24,7 @@
 #include "core/gltf_compression.hpp"
 #include "core/gltf_container.hpp"
 #include "core/gltf_materials.hpp"
+#include "core/input_file.hpp"
 #include "core/json_nesting.hpp"
 #include "core/system_memory.hpp"
 #include "core/triangle_rules.hpp"
@@ -87,6 +88,18 @@ bool noFileRead(std::vector<unsigned char>*, std::string* err, const std::string
     return false;
 }
 
+// External buffers read as the file itself is: regular files only, within this machine's
+// memory (tinygltf's own reader opens a FIFO and waits, or reads a device without end).
+bool boundedFileRead(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+    try {
+        *out = readRegularInput(path, physicalMemoryBytes());
+        return true;
+    } catch (const InputError& e) {
+        if (err) *err += std::string(e.what()) + "\n";
+        return false;
+    }
+}
+
 tinygltf::Model parseGltf(std::span<const unsigned char> bytes, const std::string& name, const std::string& baseDir,
                           bool readFiles) {
     if (bytes.size() > std::numeric_limits<unsigned int>::max())
@@ -95,6 +108,9 @@ tinygltf::Model parseGltf(std::span<const unsigned char> bytes, const std::strin
     reader.SetStoreOriginalJSONForExtrasAndExtensions(false);
     reader.SetImageLoader(gltf::keepEncodedImage, nullptr);
     if (!readFiles) reader.SetFsCallbacks(tinygltf::FsCallbacks{noFileExists, keepPath, noFileRead, nullptr, nullptr});
+    else
+        reader.SetFsCallbacks(
+            tinygltf::FsCallbacks{tinygltf::FileExists, tinygltf::ExpandFilePath, boundedFileRead, tinygltf::WriteWholeFile, nullptr});
     tinygltf::Model model;
     std::string err, warn;
     bool ok = false;
@@ -983,18 +999,7 @@ private:
 };
 
 std::vector<unsigned char> readWholeFile(const std::string& path, const GltfLimits& limits) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": no such file");
-    const std::uint64_t size = std::filesystem::file_size(path, ec);
-    if (ec) throw InputError(path + ": cannot read the file (" + ec.message() + ")");
-    const std::uint64_t limit = limits.maxBytes ? limits.maxBytes : physicalMemoryBytes();
-    if (limit && size > limit)
-        throw InputError(path + ": the file has " + str(size) + " bytes, more than the " + str(limit) + " bytes of memory");
-    std::vector<unsigned char> bytes(size);
-    std::ifstream in(path, std::ios::binary);
-    if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
-        throw InputError(path + ": cannot read the file");
-    return bytes;
+    return readRegularInput(path, limits.maxBytes ? limits.maxBytes : physicalMemoryBytes());
 }
 
 }  // namespace

@@ -9,6 +9,9 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include "core/errors.hpp"
+#include "core/input_file.hpp"
+
 namespace dacrt::gltf {
 namespace {
 
@@ -199,15 +202,11 @@ private:
             bytes = img.image;
         } else if (!img.uri.empty() && source_.readFiles) {
             const std::filesystem::path path = std::filesystem::path(source_.baseDir) / percentDecoded(img.uri);
-            std::ifstream in(path, std::ios::binary);
-            std::error_code ec;
-            const auto size = std::filesystem::file_size(path, ec);
-            if (!in || ec) why = "the file " + path.string() + " cannot be read";
-            else if (size > kMaxTextureBytes) why = "the file is larger than the texture limit";
-            else {
-                fileBytes.resize(std::size_t(size));
-                if (!in.read(reinterpret_cast<char*>(fileBytes.data()), std::streamsize(size))) why = "the file " + path.string() + " cannot be read";
+            try {
+                fileBytes = readRegularInput(path.string(), kMaxTextureBytes);
                 bytes = fileBytes;
+            } catch (const InputError& e) {
+                why = e.what();
             }
         } else {
             why = img.uri.empty() ? "it has no data" : "files named by uri are not read from memory input";

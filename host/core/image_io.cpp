@@ -5,34 +5,48 @@
 #include <cstring>
 #include <limits>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include "core/errors.hpp"
+#include "core/input_file.hpp"
+#include "core/system_memory.hpp"
 
 namespace dacrt {
 namespace {
 
-void writePixels(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format, const void* data) {
+// The file's bytes, encoded in memory by the writer of the path's extension (nothing is written
+// at path).
+std::string encodePixels(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format, const void* data) {
     auto out = OIIO::ImageOutput::create(path);
     if (!out) throw InputError(path + ": cannot write an image here: " + OIIO::geterror());
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput memory(bytes);
+    if (!out->set_ioproxy(&memory))
+        throw InputError(path + ": OpenImageIO's " + out->format_name() + " writer cannot encode into memory");
     if (!out->open(path, spec) || !out->write_image(format, data) || !out->close())
-        throw InputError(path + ": writing failed: " + out->geterror());
+        throw InputError(path + ": encoding the image failed: " + out->geterror());
+    return std::string(bytes.begin(), bytes.end());
 }
 
 }  // namespace
 
 std::string imageWriterProblem(const std::string& path) {
-    if (OIIO::ImageOutput::create(path)) return {};
-    const std::string why = OIIO::geterror();
-    return why.empty() ? "no image writer for this extension" : why;
+    const auto out = OIIO::ImageOutput::create(path);
+    if (!out) {
+        const std::string why = OIIO::geterror();
+        return why.empty() ? "no image writer for this extension" : why;
+    }
+    if (!out->supports("ioproxy")) return std::string("OpenImageIO's ") + out->format_name() + " writer cannot encode into memory";
+    return {};
 }
 
-void writeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
+std::string encodeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
     OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-    writePixels(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+    return encodePixels(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
 }
 
-void writeAov(const std::string& path, const Scene& scene, const HitImage& image, const std::vector<AovChannel>& extra) {
+std::string encodeAov(const std::string& path, const Scene& scene, const HitImage& image, const std::vector<AovChannel>& extra) {
     struct Pixel {
         float z, nx, ny, nz;
         std::uint32_t primId;
@@ -70,13 +84,26 @@ void writeAov(const std::string& path, const Scene& scene, const HitImage& image
     // OpenImageIO stamps the write's wall-clock time (OpenEXR's capDate) when none is given;
     // a fixed one keeps the same frame's file identical bit for bit across runs and shards.
     spec.attribute("DateTime", "1970:01:01 00:00:00");
-    writePixels(path, spec, OIIO::TypeDesc::UNKNOWN, packed.data());
+    return encodePixels(path, spec, OIIO::TypeDesc::UNKNOWN, packed.data());
 }
 
 Aov readAov(const std::string& path) {
+    regularInputSize(path, 0);  // OpenImageIO would wait on a FIFO or read a device without end
     auto in = OIIO::ImageInput::open(path);
     if (!in) throw InputError(path + ": cannot read image: " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
+    // The header's data window is the file's word, not a fact: a few bytes may declare an image
+    // of terabytes. dacrt writes at most 16384 x 16384 pixels (render --size).
+    if (spec.width < 1 || spec.height < 1 || spec.width > 16384 || spec.height > 16384 || spec.nchannels < 1 ||
+        spec.nchannels > 1024)
+        throw InputError(path + ": the header declares " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                         " pixels of " + std::to_string(spec.nchannels) +
+                         " channels; dacrt's AOVs have 1..16384 pixels a side and at most 1024 channels");
+    const std::uint64_t needed = std::uint64_t(spec.width) * std::uint64_t(spec.height) * (12 + std::uint64_t(spec.nchannels)) * 4;
+    if (const std::uint64_t memory = physicalMemoryBytes(); memory && needed > memory)
+        throw InputError(path + ": reading its " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                         " pixels needs " + std::to_string(needed) + " bytes, more than this machine's " +
+                         std::to_string(memory) + " bytes of memory");
     Aov aov;
     aov.width = spec.width;
     aov.height = spec.height;

@@ -9,11 +9,16 @@
 
 namespace dacrt {
 
-// Empty when OpenImageIO has a writer for the path's extension, else why not.
+// Empty when OpenImageIO has a writer for the path's extension that can encode into memory,
+// else why not.
 std::string imageWriterProblem(const std::string& path);
 
-// An 8-bit RGB image, row-major; any format OpenImageIO writes from the extension.
-void writeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb);
+// Images are encoded into memory and their bytes written by an OutputBatch
+// (core/atomic_file.hpp), which checks every step of the write: OpenImageIO's own file
+// writing reports no error for some formats on a full disk.
+
+// An 8-bit RGB image, row-major, in the format OpenImageIO writes for the path's extension.
+std::string encodeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb);
 
 // Multi-channel EXR: Z (ray parameter t, +inf on a miss; directions are unit length),
 // N.X N.Y N.Z (unit geometric normal), primId (exact uint32, 0xFFFFFFFF on a miss),
@@ -24,7 +29,9 @@ struct AovChannel {
     std::string name;
     std::vector<float> values;
 };
-void writeAov(const std::string& path, const Scene& scene, const HitImage& image, const std::vector<AovChannel>& extra = {});
+// The AOVs as an OpenEXR file's bytes.
+std::string encodeAov(const std::string& path, const Scene& scene, const HitImage& image,
+                      const std::vector<AovChannel>& extra = {});
 
 struct Aov {
     int width = 0;
@@ -37,7 +44,7 @@ struct Aov {
     std::vector<AovChannel> extra;  // the float channels after albedo.B, in the file's order
 };
 
-// Reads an AOV written by writeAov; throws InputError on a missing file, a non-image, or
+// Reads an AOV written by encodeAov; throws InputError on a missing file, a non-image, or
 // missing channels.
 Aov readAov(const std::string& path);
 

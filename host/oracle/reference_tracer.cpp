@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "cpu/option_predicates.hpp"
 
@@ -236,21 +237,19 @@ bool readReferenceCache(const std::string& path, const std::string& key, std::si
 
 void writeReferenceCache(const std::string& path, const std::string& key, const std::vector<ReferenceHit>& hits) {
     std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-    const std::string temporary = path + ".tmp" + std::to_string(getpid());  // concurrent runs do not collide
-    {
-        std::ofstream f(temporary, std::ios::binary | std::ios::trunc);
-        const std::uint64_t keySize = key.size(), count = hits.size();
-        f.write(kCacheMagic, 8);
-        f.write(reinterpret_cast<const char*>(&keySize), 8);
-        f.write(key.data(), std::streamsize(keySize));
-        f.write(reinterpret_cast<const char*>(&count), 8);
-        for (const ReferenceHit& h : hits) {
-            f.write(reinterpret_cast<const char*>(&h.t), 8);
-            f.write(reinterpret_cast<const char*>(&h.prim), 4);
-        }
-        if (!f) throw InputError(temporary + ": cannot write the reference cache");
+    std::string bytes;
+    auto append = [&bytes](const void* data, std::size_t size) { bytes.append(static_cast<const char*>(data), size); };
+    const std::uint64_t keySize = key.size(), count = hits.size();
+    bytes.reserve(32 + key.size() + hits.size() * 12);
+    append(kCacheMagic, 8);
+    append(&keySize, 8);
+    append(key.data(), key.size());
+    append(&count, 8);
+    for (const ReferenceHit& h : hits) {
+        append(&h.t, 8);
+        append(&h.prim, 4);
     }
-    std::filesystem::rename(temporary, path);  // readers never see half a file
+    writeFileAtomically(path, bytes);  // readers never see half a file; concurrent runs do not collide
 }
 
 }  // namespace dacrt

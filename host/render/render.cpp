@@ -61,9 +61,9 @@ void checkFrameOptions(const RenderOptions& o) {
 }
 
 // The names' frame patterns: one in each name of a range (so that frames do not overwrite one
-// another), none without a range. Then the usual checks, on the names of the first frame.
+// another), none without a range. The names themselves are checked once the frames are known
+// (checkEveryOutput).
 void checkOutputNames(const RenderOptions& o) {
-    std::vector<PlannedOutput> firstFrame;
     for (PlannedOutput out : namedOutputs(o)) {
         if (out.path.empty()) continue;
         const bool pattern = checkFramePattern(out.option, out.path);
@@ -74,11 +74,7 @@ void checkOutputNames(const RenderOptions& o) {
         if (!o.frames && pattern)
             throw InputError(out.option + " " + out.path + ": a frame number in the name needs a frame range (--frames "
                              "FIRST:LAST); for one instant name the file itself (write %% for a literal percent sign)");
-        out.path = expandFramePattern(out.path, o.frames ? o.frames->first : 0);
-        firstFrame.push_back(out);
     }
-    // With several cameras the files get "_camN" before the extension, in the same folder.
-    checkOutputs(firstFrame, {o.scenePath});
 }
 
 void checkRenderOptions(const RenderOptions& o) {
@@ -156,12 +152,35 @@ FrameFiles filesOf(const RenderOptions& o, const FrameInstant& instant, int came
 }
 
 // Under --skip-existing: every file of the instant is in place. A file has its final name only
-// when complete (AtomicFile), so existing is enough.
+// when complete (OutputBatch), so existing is enough.
 bool outputsExist(const RenderOptions& o, const FrameInstant& instant) {
     for (int k = 0; k < cameraCountOf(o); ++k)
         for (const std::string& path : filesOf(o, instant, k).all())
-            if (!std::filesystem::exists(path)) return false;
+            if (!std::filesystem::is_regular_file(path)) return false;  // a device or FIFO is never done
     return true;
+}
+
+// Every file of every frame of the range (every shard's: their names must not meet either) and
+// every camera, checked before anything is loaded or written: against the input, one another
+// and the file system (app/output_paths.hpp).
+void checkEveryOutput(const RenderOptions& o) {
+    const std::vector<PlannedOutput> named = namedOutputs(o);
+    const std::size_t cameras = std::size_t(cameraCountOf(o));
+    const std::size_t perFrame = cameras * named.size();
+    const std::size_t frames = o.frames ? std::size_t(o.frames->count()) : 1;
+    checkOutputs(
+        frames * perFrame,
+        [&](std::size_t i) {
+            PlannedOutput out = named[i % named.size()];
+            if (out.path.empty()) return out;
+            const std::int64_t frame = o.frames ? o.frames->frameAt(std::int64_t(i / perFrame)) : 0;
+            const int camera = int(i / named.size() % cameras);
+            out.path = pathForCamera(expandFramePattern(out.path, frame), camera, int(cameras));
+            if (o.frames) out.context = "frame " + std::to_string(frame);
+            if (cameras > 1) out.context += (o.frames ? ", camera " : "camera ") + std::to_string(camera);
+            return out;
+        },
+        {o.scenePath});
 }
 
 // A killed run's temporaries of this run's names, removed before anything is written.
@@ -346,29 +365,29 @@ std::vector<AovChannel> visibilityChannels(const Lighting& lighting, std::size_t
     return channels;
 }
 
-// The shade and write stages of one camera, each file complete or absent. Appends the paths
-// written to `written`.
+// The shade and write stages of one camera: each image written to its temporary in `batch`
+// (committed with the stats, all or none). Appends the paths to `staged`.
 void writeImages(const FrameFiles& files, const PreparedScene& p, const HitImage& image, const Lighting& lighting,
-                 const std::vector<std::uint8_t>& shaded, std::vector<std::string>& written) {
+                 const std::vector<std::uint8_t>& shaded, OutputBatch& batch, std::vector<std::string>& staged) {
     auto writeRgb = [&](const std::string& path, const std::vector<std::uint8_t>& rgb) {
-        writeThrough(path, [&](const std::string& to) { writeRgb8(to, image.width, image.height, rgb); });
-        written.push_back(path);
+        batch.add(path, encodeRgb8(encodingNameFor(path, OutputFormat::Image), image.width, image.height, rgb));
+        staged.push_back(path);
     };
     if (!files.output.empty()) writeRgb(files.output, shaded);
     if (!files.aov.empty()) {
         const std::vector<AovChannel> extra = visibilityChannels(lighting, image.hits->size());
-        writeThrough(files.aov, [&](const std::string& to) { writeAov(to, p.scene, image, extra); });
-        written.push_back(files.aov);
+        batch.add(files.aov, encodeAov(encodingNameFor(files.aov, OutputFormat::Exr), p.scene, image, extra));
+        staged.push_back(files.aov);
     }
     if (!files.depthPng.empty()) writeRgb(files.depthPng, depthPreview(image));
     if (!files.normalPng.empty()) writeRgb(files.normalPng, normalPreview(p.scene, image));
 }
 
-void writeStats(const RenderOptions& o, const std::string& path, const RenderedFrame& frame,
-                std::vector<std::string>& written) {
+void writeStats(const RenderOptions& o, const std::string& path, const RenderedFrame& frame, OutputBatch& batch,
+                std::vector<std::string>& staged) {
     if (path.empty()) return;
-    writeFileAtomically(path, renderStatsJson(o, frame).dump(2) + "\n");
-    written.push_back(path);
+    batch.add(path, renderStatsJson(o, frame).dump(2) + "\n");
+    staged.push_back(path);
 }
 
 // What a ray/triangle test costs one thread, measured on the project's 2-core VM (2026-12-01:
@@ -462,7 +481,9 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
         o.outputPath.empty() ? std::vector<std::uint8_t>() : shadedImage(o, p, camera, image, lighting, tracer, samplesMs);
     const FrameFiles files = filesOf(o, instant, k);
     const auto writeStart = Clock::now();
-    writeImages(files, p, image, lighting, shaded, tally.written);
+    OutputBatch batch;  // this camera's files: all or none
+    std::vector<std::string> staged;
+    writeImages(files, p, image, lighting, shaded, batch, staged);
     t.write = msSince(writeStart);
     tally.cameraTraceMs.push_back(t.trace);
     tally.raysPerFrame = frame.rays->size();
@@ -476,7 +497,9 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
         timings.emplace_back(name, ms);
     writeStats(o, files.stats, RenderedFrame{p.scene, camera, k, instant, frame.rays->size(), frame.output.primary,
                                              timings, &frame.output.passes, p.lights, lighting.exposure},
-               tally.written);
+               batch, staged);
+    batch.commit();
+    tally.written.insert(tally.written.end(), staged.begin(), staged.end());
     t.write = msSince(writeStart);  // the stats file too; --stats records the images' write
 
     std::cerr << "dacrt: " << instantLabel(o, instant) << toString(o.tracer.trace.backend) << " camera " << k << ": "
@@ -600,6 +623,7 @@ int runRender(const RenderOptions& o) {
     stopCleanlyOnSignals();  // first: every thread started later inherits the blocked signals
     checkRenderOptions(o);
     const FrameSchedule schedule = scheduleFrames(o);
+    checkEveryOutput(o);
     const LoadedDocument document = loadDocument(o);
     announceSchedule(o, schedule);
     if (schedule.instants.empty()) return kExitSuccess;

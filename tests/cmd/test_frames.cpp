@@ -501,9 +501,12 @@ TEST_P(FramesStopped, WhileTracingLeaveNoFile) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, FramesStopped,
-                         ::testing::Values(StopSignal{SIGTERM, 128 + SIGTERM}, StopSignal{SIGINT, 128 + SIGINT}),
+                         ::testing::Values(StopSignal{SIGTERM, 128 + SIGTERM}, StopSignal{SIGINT, 128 + SIGINT},
+                                           StopSignal{SIGHUP, 128 + SIGHUP}),
                          [](const ::testing::TestParamInfo<StopSignal>& info) {
-                             return std::string(info.param.signal == SIGTERM ? "Sigterm" : "Sigint");
+                             return std::string(info.param.signal == SIGTERM  ? "Sigterm"
+                                                : info.param.signal == SIGINT ? "Sigint"
+                                                                              : "Sighup");
                          });
 
 // Stopped among a range's writes: every file with its final name is complete, no temporary stays.
@@ -527,6 +530,10 @@ TEST(Frames, StoppedWhileWritingLeavesOnlyCompleteFiles) {
             EXPECT_TRUE(bytes.size() > 12 && bytes.compare(bytes.size() - 12, 8, std::string("\0\0\0\0IEND", 8)) == 0)
                 << name << " is not a whole PNG";
         }
+        // A frame's files are renamed into place together: never one without the other.
+        fs::path twin = e.path();
+        twin.replace_extension(e.path().extension() == ".exr" ? ".png" : ".exr");
+        if (e.path().extension() == ".exr" || e.path().extension() == ".png") EXPECT_TRUE(fs::exists(twin)) << name;
     }
 }
 
