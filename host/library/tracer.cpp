@@ -6,6 +6,7 @@
 
 #include <dacrt/errors.hpp>
 
+#include "core/system_memory.hpp"
 #include "core/timing.hpp"
 #include "library/api_results.hpp"
 #include "library/api_state.hpp"
@@ -52,7 +53,12 @@ TraceOutput traced(BackendDispatcher& dispatcher, const BackendRequest& request,
                    const RayBatch::Impl& r, HitQuery query) {
     if (r.rays.empty()) return {};  // nothing to trace (a frame reads its first ray)
     const auto start = Clock::now();
-    const TraceResult result = dispatcher.trace(frameOf(s, r, query), request);
+    // As dacrt render does: a plan larger than this machine's memory is refused before it is allocated.
+    const PlanHook fitsInMemory = [](const MemoryPlan& plan) {
+        checkFitsInMemory("the trace", plan.total(), "trace the rays in smaller batches");
+        return true;
+    };
+    const TraceResult result = dispatcher.trace(frameOf(s, r, query), request, fitsInMemory);
     return traceOutputOf(result, s.callerIds, msSince(start));
 }
 

@@ -252,11 +252,7 @@ PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t r
                       << plan.describe();
             return false;
         }
-        const std::uint64_t limit = physicalMemoryBytes();
-        if (limit && plan.total() > limit)
-            throw InputError("the frame needs " + std::to_string(plan.total()) + " bytes but this machine has " +
-                             std::to_string(limit) + " bytes of memory (over by " +
-                             std::to_string(plan.total() - limit) + " bytes); lower --size or --regions");
+        checkFitsInMemory("the frame", plan.total(), "lower --size or --regions");
         return true;
     };
 }

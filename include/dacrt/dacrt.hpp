@@ -29,6 +29,7 @@
 //                       animations, meshes, materials, extensions), as `dacrt info` prints it
 //   devices.hpp         listDevices: the processor with its SIMD kernels and every Vulkan
 //                       device with its limits, as `dacrt devices` prints them
+//   names.hpp           the command line's names of the backends and face rules, both ways
 //
 // brute, cpu-seq, cpu and gpu return the same primitive id and t, bit for bit, for every ray
 // (docs/correctness.md); embree and rayquery are peers with their own answers. A Tracer opens
@@ -38,6 +39,7 @@
 #include <dacrt/backend_tuning.hpp>
 #include <dacrt/devices.hpp>
 #include <dacrt/errors.hpp>
+#include <dacrt/names.hpp>
 #include <dacrt/options.hpp>
 #include <dacrt/rays.hpp>
 #include <dacrt/results.hpp>

@@ -21,21 +21,12 @@
 namespace dacrt {
 namespace {
 
+using test::expectInputError;
 using test::hitCount;
 using test::onBackend;
 using test::sameHits;
 
 const std::string kRoomScene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
-
-// Throws InputError whose message contains `part`.
-void expectInputError(const std::function<void()>& call, const std::string& part) {
-    try {
-        call();
-        ADD_FAILURE() << "no InputError; expected one naming '" << part << "'";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "message: " << e.what();
-    }
-}
 
 // The meshes as one set of arrays, in the order the loader flattens them (one node per mesh).
 test::SceneArrays arraysOf(const std::vector<Mesh>& meshes) {
