@@ -170,9 +170,9 @@ struct Subcommand {
     std::function<int()> run;
 };
 
-void addDeviceOptions(CLI::App* cmd, DeviceChoice& devices) {
-    cmd->add_option("--device", devices.device, "Vulkan device index or part of its name, see 'dacrt devices' (gpu, rayquery; default: discrete, integrated, then the rest)");
-    cmd->add_flag("--validate", devices.validate, "run under the Vulkan validation layers; errors fail the run with exit 3 (gpu, rayquery)");
+void addDeviceOptions(CLI::App* cmd, std::string& device, bool& validate) {
+    cmd->add_option("--device", device, "Vulkan device index or part of its name, see 'dacrt devices' (gpu, rayquery; default: discrete, integrated, then the rest)");
+    cmd->add_flag("--validate", validate, "run under the Vulkan validation layers; errors fail the run with exit 3 (gpu, rayquery)");
 }
 
 // render's instants and their shards (docs/animation.md): the values as text, parsed by
@@ -248,14 +248,14 @@ Subcommand addRenderCommand(CLI::App& app) {
                     "length of the occlusion rays (default: a tenth of the scene box's diagonal)");
     cmd->add_option("--depth-png", render.depthPngPath, "viewable depth: near bright, far dark, misses black");
     cmd->add_option("--normal-png", render.normalPngPath, "viewable normals: n * 0.5 + 0.5 as RGB, misses black");
-    addEnumOption(cmd, "--backend", render.request.trace.backend, "tracer");
+    addEnumOption(cmd, "--backend", render.tracer.trace.backend, "tracer");
     cmd->add_option("--size", s->size, "image size WIDTHxHEIGHT")->default_str("640x480");
     // The backend-specific options are added bare: describeBackendOptions gives them their help
     // and heading from the table that also refuses them.
-    cmd->add_option("--regions", render.request.trace.regions)->check(CLI::Range(1u, 4096u));
-    cmd->add_option("--threads", render.request.trace.threads)->check(CLI::Range(1u, 1024u));
-    addEnumOption(cmd, "--axis", render.request.trace.axis, "");
-    addDacrtOptions(cmd, render.request.trace.dacrt);
+    cmd->add_option("--regions", render.tracer.trace.regions)->check(CLI::Range(1u, 4096u));
+    cmd->add_option("--threads", render.tracer.trace.threads)->check(CLI::Range(1u, 1024u));
+    addEnumOption(cmd, "--axis", render.tracer.trace.axis, "");
+    addDacrtOptions(cmd, render.tracer.trace.dacrt);
     cmd->add_flag("--embree-fast", s->embreeFast);
     cmd->add_flag("--embree-single-rays", s->embreeSingleRays);
     addCameraOptions(cmd, s->camera);
@@ -264,10 +264,10 @@ Subcommand addRenderCommand(CLI::App& app) {
     cmd->add_flag("--plan", render.planOnly, "print the work plan (what is traced and skipped) and the memory plan, and stop before tracing");
     addEnumOption(cmd, "--cull", render.cull,
                   "back faces no ray hits: the materials' (glTF doubleSided false: culled), none, or every triangle's");
-    addSkipListOption(cmd, render.request.trace.skips);
-    addDeviceOptions(cmd, render.devices);
-    cmd->add_option("--workgroup-size", render.request.gpuTuning.workgroupSize)->check(CLI::Range(1u, 1024u));
-    cmd->add_option("--ray-groups", render.request.gpuTuning.rayGroups)->check(CLI::Range(1u, 64u));
+    addSkipListOption(cmd, render.tracer.trace.skips);
+    addDeviceOptions(cmd, render.tracer.device, render.tracer.validate);
+    cmd->add_option("--workgroup-size", render.tracer.gpu.workgroupSize)->check(CLI::Range(1u, 1024u));
+    cmd->add_option("--ray-groups", render.tracer.gpu.rayGroups)->check(CLI::Range(1u, 64u));
     addFrameOptions(cmd, *s);
     describeBackendOptions(cmd);
     return {cmd, [s, cmd] {
@@ -275,9 +275,9 @@ Subcommand addRenderCommand(CLI::App& app) {
                 applyFrameOptions(*s, r);
                 parseSize(s->size, r.width, r.height);
                 applyCameraOptions(*cmd, s->camera, r.camera);
-                r.request.embree.robust = !s->embreeFast;
-                r.request.embree.packets = !s->embreeSingleRays;
-                r.request.embree.imageWidth = std::uint32_t(r.width);
+                r.tracer.embree.robust = !s->embreeFast;
+                r.tracer.embree.packets = !s->embreeSingleRays;
+                r.tracer.embree.imageWidth = std::uint32_t(r.width);
                 return runRender(r);
             }};
 }
@@ -358,7 +358,7 @@ Subcommand addStressCommand(CLI::App& app) {
     cmd->add_flag("--defaults-only", s->defaultsOnly, "run only each backend's default configuration");
     cmd->add_flag("--no-determinism", s->noDeterminism, "skip the determinism checks");
     cmd->add_option("--json", stress.jsonPath, "write the table and checks as JSON");
-    addDeviceOptions(cmd, s->devices);
+    addDeviceOptions(cmd, s->devices.device, s->devices.validate);
     return {cmd, [s] {
                 s->stress.device = s->devices.device;
                 s->stress.validate = s->devices.validate;
@@ -421,7 +421,7 @@ Subcommand addBenchCommand(CLI::App& app) {
                     "the rows with their time parts (default OUT/bench.json); tools/bench/plot.py draws them");
     cmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
     cmd->add_flag("--no-cache", s->noCache, "always recompute the float64 reference");
-    addDeviceOptions(cmd, bench.devices);
+    addDeviceOptions(cmd, bench.devices.device, bench.devices.validate);
     return {cmd, [s, cmd, light, ao, aoDistance, frames, fps, animation] {
                 if (s->bench.suite != BenchSuite::Passes && (light->count() || ao->count() || aoDistance->count()))
                     throw InputError("--light, --ao and --ao-distance light the frames of --suite passes; the other "

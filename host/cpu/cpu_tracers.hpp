@@ -12,10 +12,6 @@ namespace dacrt {
 // Called now and then, from any thread, with the fraction of the frame done.
 using ProgressHook = std::function<void(double)>;
 
-// What a ray/triangle test costs one thread, measured on the project's 2-core VM (2026-12-01:
-// the Bunny at 80x60, 3.7 s on 2 threads with one busy core elsewhere); for estimates only.
-constexpr double kBruteNanosecondsPerTest = 15.0;
-
 // Every ray against every triangle (threads split the rays).
 TraceResult traceBrute(const FrameGeometry& geometry, ThreadPool& pool, const PlanHook& onPlan = {},
                        const ProgressHook& onProgress = {});

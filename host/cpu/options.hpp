@@ -3,6 +3,7 @@
 // <dacrt/options.hpp>), with one name table each.
 #include <cstdint>
 
+#include <dacrt/backend_tuning.hpp>
 #include <dacrt/options.hpp>
 
 #include "core/enum_names.hpp"
@@ -59,6 +60,13 @@ struct EnumNames<Skip> {
                                                                              {Skip::Frustum, "frustum"},
                                                                              {Skip::Uploads, "uploads"},
                                                                              {Skip::SubScenes, "subscenes"}}};
+};
+
+// The Embree peer's build (public <dacrt/backend_tuning.hpp>), named as the command line gives it:
+template <>
+struct EnumNames<EmbreeBuild> {
+    static constexpr std::array<std::pair<EmbreeBuild, std::string_view>, 3> table{
+        {{EmbreeBuild::Dynamic, "dynamic"}, {EmbreeBuild::Refit, "refit"}, {EmbreeBuild::Static, "static"}}};
 };
 
 }  // namespace dacrt

@@ -10,6 +10,7 @@
 namespace dacrt {
 
 struct PhaseTimes {
+    std::optional<double> bounds;           // the triangles' bounds and the scene's box (dacrt's backends, each frame)
     std::optional<double> makeRays;         // secondary rays made on the host from the primary hits
     std::optional<double> skips;            // the triangle skips (dacrt's backends)
     std::optional<double> allocate;         // ray queries: the structure's buffers
@@ -57,7 +58,8 @@ struct PhaseTimes {
     }
 
 private:
-    static constexpr std::array<std::pair<const char*, Field>, 13> kPhases{{
+    static constexpr std::array<std::pair<const char*, Field>, 14> kPhases{{
+        {"bounds", &PhaseTimes::bounds},
         {"make rays", &PhaseTimes::makeRays},
         {"skips", &PhaseTimes::skips},
         {"allocate", &PhaseTimes::allocate},

@@ -1,10 +1,12 @@
 #include "library/api_results.hpp"
 
+#include <dacrt/plan_text.hpp>
+
 #include "cpu/phase_times.hpp"
 
 namespace dacrt {
 
-static_assert(kNoPrimitive == kMissPrim && kUnnamedPrimitive == kUnnamedHitPrim,
+static_assert(kNoPrimitive == kMissPrim && kUnnamedPrimitive == kUnnamedHitPrim && kNotTracedPrimitive == kNotTracedPrim,
               "the public primitive ids are the kernels' own");
 
 namespace {
@@ -23,6 +25,7 @@ TraceTimings timingsOf(const PhaseTimes& phases, double totalMs) {
     timings.dispatchMs = phases.dispatch.value_or(0.0);
     timings.readbackMs = phases.readback.value_or(0.0);
     timings.traceMs = phases.trace.value_or(0.0);
+    for (const auto& [name, ms] : phases.listed()) timings.phases.push_back({name, ms});
     return timings;
 }
 
@@ -33,8 +36,15 @@ TraceCounters countersOf(const TraceResult& result) {
     c.rayTriangleTests = result.counters.rayTriangleTests;
     c.leaves = result.counters.leaves;
     c.raysCulled = result.counters.raysCulled;
+    c.raysFinishedWithoutHit = result.counters.raysFinishedWithoutHit;
+    c.raysFinishedStep1 = result.counters.finishedStep1;
+    for (std::size_t i = 0; i < result.counters.finishedPerRound.size(); ++i)
+        c.transferRounds.push_back({result.counters.roundNames[i], result.counters.finishedPerRound[i]});
+    c.transferWorkItems = result.counters.transferWorkItems;
+    c.transferWorkItemsSkipped = result.counters.transferWorkItemsSkipped;
     c.threads = result.threads;
     c.regions = result.regions;
+    c.divisionAxis = result.axis;
     if (result.gpu) c.device = result.gpu->device;
     return c;
 }
@@ -43,13 +53,33 @@ std::vector<RayHit> hitsOf(const std::vector<Hit>& hits, const std::vector<std::
     std::vector<RayHit> out;
     out.reserve(hits.size());
     for (const Hit& h : hits) {
-        const bool named = h.prim != kMissPrim && h.prim != kUnnamedHitPrim;
+        const bool named = h.prim != kMissPrim && h.prim != kUnnamedHitPrim && h.prim != kNotTracedPrim;
         out.push_back(RayHit{named && !callerIds.empty() ? callerIds[h.prim] : h.prim, h.t, h.u, h.v});
     }
     return out;
 }
 
+DeviceReport deviceReportOf(const GpuReport& g) {
+    std::vector<DeviceReport::Dispatch> dispatchTimes;
+    for (const auto& [name, ms] : g.dispatchMs) dispatchTimes.push_back({name, ms});
+    return DeviceReport{.device = g.device, .driver = g.driver, .workgroupSize = g.workgroupSize,
+                        .subgroupSize = g.subgroupSize, .rayGroups = g.rayGroups,
+                        .dispatchTimes = std::move(dispatchTimes), .dispatches = g.dispatches,
+                        .workItemsRun = g.workItemsRun, .workItemsEmpty = g.workItemsEmpty, .workItemSlices = g.slices,
+                        .raysFinished = g.raysFinished, .validationErrors = g.validationErrors};
+}
+
 }  // namespace
+
+MemoryPlan memoryPlanOf(const FramePlan& plan) {
+    MemoryPlan out;
+    for (const FramePlan::Buffer& b : plan.memory) out.add(b.name, b.bytes);
+    for (const FramePlan::Work& w : plan.work) out.addWork(w.name, w.count, w.why);
+    return out;
+}
+
+std::string describeMemory(const FramePlan& plan) { return memoryPlanOf(plan).describe(); }
+std::string describeWork(const FramePlan& plan) { return memoryPlanOf(plan).describeWork(); }
 
 FramePlan framePlanOf(const MemoryPlan& plan) {
     FramePlan out;
@@ -64,6 +94,8 @@ TraceOutput traceOutputOf(const TraceResult& result, const std::vector<std::uint
     out.timings = timingsOf(result.phases, totalMs);
     out.counters = countersOf(result);
     out.plan = framePlanOf(result.memory);
+    out.timings.step1RegionMs = result.step1RegionMs;
+    if (result.gpu) out.gpu = deviceReportOf(*result.gpu);
     return out;
 }
 

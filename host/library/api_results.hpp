@@ -17,5 +17,6 @@ namespace dacrt {
 TraceOutput traceOutputOf(const TraceResult& result, const std::vector<std::uint32_t>& callerIds, double totalMs);
 
 FramePlan framePlanOf(const MemoryPlan& plan);
+MemoryPlan memoryPlanOf(const FramePlan& plan);
 
 }  // namespace dacrt

@@ -2,6 +2,7 @@
 // The library's side of the public TraceScene and RayBatch (include/dacrt/): the arrays every
 // backend reads, prepared once.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -15,20 +16,30 @@ namespace dacrt {
 
 struct TraceScene::Impl {
     Scene scene;  // checked (validateScene), its face rule applied
-    std::vector<Bounds> triangleBounds;
+    // The triangles' box, for cameras framing the scene and the peers; dacrt's backends compute
+    // the triangles' bounds and the box anew at each trace, as every frame of a dynamic scene
+    // must (Tracer::Impl::frameBounds).
     Box box;
     // fromArrays where triangles with no area were dropped: the caller's number of each traced
     // triangle. Empty: the traced triangles' indices are the ids.
     std::vector<std::uint32_t> callerIds;
 
     explicit Impl(Scene checked)
-        : scene(std::move(checked)), triangleBounds(allTriangleBounds(scene.triangles)), box(sceneBounds(scene.triangles)) {}
+        : scene(std::move(checked)), box(sceneBounds(scene.triangles)) {}
+    Impl(Scene checked, const Box& sceneBox) : scene(std::move(checked)), box(sceneBox) {}
+
+    // The public scene around a prepared one (the library's own inputs, render_inputs.hpp).
+    static TraceScene wrap(std::unique_ptr<Impl> impl) { return TraceScene(std::move(impl)); }
+    static const Impl& of(const TraceScene& scene) { return *scene.impl_; }
 };
 
 struct RayBatch::Impl {
     std::vector<Ray> rays;
     std::uint32_t imageWidth = 0;        // a camera's: its pixels in a row (0: not an image)
     std::optional<ViewFrustum> frustum;  // a perspective camera's
+
+    static RayBatch wrap(std::unique_ptr<Impl> impl) { return RayBatch(std::move(impl)); }
+    static const Impl& of(const RayBatch& rays) { return *rays.impl_; }
 };
 
 }  // namespace dacrt

@@ -6,22 +6,9 @@
 #include "core/errors.hpp"
 #include "core/lights.hpp"
 #include "core/timing.hpp"
+#include "library/api_results.hpp"
 
 namespace dacrt {
-
-void checkPassOptions(const PassOptions& o) {
-    for (const std::string& light : o.lights) parseLightSpec(light);
-    if (o.occlusionSamples > 1024) throw InputError("--ao " + std::to_string(o.occlusionSamples) + ": at most 1024 rays per hit");
-    if (!std::isfinite(o.occlusionDistance) || o.occlusionDistance < 0.0 || o.occlusionDistance > kMaxCoordinate ||
-        (o.occlusionDistance > 0.0 && o.occlusionDistance < 1e-30))
-        throw InputError("--ao-distance must be a length from 1e-30 to " + std::to_string(kMaxCoordinate) +
-                         " (0: a tenth of the scene's diagonal)");
-}
-
-float occlusionDistance(const PassOptions& o, const Box& box) {
-    if (o.occlusionDistance > 0.0) return float(o.occlusionDistance);
-    return float(0.1 * glm::length(glm::dvec3(box.extent())));
-}
 
 std::vector<SecondaryPass> secondaryPasses(const std::vector<Light>& lights, const PassOptions& o, const Box& box,
                                            std::uint32_t seed) {
@@ -112,19 +99,35 @@ std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& p
     return traced;
 }
 
-Lighting lightingOf(const std::vector<Light>& lights, const std::vector<TracedPass>& traced) {
-    Lighting l;
-    std::size_t shadow = 0;
-    for (const TracedPass& t : traced) {
-        if (t.pass.kind == shared::kPassOcclusion) {
-            l.occlusion = &t.result.hits;
-            l.occlusionSamples = t.pass.raysPerHit;
-        } else {
-            l.lights.push_back(&lights.at(shadow++));
-            l.shadows.push_back(&t.result.hits);
-        }
-    }
-    return l;
+FramePass framePassOf(const SecondaryPass& pass) {
+    const ShadowLight& l = pass.light;
+    const LightKind kind = l.type == shared::kLightPoint
+                               ? LightKind::Point
+                               : (l.type == shared::kLightSpot ? LightKind::Spot : LightKind::Directional);
+    return FramePass{.name = pass.name,
+                     .kind = pass.kind == shared::kPassShadow ? PassKind::Shadow : PassKind::Occlusion,
+                     .light = {kind, {l.position.x, l.position.y, l.position.z},
+                               {l.direction.x, l.direction.y, l.direction.z}, l.range, l.cosOuterSquared},
+                     .raysPerHit = pass.raysPerHit,
+                     .occlusionDistance = pass.occlusionDistance,
+                     .sampleSeed = pass.sampleSeed};
+}
+
+SecondaryPass secondaryPassOf(const FramePass& pass) {
+    SecondaryPass s;
+    s.name = pass.name;
+    s.kind = pass.kind == PassKind::Shadow ? shared::kPassShadow : shared::kPassOcclusion;
+    const PassLight& l = pass.light;
+    s.light.type = l.kind == LightKind::Point ? shared::kLightPoint
+                                              : (l.kind == LightKind::Spot ? shared::kLightSpot : shared::kLightDirectional);
+    s.light.position = {l.position[0], l.position[1], l.position[2]};
+    s.light.direction = {l.direction[0], l.direction[1], l.direction[2]};
+    s.light.range = l.range;
+    s.light.cosOuterSquared = l.cosOuterSquared;
+    s.raysPerHit = pass.raysPerHit;
+    s.occlusionDistance = pass.occlusionDistance;
+    s.sampleSeed = pass.sampleSeed;
+    return s;
 }
 
 MemoryPlan secondaryPassBound(const SecondaryPass& pass, std::uint64_t primaryRays, Backend backend) {
@@ -143,6 +146,10 @@ MemoryPlan secondaryPassBound(const SecondaryPass& pass, std::uint64_t primaryRa
                  std::to_string(primaryRays) + " primary rays x " + std::to_string(pass.raysPerHit) +
                      "; none where the primary ray misses or the surface cannot send one");
     return plan;
+}
+
+FramePlan passPlanBound(const FramePass& pass, std::uint64_t primaryRays, Backend backend) {
+    return framePlanOf(secondaryPassBound(secondaryPassOf(pass), primaryRays, backend));
 }
 
 }  // namespace dacrt

@@ -1,28 +1,18 @@
 #pragma once
-// A frame's secondary passes: which the lights and --ao ask for, traced after the primary
-// pass by the same backend, and the lighting the shade stage takes from them.
+// A frame's secondary passes traced after the primary pass by the same backend, and their
+// public description (include/dacrt/frame.hpp).
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include <dacrt/frame.hpp>
+
+#include "core/lights.hpp"
 #include "library/backend_dispatcher.hpp"
-#include "core/shading.hpp"
+#include "library/pass_options.hpp"
 #include "cpu/secondary_rays.hpp"
 
 namespace dacrt {
-
-// What the command line asks of the secondary passes.
-struct PassOptions {
-    std::vector<std::string> lights;  // --light values; empty: the scene's lights, else a key light
-    std::uint32_t occlusionSamples = 0;  // --ao
-    double occlusionDistance = 0.0;      // --ao-distance; 0: a tenth of the scene box's diagonal
-};
-
-// Throws InputError on a bad --light, --ao or --ao-distance, before anything is loaded.
-void checkPassOptions(const PassOptions& options);
-
-// The occlusion rays' length: --ao-distance, or a tenth of the scene box's diagonal.
-float occlusionDistance(const PassOptions& options, const Box& sceneBox);
 
 // One shadow pass per light, then the occlusion pass (with --ao), in the order their results
 // are shaded. seed picks the occlusion sample sequence (an antialiasing sample's own).
@@ -41,8 +31,9 @@ std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& p
                                              const std::vector<Hit>& primaryHits, BackendDispatcher& backends,
                                              const BackendRequest& request, const PlanHook& onPlan);
 
-// The shade stage's view of the traced passes (which must outlive it).
-Lighting lightingOf(const std::vector<Light>& lights, const std::vector<TracedPass>& traced);
+// The passes as the public API describes them (Tracer::traceFrame), and back.
+SecondaryPass secondaryPassOf(const FramePass& pass);
+FramePass framePassOf(const SecondaryPass& pass);
 
 // What a pass will allocate at most, from the counts alone (--plan: the primary hits that
 // decide how many rays each pass makes are not traced then).

@@ -11,6 +11,7 @@
 #include "library/api_results.hpp"
 #include "library/api_state.hpp"
 #include "library/backend_dispatcher.hpp"
+#include "library/frame_passes.hpp"
 
 namespace dacrt {
 
@@ -18,6 +19,9 @@ struct Tracer::Impl {
     TracerOptions options;
     BackendRequest request;
     BackendDispatcher dispatcher;
+    // The triangles' bounds of the frame being traced (dacrt's backends), their memory reused
+    // from trace to trace.
+    std::vector<Bounds> bounds;
 
     explicit Impl(const TracerOptions& o)
         : options(o),
@@ -39,30 +43,66 @@ struct Tracer::Impl {
 namespace {
 
 // The frame of a batch: a camera's keeps its image width and view frustum (the frustum skip);
-// any-hit rays are traced as a secondary pass's are.
-FrameGeometry frameOf(const TraceScene::Impl& s, const RayBatch::Impl& r, HitQuery query) {
-    FrameGeometry g = query == HitQuery::Any
-                          ? secondaryFrame(s.scene.triangles, s.triangleBounds, r.rays, s.box)
-                          : frameGeometry(s.scene.triangles, s.triangleBounds, r.rays, s.box, r.imageWidth);
+// any-hit rays are traced as a secondary pass's are. dacrt's backends read the triangles'
+// bounds, made here on the trace's threads: dacrt keeps no structure between traces, so each
+// one pays for what a frame of a dynamic scene needs (the peers, which build their own, do not).
+// boundsMs: the time they took (0 for a peer).
+FrameGeometry frameOf(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch::Impl& r, HitQuery query,
+                      double& boundsMs) {
+    const auto start = Clock::now();
+    Box box = s.box;
+    if (isPeer(t.request.trace.backend)) t.bounds.clear();
+    else triangleBoundsInParallel(s.scene.triangles, t.dispatcher.pool(BackendDispatcher::threadsOf(t.request.trace)),
+                                  t.bounds, box);
+    boundsMs = isPeer(t.request.trace.backend) ? 0.0 : msSince(start);
+    FrameGeometry g = query == HitQuery::Any ? secondaryFrame(s.scene.triangles, t.bounds, r.rays, box)
+                                             : frameGeometry(s.scene.triangles, t.bounds, r.rays, box, r.imageWidth);
     if (query == HitQuery::Closest) g.frustum = r.frustum;
     g.trianglesVersion = s.scene.trianglesVersion;
     return g;
 }
 
-TraceOutput traced(BackendDispatcher& dispatcher, const BackendRequest& request, const TraceScene::Impl& s,
-                   const RayBatch::Impl& r, HitQuery query) {
+// The bounds' time as the trace's first phase.
+TraceResult withBoundsPhase(TraceResult result, double boundsMs) {
+    if (boundsMs > 0.0) result.phases.bounds = boundsMs;
+    return result;
+}
+
+TraceOutput traced(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch::Impl& r, HitQuery query) {
     if (r.rays.empty()) return {};  // nothing to trace (a frame reads its first ray)
     const auto start = Clock::now();
+    double boundsMs = 0.0;
+    const FrameGeometry g = frameOf(t, s, r, query, boundsMs);
     // As dacrt render does: a plan larger than this machine's memory is refused before it is allocated.
     const PlanHook fitsInMemory = [](const MemoryPlan& plan) {
         checkFitsInMemory("the trace", plan.total(), "trace the rays in smaller batches");
         return true;
     };
-    const TraceResult result = dispatcher.trace(frameOf(s, r, query), request, fitsInMemory);
+    const TraceResult result = withBoundsPhase(t.dispatcher.trace(g, t.request, fitsInMemory), boundsMs);
     return traceOutputOf(result, s.callerIds, msSince(start));
 }
 
+// The caller's plan callback as the backends call it.
+PlanHook planHookOf(const PlanCallback& onPlan) {
+    if (!onPlan) return {};
+    return [&onPlan](const MemoryPlan& plan) { return onPlan(framePlanOf(plan)); };
+}
+
+std::vector<PassOutput> passOutputsOf(std::vector<TracedPass> traced, const TraceScene::Impl& s) {
+    std::vector<PassOutput> out;
+    for (TracedPass& t : traced)
+        out.push_back({framePassOf(t.pass), traceOutputOf(t.result, s.callerIds, t.ms), t.rays, t.ms});
+    return out;
+}
+
 }  // namespace
+
+void checkTracerOptions(const TracerOptions& options) {
+    Tracer::Impl::checkedRequest(options);
+    Tracer::Impl::checkedDevices(options);
+}
+
+unsigned traceThreads(const TraceOptions& options) { return BackendDispatcher::threadsOf(options); }
 
 Tracer::Tracer(const TracerOptions& options) : impl_(std::make_unique<Impl>(options)) {}
 Tracer::Tracer(Tracer&&) noexcept = default;
@@ -70,11 +110,33 @@ Tracer& Tracer::operator=(Tracer&&) noexcept = default;
 Tracer::~Tracer() = default;
 
 TraceOutput Tracer::trace(const TraceScene& scene, const RayBatch& rays) {
-    return traced(impl_->dispatcher, impl_->request, *scene.impl_, *rays.impl_, HitQuery::Closest);
+    return traced(*impl_, *scene.impl_, *rays.impl_, HitQuery::Closest);
 }
 
 TraceOutput Tracer::occluded(const TraceScene& scene, const RayBatch& rays) {
-    return traced(impl_->dispatcher, impl_->request, *scene.impl_, *rays.impl_, HitQuery::Any);
+    return traced(*impl_, *scene.impl_, *rays.impl_, HitQuery::Any);
+}
+
+FrameOutput Tracer::traceFrame(const TraceScene& scene, const RayBatch& cameraRays, const std::vector<FramePass>& passes,
+                               const PlanCallback& onPlan, const ProgressCallback& onProgress) {
+    FrameOutput out;
+    if (cameraRays.impl_->rays.empty()) return out;
+    const TraceScene::Impl& s = *scene.impl_;
+    const auto start = Clock::now();
+    double boundsMs = 0.0;
+    const FrameGeometry g = frameOf(*impl_, s, *cameraRays.impl_, HitQuery::Closest, boundsMs);
+    BackendRequest request = impl_->request;
+    request.keepForPasses = !passes.empty();  // gpu: the passes start from the device's hits
+    const PlanHook hook = planHookOf(onPlan);
+    const TraceResult primary = withBoundsPhase(impl_->dispatcher.trace(g, request, hook, onProgress), boundsMs);
+    out.stoppedAtPlan = primary.hits.empty();
+    if (out.stoppedAtPlan) return out;
+    out.primary = traceOutputOf(primary, s.callerIds, msSince(start));
+    std::vector<SecondaryPass> secondary;
+    for (const FramePass& pass : passes) secondary.push_back(secondaryPassOf(pass));
+    out.passes = passOutputsOf(traceSecondaryPasses(secondary, g, primary.hits, impl_->dispatcher, request, hook), s);
+    out.stoppedAtPlan = out.passes.size() < passes.size();
+    return out;
 }
 
 FramePlan Tracer::plan(const TraceScene& scene, const RayBatch& rays) {
@@ -86,7 +148,9 @@ FramePlan Tracer::plan(const TraceScene& scene, const RayBatch& rays) {
         planned = p;
         return false;  // stop before anything is traced
     };
-    impl_->dispatcher.trace(frameOf(*scene.impl_, *rays.impl_, HitQuery::Closest), impl_->request, stopAtPlan);
+    double boundsMs = 0.0;
+    impl_->dispatcher.trace(frameOf(*impl_, *scene.impl_, *rays.impl_, HitQuery::Closest, boundsMs), impl_->request,
+                            stopAtPlan);
     if (!planned) throw InternalError("the backend traced without showing its plan first");
     return framePlanOf(*planned);
 }
@@ -110,5 +174,10 @@ std::string Tracer::device() const {
 }
 
 std::uint32_t Tracer::validationErrors() const { return impl_->dispatcher.validationErrors(); }
+
+std::vector<std::string> Tracer::validationMessages() const {
+    const gpu::Context* gpu = impl_->dispatcher.gpuContext();
+    return gpu ? gpu->validationMessages() : std::vector<std::string>();
+}
 
 }  // namespace dacrt

@@ -10,20 +10,12 @@
 
 #include <dacrt/backend_tuning.hpp>
 
-#include "core/enum_names.hpp"
+#include "cpu/options.hpp"  // EmbreeBuild's names
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/trace_result.hpp"
 
 namespace dacrt {
-
-// EmbreeBuild and EmbreeOptions are defined in the public <dacrt/backend_tuning.hpp>; the
-// build's names as the command line gives them:
-template <>
-struct EnumNames<EmbreeBuild> {
-    static constexpr std::array<std::pair<EmbreeBuild, std::string_view>, 3> table{
-        {{EmbreeBuild::Dynamic, "dynamic"}, {EmbreeBuild::Refit, "refit"}, {EmbreeBuild::Static, "static"}}};
-};
 
 // One Embree device (per thread count, for the whole process) and one committed scene over
 // the given triangles, whose vertices Embree reads in place (a shared buffer: the array must

@@ -10,6 +10,9 @@
 #include <iostream>
 #include <sstream>
 
+#include <dacrt/plan_text.hpp>
+#include <dacrt/tracer.hpp>
+
 #include "app/exit_codes.hpp"
 #include "render/frame_pattern.hpp"
 #include "app/interrupt_cleanup.hpp"
@@ -25,6 +28,7 @@
 #include "core/shading.hpp"
 #include "core/system_memory.hpp"
 #include "core/timing.hpp"
+#include "library/render_inputs.hpp"
 
 namespace dacrt {
 namespace {
@@ -80,10 +84,9 @@ void checkOutputNames(const RenderOptions& o) {
 void checkRenderOptions(const RenderOptions& o) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw InputError("--size: width and height must lie in 1..16384");
-    if (o.request.trace.backend == Backend::Embree && o.planOnly)
+    if (o.tracer.trace.backend == Backend::Embree && o.planOnly)
         throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
-    checkBackendRequest(o.request);
-    checkDeviceChoice(o.devices, {o.request.trace.backend});
+    checkTracerOptions(o.tracer);
     checkPassOptions(o.passes);
     checkFrameOptions(o);
     checkOutputNames(o);
@@ -193,9 +196,9 @@ LoadedDocument loadDocument(const RenderOptions& o) {
 // What every camera of the instant shares: the scene at that instant, its bounds, the cameras
 // and the lights (fixed in the world: a key light follows the first camera only).
 struct PreparedScene {
-    Scene scene;
-    std::vector<Bounds> triangleBounds;
-    Box box;
+    TraceScene traced;   // the posed scene, moved into the tracer's input (no copy)
+    const Scene& scene;  // read through it by the shading and the stats
+    const Box& box;      // its triangles'
     std::vector<Camera> cameras;
     std::vector<Light> lights;
     bool headlight = false;
@@ -216,11 +219,12 @@ Scene evaluateAnimation(const RenderOptions& o, const GltfDocument& document, co
     return scene;
 }
 
-PreparedScene prepareFrame(const RenderOptions& o, Scene scene) {
-    PreparedScene p;
-    p.scene = std::move(scene);
-    p.triangleBounds = allTriangleBounds(p.scene.triangles);
-    p.box = sceneBounds(p.scene.triangles);
+PreparedScene prepareFrame(const RenderOptions& o, Scene posed) {
+    const Box box = sceneBounds(posed.triangles);
+    TraceScene traced = adoptScene(std::move(posed), box);
+    const Scene& scene = sceneOf(traced);  // the TraceScene holds it on the heap: moving it keeps these
+    const Box& tracedBox = boxOf(traced);
+    PreparedScene p{std::move(traced), scene, tracedBox};
     p.cameras = makeCameras(p.scene, p.box, o.camera, double(o.width) / double(o.height));
     p.lights = frameLights(p.scene, p.cameras.front(), p.box, o.passes.lights, p.headlight);
     return p;
@@ -228,68 +232,80 @@ PreparedScene prepareFrame(const RenderOptions& o, Scene scene) {
 
 // ---- per camera: trace, shade, write --------------------------------------------------------
 
-// The frame of one camera's rays: the scene's arrays, its view frustum, its triangles' version.
-FrameGeometry cameraFrame(const RenderOptions& o, const PreparedScene& p, const Camera& camera,
-                          const std::vector<Ray>& rays) {
-    FrameGeometry g = frameGeometry(p.scene.triangles, p.triangleBounds, rays, p.box, std::uint32_t(o.width));
-    g.frustum = viewFrustum(camera, o.width, o.height);
-    g.trianglesVersion = p.scene.trianglesVersion;
-    return g;
-}
-
 // Prints the plan and stops the frame under --plan; otherwise refuses a plan that exceeds
 // this machine's memory.
-PlanHook planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t rays, int cameraIndex) {
-    return [&o, &p, rays, cameraIndex](const MemoryPlan& plan) {
+PlanCallback planCheck(const RenderOptions& o, const PreparedScene& p, std::size_t rays, int cameraIndex) {
+    return [&o, &p, rays, cameraIndex](const FramePlan& plan) {
         if (o.planOnly) {
-            const std::string frame = toString(o.request.trace.backend) + ", " + std::to_string(p.scene.triangleCount()) +
+            const std::string frame = toString(o.tracer.trace.backend) + ", " + std::to_string(p.scene.triangleCount()) +
                                       " triangles, " + std::to_string(rays) + " rays" +
                                       (p.cameras.size() > 1 ? ", camera " + std::to_string(cameraIndex) : std::string());
             std::cout << "work plan (" << frame << "):\n"
                       << "  degenerate triangles dropped at load  " << p.scene.degenerateTrianglesDropped
                       << "  (no area: never hit)\n"
-                      << plan.describeWork() << "memory plan (" << frame << "):\n"
-                      << plan.describe();
+                      << describeWork(plan) << "memory plan (" << frame << "):\n"
+                      << describeMemory(plan);
             return false;
         }
-        checkFitsInMemory("the frame", plan.total(), "lower --size or --regions");
+        checkFitsInMemory("the frame", plan.totalBytes(), "lower --size or --regions");
         return true;
     };
 }
 
-// Pipeline compilation within a trace: a cost of the process, not of the frame.
-double compiledMs(const TraceResult& r) {
-    return r.phases.compileMs();
-}
-
-// A traced frame: the primary pass and its secondary passes.
+// A traced frame: the primary pass and its secondary passes, with their hits as the shade
+// stage reads them.
 struct TracedFrame {
-    std::vector<Ray> rays;
-    TraceResult primary;
-    std::vector<TracedPass> passes;
+    RayBatch batch;                  // the primary rays, as the tracer takes them
+    const std::vector<Ray>* rays;    // read through it by the shading
+    FrameOutput output;
+    std::vector<Hit> hits;                   // the primary pass's
+    std::vector<std::vector<Hit>> passHits;  // each secondary pass's, in its order
 };
+
+std::vector<Hit> shadingHits(const std::vector<RayHit>& hits) {
+    std::vector<Hit> out;
+    out.reserve(hits.size());
+    for (const RayHit& h : hits) out.push_back(Hit{h.t, h.primitive, h.u, h.v});
+    return out;
+}
 
 // Traces one sample of a camera's frame: the primary rays through `offset` of each pixel, then
 // the secondary passes from their hits (seed: the occlusion sequence of this sample).
 TracedFrame traceFrame(const RenderOptions& o, const PreparedScene& p, const Camera& camera, glm::dvec2 offset,
-                       std::uint32_t seed, BackendDispatcher& backends, const PlanHook& onPlan, const ProgressHook& onProgress) {
-    TracedFrame f;
-    f.rays = primaryRays(camera, o.width, o.height, offset);
-    const FrameGeometry g = cameraFrame(o, p, camera, f.rays);
-    const std::vector<SecondaryPass> passes = secondaryPasses(p.lights, o.passes, p.box, seed);
-    BackendRequest request = o.request;
-    request.keepForPasses = !passes.empty();
-    f.primary = backends.trace(g, request, onPlan, onProgress);
-    if (f.primary.hits.empty()) return f;  // stopped at the plan
-    f.passes = traceSecondaryPasses(passes, g, f.primary.hits, backends, request, onPlan);
+                       std::uint32_t seed, Tracer& tracer, const PlanCallback& onPlan,
+                       const ProgressCallback& onProgress) {
+    TracedFrame f{adoptCameraRays(primaryRays(camera, o.width, o.height, offset), std::uint32_t(o.width),
+                                  viewFrustum(camera, o.width, o.height)),
+                  nullptr};
+    f.rays = &raysOf(f.batch);
+    f.output = tracer.traceFrame(p.traced, f.batch, framePasses(p.lights, o.passes, p.box, seed), onPlan, onProgress);
+    f.hits = shadingHits(f.output.primary.hits);
+    for (const PassOutput& pass : f.output.passes) f.passHits.push_back(shadingHits(pass.output.hits));
     return f;
+}
+
+// The shade stage's view of the traced passes (which must outlive it).
+Lighting lightingOf(const std::vector<Light>& lights, const TracedFrame& f) {
+    Lighting l;
+    std::size_t shadow = 0;
+    for (std::size_t i = 0; i < f.output.passes.size(); ++i) {
+        const FramePass& pass = f.output.passes[i].pass;
+        if (pass.kind == PassKind::Occlusion) {
+            l.occlusion = &f.passHits[i];
+            l.occlusionSamples = pass.raysPerHit;
+        } else {
+            l.lights.push_back(&lights.at(shadow++));
+            l.shadows.push_back(&f.passHits[i]);
+        }
+    }
+    return l;
 }
 
 // The shaded image: the centre sample alone, or the mean of k x k strata per pixel (the extra
 // samples are traced here, by the same backend, secondary passes included; their time is
 // returned in `samplesMs`). The exposure is the centre sample's.
 std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScene& p, const Camera& camera,
-                                      const HitImage& centre, const Lighting& lighting, BackendDispatcher& backends,
+                                      const HitImage& centre, const Lighting& lighting, Tracer& tracer,
                                       double& samplesMs) {
     samplesMs = 0.0;
     if (o.samplesPerPixel == 1) return shadeImage(p.scene, centre, &lighting);
@@ -299,10 +315,10 @@ std::vector<std::uint8_t> shadedImage(const RenderOptions& o, const PreparedScen
     for (int j = 0; j < k; ++j)
         for (int i = 0; i < k; ++i) {
             const std::uint32_t seed = std::uint32_t(1 + j * k + i);
-            const TracedFrame f = traceFrame(o, p, camera, {(i + 0.5) / k, (j + 0.5) / k}, seed, backends, {}, {});
-            Lighting sample = lightingOf(p.lights, f.passes);
+            const TracedFrame f = traceFrame(o, p, camera, {(i + 0.5) / k, (j + 0.5) / k}, seed, tracer, {}, {});
+            Lighting sample = lightingOf(p.lights, f);
             sample.exposure = lighting.exposure;
-            accumulateShading(p.scene, HitImage{o.width, o.height, &f.rays, &f.primary.hits}, 1.0f / float(k * k), sum,
+            accumulateShading(p.scene, HitImage{o.width, o.height, f.rays, &f.hits}, 1.0f / float(k * k), sum,
                               &sample);
         }
     samplesMs = msSince(start);
@@ -351,6 +367,10 @@ void writeStats(const RenderOptions& o, const std::string& path, const RenderedF
     written.push_back(path);
 }
 
+// What a ray/triangle test costs one thread, measured on the project's 2-core VM (2026-12-01:
+// the Bunny at 80x60, 3.7 s on 2 threads with one busy core elsewhere); for estimates only.
+constexpr double kBruteNanosecondsPerTest = 15.0;
+
 // Brute force's cost grows with triangles times rays: say so before a long frame.
 void announceBruteForce(std::size_t triangles, std::size_t rays, unsigned threads) {
     const double seconds = double(triangles) * double(rays) * kBruteNanosecondsPerTest * 1e-9 / double(threads);
@@ -362,11 +382,11 @@ void announceBruteForce(std::size_t triangles, std::size_t rays, unsigned thread
 // Under --plan: what each secondary pass will allocate at most (how many rays it makes
 // depends on the primary hits, which --plan does not trace).
 void printPassBounds(const RenderOptions& o, const PreparedScene& p, std::size_t primaryRays) {
-    for (const SecondaryPass& pass : secondaryPasses(p.lights, o.passes, p.box, 0)) {
-        const MemoryPlan bound = secondaryPassBound(pass, primaryRays, o.request.trace.backend);
+    for (const FramePass& pass : framePasses(p.lights, o.passes, p.box, 0)) {
+        const FramePlan bound = passPlanBound(pass, primaryRays, o.tracer.trace.backend);
         std::cout << "pass '" << pass.name << "', after the primary pass: work plan:\n"
-                  << bound.describeWork() << "memory plan (at most; plus the buffers of a pass over every triangle):\n"
-                  << bound.describe();
+                  << describeWork(bound) << "memory plan (at most; plus the buffers of a pass over every triangle):\n"
+                  << describeMemory(bound);
     }
 }
 
@@ -401,47 +421,47 @@ std::string instantLabel(const RenderOptions& o, const FrameInstant& instant) {
 // images and the stats. Returns the camera's stage times (evaluate and prepare: the caller's).
 StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, const FrameInstant& instant,
                         double sharedMs, const std::vector<std::pair<std::string, double>>& sharedTimings,
-                        BackendDispatcher& backends, RenderTally& tally) {
+                        Tracer& tracer, RenderTally& tally) {
     StageTimes t;
     const Camera& camera = p.cameras[std::size_t(k)];
     const auto cameraStart = Clock::now();
     const std::size_t pixels = std::size_t(o.width) * std::size_t(o.height);
-    const bool brute = o.request.trace.backend == Backend::Brute;
+    const bool brute = o.tracer.trace.backend == Backend::Brute;
     std::size_t frameRays = pixels;
-    for (const SecondaryPass& pass : secondaryPasses(p.lights, o.passes, p.box, 0)) frameRays += pixels * pass.raysPerHit;
+    for (const FramePass& pass : framePasses(p.lights, o.passes, p.box, 0)) frameRays += pixels * pass.raysPerHit;
     if (brute && !o.planOnly && !tally.bruteAnnounced) {
-        announceBruteForce(p.scene.triangleCount(), frameRays, BackendDispatcher::threadsOf(o.request.trace));
+        announceBruteForce(p.scene.triangleCount(), frameRays, traceThreads(o.tracer.trace));
         tally.bruteAnnounced = true;
     }
     Progress progress("dacrt render", 1);
     const auto traceStart = Clock::now();
-    const TracedFrame frame = traceFrame(o, p, camera, {0.5, 0.5}, 0, backends, planCheck(o, p, pixels, k),
-                                         brute ? ProgressHook([&](double f) { progress.fraction(f, "brute force"); })
-                                               : ProgressHook());
+    const TracedFrame frame = traceFrame(o, p, camera, {0.5, 0.5}, 0, tracer, planCheck(o, p, pixels, k),
+                                         brute ? ProgressCallback([&](double f) { progress.fraction(f, "brute force"); })
+                                               : ProgressCallback());
     if (o.planOnly) {
         printPassBounds(o, p, pixels);
         return t;
     }
     // Pipeline compilation is a cost of the process, not of the frame: reported apart.
-    double compileMs = compiledMs(frame.primary);
-    for (const TracedPass& pass : frame.passes) {
-        t.secondary += pass.ms - compiledMs(pass.result);
-        compileMs += compiledMs(pass.result);
+    double compileMs = frame.output.primary.timings.pipelineCompileMs;
+    for (const PassOutput& pass : frame.output.passes) {
+        t.secondary += pass.ms - pass.output.timings.pipelineCompileMs;
+        compileMs += pass.output.timings.pipelineCompileMs;
     }
     t.trace = msSince(traceStart) - compileMs - t.secondary;  // the primary pass
 
-    const HitImage image{o.width, o.height, &frame.rays, &frame.primary.hits};
-    Lighting lighting = lightingOf(p.lights, frame.passes);
+    const HitImage image{o.width, o.height, frame.rays, &frame.hits};
+    Lighting lighting = lightingOf(p.lights, frame);
     lighting.exposure = autoExposure(p.scene, image, lighting.lights);
     double samplesMs = 0.0;
     const std::vector<std::uint8_t> shaded =
-        o.outputPath.empty() ? std::vector<std::uint8_t>() : shadedImage(o, p, camera, image, lighting, backends, samplesMs);
+        o.outputPath.empty() ? std::vector<std::uint8_t>() : shadedImage(o, p, camera, image, lighting, tracer, samplesMs);
     const FrameFiles files = filesOf(o, instant, k);
     const auto writeStart = Clock::now();
     writeImages(files, p, image, lighting, shaded, tally.written);
     t.write = msSince(writeStart);
     tally.cameraTraceMs.push_back(t.trace);
-    tally.raysPerFrame = frame.rays.size();
+    tally.raysPerFrame = frame.rays->size();
     // The instant's shared stages (load: the first instant's) count in its first camera's total.
     t.total = (k == 0 ? sharedMs : 0.0) + msSince(cameraStart);
 
@@ -450,16 +470,16 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
              {"shader_compile", compileMs}, {"trace", t.trace}, {"secondary_passes", t.secondary},
              {"antialiasing_samples", samplesMs}, {"write", t.write}, {"total", t.total}})
         timings.emplace_back(name, ms);
-    writeStats(o, files.stats, RenderedFrame{p.scene, camera, k, instant, frame.rays.size(), frame.primary, timings,
-                                             &frame.passes, p.lights, lighting.exposure},
+    writeStats(o, files.stats, RenderedFrame{p.scene, camera, k, instant, frame.rays->size(), frame.output.primary,
+                                             timings, &frame.output.passes, p.lights, lighting.exposure},
                tally.written);
     t.write = msSince(writeStart);  // the stats file too; --stats records the images' write
 
-    std::cerr << "dacrt: " << instantLabel(o, instant) << toString(o.request.trace.backend) << " camera " << k << ": "
-              << p.scene.triangleCount() << " triangles, " << frame.rays.size() << " rays";
-    for (const TracedPass& pass : frame.passes) std::cerr << " + " << pass.rays << " " << pass.pass.name;
+    std::cerr << "dacrt: " << instantLabel(o, instant) << toString(o.tracer.trace.backend) << " camera " << k << ": "
+              << p.scene.triangleCount() << " triangles, " << frame.rays->size() << " rays";
+    for (const PassOutput& pass : frame.output.passes) std::cerr << " + " << pass.rays << " " << pass.pass.name;
     std::cerr << ", trace " << t.trace << " ms";
-    if (!frame.passes.empty()) std::cerr << " + " << t.secondary << " ms";
+    if (!frame.output.passes.empty()) std::cerr << " + " << t.secondary << " ms";
     if (instant.frame || o.time)
         std::cerr << "; evaluate_animation " << p.evaluateMs << " ms, prepare " << p.prepareMs << " ms, write "
                   << t.write << " ms, total " << t.total << " ms";
@@ -470,7 +490,7 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
 // One instant, every camera: evaluate the animation, prepare, then each camera's trace, shade
 // and write.
 void renderInstant(const RenderOptions& o, const LoadedDocument& d, const FrameInstant& instant, bool first,
-                   BackendDispatcher& backends, RenderTally& tally) {
+                   Tracer& tracer, RenderTally& tally) {
     const auto evaluateStart = Clock::now();
     Scene scene = evaluateAnimation(o, d.document, instant, first);
     const double evaluateMs = msSince(evaluateStart);
@@ -485,7 +505,7 @@ void renderInstant(const RenderOptions& o, const LoadedDocument& d, const FrameI
     StageTimes frame{p.evaluateMs, p.prepareMs};
     for (int k = 0; k < int(p.cameras.size()); ++k) {
         const StageTimes c =
-            renderCamera(o, p, k, instant, loadMs + p.evaluateMs + p.prepareMs, shared, backends, tally);
+            renderCamera(o, p, k, instant, loadMs + p.evaluateMs + p.prepareMs, shared, tracer, tally);
         frame.trace += c.trace;
         frame.secondary += c.secondary;
         frame.write += c.write;
@@ -496,6 +516,15 @@ void renderInstant(const RenderOptions& o, const LoadedDocument& d, const FrameI
 }
 
 // ---- the last lines -------------------------------------------------------------------------
+
+// Under --validate: every validation message; true when there were errors (the command then
+// fails with its validation exit code).
+bool reportValidationErrors(const RenderOptions& o, const Tracer& tracer) {
+    if (!o.tracer.validate || tracer.validationErrors() == 0) return false;
+    for (const std::string& m : tracer.validationMessages()) std::cerr << "dacrt: validation " << m << "\n";
+    std::cerr << "dacrt: error: " << tracer.validationErrors() << " Vulkan validation errors\n";
+    return true;
+}
 
 // A range's summary: frames rendered and skipped, then each stage's mean, min and max per frame.
 void reportFrames(const RenderOptions& o, const FrameSchedule& s, const RenderTally& tally) {
@@ -536,7 +565,7 @@ void reportRender(const RenderOptions& o, const RenderTally& tally) {
             return;
         }
         std::cerr << "dacrt: traced " << tally.raysPerFrame * traceMs.size() << " rays with "
-                  << toString(o.request.trace.backend)
+                  << toString(o.tracer.trace.backend)
                   << " and wrote nothing: name a shaded image with -o OUT.png, AOVs with --aov OUT.exr, "
                      "stats with --stats OUT.json\n";
         return;
@@ -571,7 +600,7 @@ int runRender(const RenderOptions& o) {
     announceSchedule(o, schedule);
     if (schedule.instants.empty()) return kExitSuccess;
     removeStaleTemporariesOf(o, schedule);
-    BackendDispatcher backends(o.devices, {o.request.trace.backend});
+    Tracer tracer(o.tracer);
 
     RenderTally tally;
     for (const FrameInstant& instant : schedule.instants) {
@@ -580,9 +609,9 @@ int runRender(const RenderOptions& o) {
             std::cerr << "dacrt: " << instantLabel(o, instant) << "skipped, every output exists\n";
             continue;
         }
-        renderInstant(o, document, instant, tally.frameTimes.empty(), backends, tally);
+        renderInstant(o, document, instant, tally.frameTimes.empty(), tracer, tally);
     }
-    const int code = (backends.reportValidationErrors(std::cerr) ? kExitValidation : kExitSuccess);
+    const int code = (reportValidationErrors(o, tracer) ? kExitValidation : kExitSuccess);
     reportFrames(o, schedule, tally);
     if (!o.planOnly) reportRender(o, tally);
     return code;

@@ -4,8 +4,10 @@
 #include <optional>
 #include <string>
 
-#include "library/backend_dispatcher.hpp"
-#include "library/frame_passes.hpp"
+#include <dacrt/tracer.hpp>
+
+#include "cpu/options.hpp"  // the option enums' names
+#include "library/pass_options.hpp"
 #include "render/frame_range.hpp"
 #include "render/frame_shards.hpp"
 #include "core/camera.hpp"
@@ -34,8 +36,7 @@ struct RenderOptions {
     int height = 480;
     bool planOnly = false;    // print the work and memory plans and stop before tracing
     CullMode cull = CullMode::Material;
-    DeviceChoice devices;     // gpu
-    BackendRequest request;
+    TracerOptions tracer;     // the backend and its options, the device (gpu, rayquery)
     CameraOptions camera;
     PassOptions passes;       // lights (shadow passes) and ambient occlusion
 };

@@ -7,32 +7,43 @@ namespace {
 
 nlohmann::ordered_json vec(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
 
-nlohmann::ordered_json countersJson(const Counters& c) {
+nlohmann::ordered_json countersJson(const TraceCounters& c) {
     nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
-    for (std::size_t i = 0; i < c.finishedPerRound.size(); ++i)
-        rounds.push_back({{"round", c.roundNames[i]}, {"terminated", c.finishedPerRound[i]}});
+    for (const TraceCounters::Round& r : c.transferRounds)
+        rounds.push_back({{"round", r.name}, {"terminated", r.raysFinished}});
     return {{"ray_box_tests", c.rayBoxTests},
             {"packet_box_tests", c.packetBoxTests},
             {"ray_triangle_tests", c.rayTriangleTests},
             {"leaves", c.leaves},
             {"rays_retired_without_hit", c.raysFinishedWithoutHit},
             {"rays_culled", c.raysCulled},
-            {"rays_terminated_step1", c.finishedStep1},
+            {"rays_terminated_step1", c.raysFinishedStep1},
             {"rays_terminated_per_round", rounds},
             {"transfer_work_items", c.transferWorkItems},
             {"transfer_work_items_skipped", c.transferWorkItemsSkipped}};
 }
 
-nlohmann::ordered_json memoryJson(const MemoryPlan& plan) {
+nlohmann::ordered_json memoryJson(const FramePlan& plan) {
     nlohmann::ordered_json mem;
-    for (const auto& [name, bytes] : plan.buffers) mem[jsonKey(name)] = bytes;
-    mem["total"] = plan.total();
+    for (const FramePlan::Buffer& b : plan.memory) mem[jsonKey(b.name)] = b.bytes;
+    mem["total"] = plan.totalBytes();
     return mem;
 }
 
-nlohmann::ordered_json gpuJson(const GpuReport& g) {
+nlohmann::ordered_json workJson(const FramePlan& plan, nlohmann::ordered_json work = nlohmann::ordered_json::array()) {
+    for (const FramePlan::Work& w : plan.work) work.push_back({{"name", w.name}, {"count", w.count}, {"why", w.why}});
+    return work;
+}
+
+nlohmann::ordered_json phasesJson(const TraceTimings& timings) {
+    nlohmann::ordered_json phases;
+    for (const TraceTimings::Phase& phase : timings.phases) phases[jsonKey(phase.name)] = phase.ms;
+    return phases;
+}
+
+nlohmann::ordered_json gpuJson(const DeviceReport& g) {
     nlohmann::ordered_json dispatches = nlohmann::ordered_json::array();
-    for (const auto& [name, ms] : g.dispatchMs) dispatches.push_back({{"name", name}, {"gpu_ms", ms}});
+    for (const DeviceReport::Dispatch& d : g.dispatchTimes) dispatches.push_back({{"name", d.name}, {"gpu_ms", d.gpuMs}});
     return {{"device", g.device},
             {"driver", g.driver},
             {"workgroup_size", g.workgroupSize},
@@ -42,7 +53,7 @@ nlohmann::ordered_json gpuJson(const GpuReport& g) {
             {"dispatch_times", dispatches},
             {"work_items_run", g.workItemsRun},
             {"work_items_empty", g.workItemsEmpty},
-            {"work_item_slices", g.slices},
+            {"work_item_slices", g.workItemSlices},
             {"rays_finished", g.raysFinished},
             {"validation_errors", g.validationErrors}};
 }
@@ -56,30 +67,27 @@ nlohmann::ordered_json passesJson(const RenderedFrame& frame, double primaryMs) 
     passes.push_back({{"name", "primary"}, {"rays", frame.rayCount}, {"trace_ms", primaryMs},
                       {"rays_per_second", perSecond(frame.rayCount, primaryMs)}});
     if (!frame.passes) return passes;
-    for (const TracedPass& t : *frame.passes) {
-        nlohmann::ordered_json phases;  // a batched pass's: summed over its batches
-        for (const auto& [name, ms] : t.result.phases.listed()) phases[jsonKey(name)] = ms;
-        const double ms = t.ms - t.result.phases.compileMs();
+    for (const PassOutput& t : *frame.passes) {
+        const TraceOutput& r = t.output;
+        const double ms = t.ms - r.timings.pipelineCompileMs;
         std::uint64_t hits = 0;
-        for (const Hit& h : t.result.hits) hits += h.prim != kMissPrim && h.prim != kNotTracedPrim;
+        for (const RayHit& h : r.hits) hits += h.hit();
         nlohmann::ordered_json p = {{"name", t.pass.name},
-                                    {"kind", t.pass.kind == shared::kPassShadow ? "shadow" : "occlusion"},
-                                    {"slots", t.result.hits.size()},
+                                    {"kind", t.pass.kind == PassKind::Shadow ? "shadow" : "occlusion"},
+                                    {"slots", r.hits.size()},
                                     {"rays", t.rays},
                                     {"rays_hit", hits},
                                     {"trace_ms", ms},
                                     {"rays_per_second", perSecond(t.rays, ms)},
-                                    {"trace_phases", phases},
-                                    {"counters", countersJson(t.result.counters)},
-                                    {"memory_plan_bytes", memoryJson(t.result.memory)}};
-        if (t.pass.kind == shared::kPassOcclusion) {
+                                    {"trace_phases", phasesJson(r.timings)},  // a batched pass's: summed
+                                    {"counters", countersJson(r.counters)},
+                                    {"memory_plan_bytes", memoryJson(r.plan)}};
+        if (t.pass.kind == PassKind::Occlusion) {
             p["rays_per_hit"] = t.pass.raysPerHit;
             p["distance"] = t.pass.occlusionDistance;
         }
-        nlohmann::ordered_json work = nlohmann::ordered_json::array();
-        for (const WorkLine& w : t.result.memory.work) work.push_back({{"name", w.name}, {"count", w.count}, {"why", w.why}});
-        p["work_plan"] = work;
-        if (t.result.gpu) p["gpu"] = gpuJson(*t.result.gpu);
+        p["work_plan"] = workJson(r.plan);
+        if (r.gpu) p["gpu"] = gpuJson(*r.gpu);
         passes.push_back(p);
     }
     return passes;
@@ -102,8 +110,8 @@ nlohmann::ordered_json lightsJson(const RenderedFrame& frame) {
 nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFrame& frame) {
     const Scene& scene = frame.scene;
     const Camera& camera = frame.camera;
-    const TraceResult& r = frame.result;
-    const TraceOptions& trace = o.request.trace;
+    const TraceOutput& r = frame.result;
+    const TraceOptions& trace = o.tracer.trace;
     nlohmann::ordered_json j;
     j["backend"] = toString(trace.backend);
     j["scene"] = o.scenePath;
@@ -115,9 +123,10 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     j["rays"] = frame.rayCount;
     j["width"] = o.width;
     j["height"] = o.height;
-    j["regions"] = r.regions;
-    j["threads"] = r.threads;
-    j["division_axis"] = r.axis < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(std::string(1, "xyz"[r.axis]));
+    j["regions"] = r.counters.regions;
+    j["threads"] = r.counters.threads;
+    const int axis = r.counters.divisionAxis;
+    j["division_axis"] = axis < 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(std::string(1, "xyz"[axis]));
     j["camera"] = {{"index", frame.cameraIndex}, {"projection", toString(camera.projection)}, {"eye", vec(camera.eye)},
                    {"forward", vec(camera.forward)}, {"up", vec(camera.up)}};
     if (camera.projection == Projection::Perspective) j["camera"]["yfov_degrees"] = glm::degrees(camera.yfovRadians);
@@ -135,24 +144,23 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
                     {"skip_uploads", trace.skips.uploads},
                     {"skip_subscenes", trace.skips.subScenes}};
     if (trace.backend == Backend::Embree)
-        j["options"] = {{"robust", o.request.embree.robust}, {"build", toString(o.request.embree.build)},
-                        {"packets", o.request.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
+        j["options"] = {{"robust", o.tracer.embree.robust}, {"build", toString(o.tracer.embree.build)},
+                        {"packets", o.tracer.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
     nlohmann::ordered_json t;
     for (const auto& [name, ms] : frame.timingsMs) t[name] = ms;
-    nlohmann::ordered_json phases;
-    for (const auto& [name, ms] : r.phases.listed()) phases[jsonKey(name)] = ms;
+    const nlohmann::ordered_json phases = phasesJson(r.timings);
     if (!phases.empty()) t["trace_phases"] = phases;
-    if (!r.step1RegionMs.empty()) t["step1_region"] = r.step1RegionMs;
+    if (!r.timings.step1RegionMs.empty()) t["step1_region"] = r.timings.step1RegionMs;
     j["timings_ms"] = t;
-    j["memory_plan_bytes"] = memoryJson(r.memory);
-    nlohmann::ordered_json work = nlohmann::ordered_json::array();
-    work.push_back({{"name", "degenerate triangles dropped at load"}, {"count", frame.scene.degenerateTrianglesDropped},
-                    {"why", "no area: never hit"}});
-    for (const WorkLine& w : r.memory.work) work.push_back({{"name", w.name}, {"count", w.count}, {"why", w.why}});
-    j["work_plan"] = work;
+    j["memory_plan_bytes"] = memoryJson(r.plan);
+    nlohmann::ordered_json dropped = nlohmann::ordered_json::array();
+    dropped.push_back({{"name", "degenerate triangles dropped at load"},
+                       {"count", frame.scene.degenerateTrianglesDropped},
+                       {"why", "no area: never hit"}});
+    j["work_plan"] = workJson(r.plan, dropped);
     j["counters"] = countersJson(r.counters);
     std::uint64_t hits = 0;
-    for (const Hit& h : r.hits) hits += h.prim != kMissPrim;
+    for (const RayHit& h : r.hits) hits += h.hit();
     j["hits"] = hits;
     if (r.gpu) j["gpu"] = gpuJson(*r.gpu);
     double primaryMs = 0.0;

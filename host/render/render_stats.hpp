@@ -8,6 +8,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dacrt/frame.hpp>
+#include <dacrt/results.hpp>
+
 #include "render/render.hpp"
 #include "core/scene.hpp"
 
@@ -19,11 +22,11 @@ struct RenderedFrame {
     int cameraIndex = 0;
     FrameInstant instant;                                   // the frame number (of a range) and its time
     std::size_t rayCount = 0;
-    const TraceResult& result;
+    const TraceOutput& result;  // the primary pass
     // load, evaluate_animation, prepare, shader_compile, trace, secondary_passes,
     // antialiasing_samples, write, total
     std::vector<std::pair<std::string, double>> timingsMs;
-    const std::vector<TracedPass>* passes = nullptr;        // the secondary passes
+    const std::vector<PassOutput>* passes = nullptr;        // the secondary passes
     std::vector<Light> lights;                              // the lights shaded with (none: headlight)
     float exposure = 1.0f;
 };

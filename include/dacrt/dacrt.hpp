@@ -24,7 +24,11 @@
 //   tracer.hpp          Tracer: a backend with its options (options.hpp, backend_tuning.hpp);
 //                       trace() gives each ray's closest hit, occluded() whether anything lies
 //                       on it, plan() the memory and work a trace needs, without tracing
+//                       traceFrame() a camera's frame with its shadow and occlusion passes
+//   frame.hpp           FramePass (a shadow or occlusion pass), FrameOutput, passPlanBound
 //   results.hpp         RayHit (primitive id, t, u, v), TraceTimings, TraceCounters, FramePlan
+//   device_report.hpp   DeviceReport: the gpu's dispatches and work items
+//   plan_text.hpp       a FramePlan as `dacrt render --plan` prints it
 //   errors.hpp          InputError (bad input, with a message naming it), InternalError
 //   scene_info.hpp      describeSceneFile: what a glTF file holds (scenes, cameras, lights,
 //                       animations, meshes, materials, extensions), as `dacrt info` prints it
@@ -39,9 +43,12 @@
 // A TraceScene, RayBatch or Tracer may be used from one thread at a time.
 #include <dacrt/backend_tuning.hpp>
 #include <dacrt/devices.hpp>
+#include <dacrt/device_report.hpp>
 #include <dacrt/errors.hpp>
+#include <dacrt/frame.hpp>
 #include <dacrt/names.hpp>
 #include <dacrt/options.hpp>
+#include <dacrt/plan_text.hpp>
 #include <dacrt/rays.hpp>
 #include <dacrt/results.hpp>
 #include <dacrt/scene.hpp>

@@ -86,4 +86,7 @@ struct TraceOptions {
     DacrtOptions dacrt;
 };
 
+// The threads a trace with these options runs on: 1 for cpu-seq, else `threads` or every core.
+unsigned traceThreads(const TraceOptions& options);
+
 }  // namespace dacrt

@@ -2,8 +2,11 @@
 // What a trace returns: one hit per ray, the time its phases took, what it counted, and the
 // plan of the memory and work it needed.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <dacrt/device_report.hpp>
 
 namespace dacrt {
 
@@ -11,13 +14,15 @@ namespace dacrt {
 inline constexpr std::uint32_t kNoPrimitive = 0xFFFFFFFFu;
 // An any-hit answer that names no triangle (Embree's occlusion query): occluded, by some triangle.
 inline constexpr std::uint32_t kUnnamedPrimitive = 0xFFFFFFFDu;
+// A frame pass's slot that made no ray (its primary ray missed, or its surface cannot send one).
+inline constexpr std::uint32_t kNotTracedPrimitive = 0xFFFFFFFEu;
 
 struct RayHit {
     std::uint32_t primitive = kNoPrimitive;  // the triangle's id in its scene
     float t = 0.0f;  // distance along the ray's unit direction; a miss: the ray's tmax
     float u = 0.0f;  // barycentric weight of the triangle's second vertex
     float v = 0.0f;  // barycentric weight of its third
-    bool hit() const { return primitive != kNoPrimitive; }
+    bool hit() const { return primitive != kNoPrimitive && primitive != kNotTracedPrimitive; }
 };
 
 // Milliseconds, measured on the host. A phase the backend does not have stays 0.
@@ -34,6 +39,13 @@ struct TraceTimings {
     double dispatchMs = 0.0;         // gpu, rayquery: the device's work
     double readbackMs = 0.0;         // gpu, rayquery
     double traceMs = 0.0;            // embree: the rays
+    // The phases run, with the names `dacrt render --stats` gives them, in the order they ran.
+    struct Phase {
+        std::string name;
+        double ms = 0.0;
+    };
+    std::vector<Phase> phases;
+    std::vector<double> step1RegionMs;  // cpu: each region's Step 1 work item, for load balance
 };
 
 // What the trace did. Embree and rayquery count nothing but the threads.
@@ -43,8 +55,18 @@ struct TraceCounters {
     std::uint64_t rayTriangleTests = 0;
     std::uint64_t leaves = 0;
     std::uint64_t raysCulled = 0;        // missed the scene's bounds
+    std::uint64_t raysFinishedWithoutHit = 0;  // cpu: finished early, unable to reach a further region
+    std::uint64_t raysFinishedStep1 = 0;       // in their own region's Step 1 (cpu-seq: every ray)
+    struct Round {
+        std::string name;
+        std::uint64_t raysFinished = 0;
+    };
+    std::vector<Round> transferRounds;   // cpu: the rounds that hand rays on, in execution order
+    std::uint64_t transferWorkItems = 0;
+    std::uint64_t transferWorkItemsSkipped = 0;
     unsigned threads = 1;
     unsigned regions = 1;                // sub-scenes the parallel scheme divided the scene into
+    int divisionAxis = -1;               // the regions' axis: 0 x, 1 y, 2 z; -1 no division
     std::string device;                  // gpu, rayquery: the Vulkan device that traced
 };
 
@@ -74,6 +96,7 @@ struct TraceOutput {
     TraceTimings timings;
     TraceCounters counters;
     FramePlan plan;
+    std::optional<DeviceReport> gpu;  // gpu only
 };
 
 }  // namespace dacrt

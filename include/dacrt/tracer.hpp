@@ -4,8 +4,10 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <dacrt/backend_tuning.hpp>
+#include <dacrt/frame.hpp>
 #include <dacrt/options.hpp>
 #include <dacrt/rays.hpp>
 #include <dacrt/results.hpp>
@@ -20,6 +22,10 @@ struct TracerOptions {
     std::string device;     // gpu, rayquery: a device index or part of its name; empty: the best
     bool validate = false;  // gpu, rayquery: under the Vulkan validation layers (validationErrors())
 };
+
+// The checks the Tracer's constructor makes, without opening a device: a command checks its
+// options before loading anything. Throws InputError as the constructor does.
+void checkTracerOptions(const TracerOptions& options);
 
 class Tracer {
 public:
@@ -40,6 +46,11 @@ public:
     // them (kUnnamedPrimitive, t the ray's tmin).
     TraceOutput occluded(const TraceScene& scene, const RayBatch& rays);
 
+    // A camera's frame (RayBatch::fromCamera) and then its secondary passes from the primary
+    // hits, by the same backend: what `dacrt render` traces. onPlan sees each pass's plan first.
+    FrameOutput traceFrame(const TraceScene& scene, const RayBatch& cameraRays, const std::vector<FramePass>& passes,
+                           const PlanCallback& onPlan = {}, const ProgressCallback& onProgress = {});
+
     // The memory and work plan trace() would follow, without tracing: no ray meets a
     // triangle. The plan depends on more than the counts: the skips and the division into
     // sub-scenes decide it, so their passes over the scene and rays run (as for `dacrt render
@@ -58,9 +69,12 @@ public:
     std::string device() const;
     // Vulkan validation errors so far (with options.validate; 0 otherwise).
     std::uint32_t validationErrors() const;
+    // Their messages, as the validation layers gave them.
+    std::vector<std::string> validationMessages() const;
+
+    struct Impl;  // the library's own
 
 private:
-    struct Impl;
     std::unique_ptr<Impl> impl_;
 };
 

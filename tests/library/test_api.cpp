@@ -23,6 +23,7 @@ namespace {
 
 using test::expectInputError;
 using test::hitCount;
+using test::kRoomScene;
 using test::onBackend;
 using test::sameHits;
 

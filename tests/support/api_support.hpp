@@ -15,6 +15,9 @@
 
 namespace dacrt::test {
 
+// The repository's room, as `dacrt render` renders it by default in the docs.
+inline const std::string kRoomScene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
+
 struct SceneArrays {
     std::vector<float> positions;
     std::vector<std::uint32_t> indices;

@@ -1,0 +1,106 @@
+// The public API's camera frames (Tracer::traceFrame): the primary pass as trace() gives it,
+// then the shadow and occlusion passes from its hits, their plans, and the pass bounds.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include <dacrt/dacrt.hpp>
+
+#include "support/api_support.hpp"
+
+namespace dacrt {
+namespace {
+
+// A point light in the middle of the scene, then ambient occlusion with three rays per hit.
+std::vector<FramePass> lightAndOcclusion(const TraceScene& scene) {
+    const SceneBounds b = scene.bounds();
+    FramePass shadow{.name = "shadow: centre", .kind = PassKind::Shadow};
+    float diagonal = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        shadow.light.position[a] = 0.5f * (b.lo[a] + b.hi[a]);
+        diagonal += (b.hi[a] - b.lo[a]) * (b.hi[a] - b.lo[a]);
+    }
+    FramePass occlusion{.name = "occlusion", .kind = PassKind::Occlusion, .raysPerHit = 3,
+                        .occlusionDistance = 0.1f * std::sqrt(diagonal), .sampleSeed = 1};
+    return {shadow, occlusion};
+}
+
+std::size_t slotsWithRays(const std::vector<RayHit>& hits) {
+    return std::size_t(std::count_if(hits.begin(), hits.end(), [](const RayHit& h) {
+        return h.primitive != kNotTracedPrimitive;
+    }));
+}
+
+TEST(ApiFrame, TracesTheCameraFrameThenItsPasses) {
+    const TraceScene scene = TraceScene::load(test::kRoomScene);
+    const RayBatch rays = RayBatch::fromCamera(scene, {}, 80, 60);
+    const std::vector<FramePass> passes = lightAndOcclusion(scene);
+    Tracer cpu(test::onBackend(Backend::Cpu, 2));
+    const FrameOutput frame = cpu.traceFrame(scene, rays, passes);
+    EXPECT_FALSE(frame.stoppedAtPlan);
+    EXPECT_TRUE(test::sameHits(frame.primary.hits, cpu.trace(scene, rays).hits));
+    ASSERT_EQ(frame.passes.size(), 2u);
+
+    const PassOutput& shadow = frame.passes[0];
+    EXPECT_EQ(shadow.pass.name, "shadow: centre");
+    ASSERT_EQ(shadow.output.hits.size(), rays.size());
+    EXPECT_EQ(shadow.rays, slotsWithRays(shadow.output.hits));
+    EXPECT_GT(shadow.rays, 0u);
+    EXPECT_LE(shadow.rays, test::hitCount(frame.primary.hits));
+    const PassOutput& occlusion = frame.passes[1];
+    ASSERT_EQ(occlusion.output.hits.size(), 3 * rays.size());
+    EXPECT_EQ(occlusion.rays, slotsWithRays(occlusion.output.hits));
+    EXPECT_GT(test::hitCount(occlusion.output.hits), 0u);
+    EXPECT_LT(test::hitCount(occlusion.output.hits), occlusion.rays);
+    EXPECT_FALSE(occlusion.output.plan.work.empty());
+
+    // Every pass is exact: the sequential backend makes and answers the same rays.
+    const FrameOutput sequential = Tracer(test::onBackend(Backend::CpuSeq)).traceFrame(scene, rays, passes);
+    ASSERT_EQ(sequential.passes.size(), 2u);
+    for (std::size_t k = 0; k < 2; ++k) {
+        EXPECT_EQ(sequential.passes[k].rays, frame.passes[k].rays) << k;
+        EXPECT_TRUE(test::sameHits(sequential.passes[k].output.hits, frame.passes[k].output.hits)) << k;
+    }
+}
+
+TEST(ApiFrame, PlanCallbackSeesEachPassAndMayStop) {
+    const TraceScene scene = TraceScene::load(test::kRoomScene);
+    const RayBatch rays = RayBatch::fromCamera(scene, {}, 40, 30);
+    const std::vector<FramePass> passes = lightAndOcclusion(scene);
+    Tracer tracer(test::onBackend(Backend::Cpu, 2));
+    std::vector<std::uint64_t> seen;
+    const auto record = [&seen](bool go) {
+        return [&seen, go](const FramePlan& plan) {
+            seen.push_back(plan.totalBytes());
+            return go;
+        };
+    };
+    const FrameOutput stopped = tracer.traceFrame(scene, rays, passes, record(false));
+    EXPECT_TRUE(stopped.stoppedAtPlan);
+    EXPECT_TRUE(stopped.primary.hits.empty());
+    EXPECT_TRUE(stopped.passes.empty());
+    ASSERT_EQ(seen.size(), 1u);
+    EXPECT_EQ(seen[0], tracer.plan(scene, rays).totalBytes());
+
+    seen.clear();
+    const FrameOutput traced = tracer.traceFrame(scene, rays, passes, record(true));
+    EXPECT_FALSE(traced.stoppedAtPlan);
+    EXPECT_GE(seen.size(), 1 + passes.size());  // a pass may show more than one plan
+    EXPECT_EQ(traced.passes.size(), passes.size());
+}
+
+TEST(ApiFrame, PassBoundCountsEveryPossibleRay) {
+    FramePass occlusion{.name = "occlusion", .kind = PassKind::Occlusion, .raysPerHit = 3, .occlusionDistance = 1.0f};
+    const FramePlan bound = passPlanBound(occlusion, 4800, Backend::Cpu);
+    ASSERT_FALSE(bound.work.empty());
+    EXPECT_EQ(bound.work[0].name, "rays (at most)");
+    EXPECT_EQ(bound.work[0].count, 3u * 4800u);
+    EXPECT_NE(describeWork(bound).find("rays (at most)"), std::string::npos);
+    EXPECT_NE(describeMemory(bound).find("total"), std::string::npos);
+    EXPECT_GT(bound.totalBytes(), 3u * 4800u * 32u);  // a ray alone takes 32 bytes or more
+}
+
+}  // namespace
+}  // namespace dacrt
