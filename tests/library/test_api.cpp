@@ -27,8 +27,6 @@ using test::kRoomScene;
 using test::onBackend;
 using test::sameHits;
 
-const std::string kRoomScene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
-
 // The meshes as one set of arrays, in the order the loader flattens them (one node per mesh).
 test::SceneArrays arraysOf(const std::vector<Mesh>& meshes) {
     test::SceneArrays a;

@@ -19,7 +19,7 @@ using test::expectInputError;
 using test::onBackend;
 using test::sameHits;
 
-const std::string kRoomScene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
+using test::kRoomScene;
 
 // Origins and directions interleaved, six floats per ray.
 std::vector<float> interleaved(const test::RayArrays& r) {
