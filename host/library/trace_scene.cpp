@@ -1,5 +1,6 @@
 // The public TraceScene: a glTF file's scene as `dacrt render` loads it, or triangles from the
 // caller's arrays, checked with messages that name the caller's element.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -7,6 +8,7 @@
 #include <dacrt/results.hpp>
 
 #include "core/gltf_loader.hpp"
+#include "core/system_memory.hpp"
 #include "core/triangle_rules.hpp"
 #include "library/api_state.hpp"
 
@@ -73,6 +75,11 @@ TraceScene TraceScene::load(const std::string& path, const SceneLoadOptions& opt
 TraceScene TraceScene::fromArrays(std::span<const float> positions, std::span<const std::uint32_t> indices,
                                   std::span<const std::uint8_t> singleSided) {
     checkArraySizes(positions.size(), indices.size(), singleSided.size());
+    // What the scene keeps of each triangle: its vertices, bounds, source and caller's id.
+    checkFitsInMemory("a scene of " + std::to_string(indices.size() / 3) + " triangles",
+                      std::uint64_t(indices.size() / 3) *
+                          (sizeof(Triangle) + sizeof(Bounds) + sizeof(TriangleSource) + sizeof(std::uint32_t)),
+                      "trace fewer triangles");
     checkPositions(positions);
     checkIndices(indices, positions.size() / 3);
     Scene scene;
@@ -103,6 +110,38 @@ TraceScene TraceScene::fromArrays(std::span<const float> positions, std::span<co
 std::size_t TraceScene::triangleCount() const { return impl_->scene.triangles.size(); }
 
 std::uint64_t TraceScene::trianglesDropped() const { return impl_->scene.degenerateTrianglesDropped; }
+
+namespace {
+
+// The traced triangle a hit's primitive id names (callerIds: fromArrays's numbering, sorted).
+const Triangle& triangleNamed(const TraceScene::Impl& s, std::uint32_t id) {
+    std::size_t index = id;
+    if (!s.callerIds.empty()) {
+        const auto at = std::lower_bound(s.callerIds.begin(), s.callerIds.end(), id);
+        index = at != s.callerIds.end() && *at == id ? std::size_t(at - s.callerIds.begin()) : s.scene.triangles.size();
+    }
+    if (index >= s.scene.triangles.size())
+        throw InputError("primitive id " + std::to_string(id) + " names no triangle of the scene (" +
+                         std::to_string(s.scene.triangles.size()) + " traced" +
+                         (s.callerIds.empty() ? std::string() : ", numbered as given, those with no area dropped") + ")");
+    return s.scene.triangles[index];
+}
+
+}  // namespace
+
+void TraceScene::geometricNormals(std::span<const std::uint32_t> primitives, std::span<float> normals) const {
+    if (normals.size() != 3 * primitives.size())
+        throw InputError("geometricNormals: " + std::to_string(normals.size()) + " floats for " +
+                         std::to_string(primitives.size()) + " primitive ids (three per id)");
+    for (std::size_t i = 0; i < primitives.size(); ++i) {
+        const std::uint32_t id = primitives[i];
+        const glm::vec3 n = id == kNoPrimitive || id == kUnnamedPrimitive ? glm::vec3(0.0f)
+                                                                          : geometricNormal(triangleNamed(*impl_, id));
+        normals[3 * i] = n.x;
+        normals[3 * i + 1] = n.y;
+        normals[3 * i + 2] = n.z;
+    }
+}
 
 SceneBounds TraceScene::bounds() const {
     const Box& box = impl_->box;

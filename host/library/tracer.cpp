@@ -6,6 +6,7 @@
 
 #include <dacrt/errors.hpp>
 
+#include "core/system_memory.hpp"
 #include "core/timing.hpp"
 #include "library/api_results.hpp"
 #include "library/api_state.hpp"
@@ -72,7 +73,12 @@ TraceOutput traced(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch::I
     const auto start = Clock::now();
     double boundsMs = 0.0;
     const FrameGeometry g = frameOf(t, s, r, query, boundsMs);
-    const TraceResult result = withBoundsPhase(t.dispatcher.trace(g, t.request), boundsMs);
+    // As dacrt render does: a plan larger than this machine's memory is refused before it is allocated.
+    const PlanHook fitsInMemory = [](const MemoryPlan& plan) {
+        checkFitsInMemory("the trace", plan.total(), "trace the rays in smaller batches");
+        return true;
+    };
+    const TraceResult result = withBoundsPhase(t.dispatcher.trace(g, t.request, fitsInMemory), boundsMs);
     return traceOutputOf(result, s.callerIds, msSince(start));
 }
 

@@ -266,11 +266,7 @@ PlanCallback planCheck(const RenderOptions& o, const PreparedScene& p, std::size
                       << describeMemory(plan);
             return false;
         }
-        const std::uint64_t limit = physicalMemoryBytes();
-        if (limit && plan.totalBytes() > limit)
-            throw InputError("the frame needs " + std::to_string(plan.totalBytes()) + " bytes but this machine has " +
-                             std::to_string(limit) + " bytes of memory (over by " +
-                             std::to_string(plan.totalBytes() - limit) + " bytes); lower --size or --regions");
+        checkFitsInMemory("the frame", plan.totalBytes(), "lower --size or --regions");
         return true;
     };
 }

@@ -16,10 +16,11 @@
 // The parts, one header each:
 //   scene.hpp           TraceScene: triangles from a glTF file (scene_options.hpp: which scene,
 //                       when, which camera, which face rule) or from arrays with a single-sided
-//                       flag per triangle
+//                       flag per triangle; the hit triangles' geometric normals
 //   rays.hpp            RayBatch: a camera's rays (as `dacrt render` makes them) or any rays
-//                       with their segments (tmin < t <= tmax), t a distance or in units of
-//                       the direction as given (DirectionLength)
+//                       with their segments (tmin < t <= tmax), origins and directions apart
+//                       or six floats per ray (fromRays), t a distance or in units of the
+//                       direction as given (DirectionLength); writeRays gives them back
 //   tracer.hpp          Tracer: a backend with its options (options.hpp, backend_tuning.hpp);
 //                       trace() gives each ray's closest hit, occluded() whether anything lies
 //                       on it, plan() the memory and work a trace needs, without tracing
@@ -33,6 +34,7 @@
 //                       animations, meshes, materials, extensions), as `dacrt info` prints it
 //   devices.hpp         listDevices: the processor with its SIMD kernels and every Vulkan
 //                       device with its limits, as `dacrt devices` prints them
+//   names.hpp           the command line's names of the backends and face rules, both ways
 //
 // brute, cpu-seq, cpu and gpu return the same primitive id and t, bit for bit, for every ray
 // (docs/correctness.md); embree and rayquery are peers with their own answers. A Tracer opens
@@ -44,6 +46,7 @@
 #include <dacrt/device_report.hpp>
 #include <dacrt/errors.hpp>
 #include <dacrt/frame.hpp>
+#include <dacrt/names.hpp>
 #include <dacrt/options.hpp>
 #include <dacrt/plan_text.hpp>
 #include <dacrt/rays.hpp>

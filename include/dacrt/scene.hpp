@@ -33,8 +33,8 @@ public:
     // that meets the triangle's back face does not hit it; empty: every triangle two-sided.
     // Triangles with no area are dropped (no ray can hit them); the hits keep the caller's
     // numbering (triangle k of `indices` is primitive k). Throws InputError on sizes that do
-    // not match, an index out of range, a coordinate not finite or beyond +-1e9, or no
-    // triangle that can be hit.
+    // not match, an index out of range, a coordinate not finite or beyond +-1e9, no triangle
+    // that can be hit, or more triangles than this machine's memory holds.
     static TraceScene fromArrays(std::span<const float> positions, std::span<const std::uint32_t> indices,
                                  std::span<const std::uint8_t> singleSided = {});
 
@@ -45,6 +45,13 @@ public:
     std::size_t triangleCount() const;          // triangles traced (those with area)
     std::uint64_t trianglesDropped() const;     // triangles with no area, dropped
     SceneBounds bounds() const;                 // of the traced triangles, exact
+
+    // The unit geometric normal of each primitive id as the hits report it (the caller's
+    // numbering), three floats each into `normals` (3 * primitives.size()): cross(v1 - v0,
+    // v2 - v0) normalized, in double precision, as `dacrt render --aov` writes N; (0, 0, 0)
+    // for kNoPrimitive and kUnnamedPrimitive. Throws InputError on another size, or an id that
+    // names no traced triangle (out of range, or dropped for having no area).
+    void geometricNormals(std::span<const std::uint32_t> primitives, std::span<float> normals) const;
 
     struct Impl;  // the library's own
 

@@ -37,7 +37,8 @@ public:
     Tracer& operator=(Tracer&&) noexcept;
     ~Tracer();
 
-    // Each ray's closest hit within its segment.
+    // Each ray's closest hit within its segment. Throws InputError where the trace's plan
+    // exceeds this machine's memory (before it is allocated) or a buffer the device's limits.
     TraceOutput trace(const TraceScene& scene, const RayBatch& rays);
 
     // Whether each ray hits anything within its segment (shadow and occlusion rays): the

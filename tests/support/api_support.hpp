@@ -3,6 +3,7 @@
 // bit for bit.
 #include <bit>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -70,6 +71,16 @@ inline ::testing::AssertionResult sameHits(const std::vector<RayHit>& a, const s
                                                  << " against primitive " << b[i].primitive << " t " << b[i].t;
     }
     return ::testing::AssertionSuccess();
+}
+
+// Expects `call` to throw InputError whose message contains `part`.
+inline void expectInputError(const std::function<void()>& call, const std::string& part) {
+    try {
+        call();
+        ADD_FAILURE() << "no InputError; expected one naming '" << part << "'";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "message: " << e.what();
+    }
 }
 
 inline std::size_t hitCount(const std::vector<RayHit>& hits) {
