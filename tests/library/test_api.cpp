@@ -3,7 +3,6 @@
 // the plan.
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <limits>
 #include <string>
 
@@ -21,20 +20,11 @@
 namespace dacrt {
 namespace {
 
+using test::expectInputError;
 using test::hitCount;
 using test::kRoomScene;
 using test::onBackend;
 using test::sameHits;
-
-// Throws InputError whose message contains `part`.
-void expectInputError(const std::function<void()>& call, const std::string& part) {
-    try {
-        call();
-        ADD_FAILURE() << "no InputError; expected one naming '" << part << "'";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "message: " << e.what();
-    }
-}
 
 // The meshes as one set of arrays, in the order the loader flattens them (one node per mesh).
 test::SceneArrays arraysOf(const std::vector<Mesh>& meshes) {
