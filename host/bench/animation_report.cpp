@@ -222,8 +222,8 @@ std::vector<AnimationSummary> summarizeAnimation(const std::vector<AnimationFram
         if (isPeer(s.config.backend())) {
             s.build = statsOf(frames, [](const AnimationFrameRow& r) { return r.buildMs.value_or(0.0); });
             s.copy = statsOf(frames, [](const AnimationFrameRow& r) { return r.copyMs; });
-            const bool refit = s.config.backend() == Backend::Embree ? s.config.request.embree.build == EmbreeBuild::Refit
-                                                                     : s.config.request.rayQueryBuild == RayQueryBuild::Refit;
+            const bool refit = s.config.backend() == Backend::Embree ? s.config.options.embree.build == EmbreeBuild::Refit
+                                                                     : s.config.options.rayQueryBuild == RayQueryBuild::Refit;
             if (refit) s.initialBuildMs = frames.front().initialBuildMs;
         }
         for (const AnimationFrameRow& r : frames) {
@@ -283,8 +283,7 @@ void printAnimationTables(const BenchCommand& cmd, const std::vector<AnimationSc
 }
 
 void writeAnimationOutputs(const BenchCommand& cmd, const std::vector<AnimationScene>& scenes,
-                           const std::vector<AnimationFrameRow>& rows, const BackendDispatcher& dispatcher,
-                           unsigned hardwareThreads) {
+                           const std::vector<AnimationFrameRow>& rows, const Tracer& tracer, unsigned hardwareThreads) {
     const std::vector<AnimationSummary> summaries = summarizeAnimation(rows);
     std::vector<Json> csv;
     for (const AnimationFrameRow& r : rows) {
@@ -296,7 +295,7 @@ void writeAnimationOutputs(const BenchCommand& cmd, const std::vector<AnimationS
         for (Json& j : summaryCsvRows(s)) csv.push_back(std::move(j));
     writeCsvOf(cmd.csvPath, kCsvColumns, csv);
 
-    Json j = runJson(cmd, dispatcher, hardwareThreads);
+    Json j = runJson(cmd, tracer, hardwareThreads);
     j["scenes"] = Json::array();
     for (const AnimationScene& s : scenes)
         j["scenes"].push_back(Json{{"name", s.name},

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <dacrt/tracer.hpp>
+
 #include "bench/bench.hpp"
 #include "bench/bench_rows.hpp"
 
@@ -41,7 +43,6 @@ void printAnimationTables(const BenchCommand& cmd, const std::vector<AnimationSc
                           const std::vector<AnimationFrameRow>& rows);
 
 void writeAnimationOutputs(const BenchCommand& cmd, const std::vector<AnimationScene>& scenes,
-                           const std::vector<AnimationFrameRow>& rows, const BackendDispatcher& dispatcher,
-                           unsigned hardwareThreads);
+                           const std::vector<AnimationFrameRow>& rows, const Tracer& tracer, unsigned hardwareThreads);
 
 }  // namespace dacrt

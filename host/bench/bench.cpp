@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <dacrt/devices.hpp>
+
 #include "bench/bench_animation.hpp"
 #include "bench/bench_configs.hpp"
 #include "bench/bench_frame.hpp"
@@ -26,8 +28,6 @@
 #include "core/shading.hpp"
 #include "core/timing.hpp"
 #include "oracle/compare.hpp"
-#include "gpu/device_defaults.hpp"
-#include "peers/embree_tracer.hpp"
 
 namespace dacrt {
 namespace {
@@ -84,44 +84,48 @@ std::vector<Backend> withReferenceFirst(const BenchCommand& cmd, std::vector<Bac
     return backends;
 }
 
+// The backends named, or the defaults: cpu-seq, cpu, gpu where a Vulkan device exists, embree
+// (rayquery joins them once the device is open: addRayQuery).
 std::vector<Backend> chooseBackends(const BenchCommand& cmd) {
     if (!cmd.backends.empty()) return withReferenceFirst(cmd, cmd.backends);
     std::vector<Backend> backends = {Backend::CpuSeq, Backend::Cpu};
-    const std::vector<gpu::DeviceInfo> devices = gpu::listDevices();
-    if (!devices.empty())
+    if (!listDevices().vulkan.empty())
         backends.push_back(Backend::Gpu);
     else
         std::cerr << "dacrt bench: no Vulkan device, so no gpu rows (name --backends gpu to make that an error)\n";
-    if (cmd.suite != BenchSuite::Table51) {
-        backends.push_back(Backend::Embree);
-        // The peer on the same device as gpu (the one the dispatcher opens), where that device
-        // has ray query; a --device that matches nothing fails when the dispatcher opens it.
-        bool rayQuery = false;
-        if (!devices.empty()) {
-            try {
-                rayQuery = devices[gpu::chooseDevice(devices, cmd.devices.device)].rayQuery;
-            } catch (const InputError&) {
-            }
-        }
-        if (rayQuery) backends.push_back(Backend::RayQuery);
-        else if (!devices.empty())
-            std::cerr << "dacrt bench: the Vulkan device has no ray query, so no rayquery rows (Mesa >= 24.1 has it)\n";
-    }
+    if (cmd.suite != BenchSuite::Table51) backends.push_back(Backend::Embree);
     return backends;
 }
 
+// The run's one Tracer: on the Vulkan device (--device, --validate) where a backend of the run
+// runs there, so that a missing or unmatched device fails before any long work; else on the CPU
+// alone (the device options then choose nothing, as before the Tracer).
+Tracer openTracer(const BenchCommand& cmd, const std::vector<Backend>& backends) {
+    TracerOptions o;
+    const auto vulkan = std::find_if(backends.begin(), backends.end(), runsOnVulkan);
+    if (vulkan == backends.end()) return Tracer(o);
+    o.trace.backend = *vulkan;
+    o.device = cmd.device;
+    o.validate = cmd.validate;
+    return Tracer(o);
+}
+
+// The default backends' peer on the device gpu opened, where that device has ray query.
+void addRayQuery(const BenchCommand& cmd, const Tracer& tracer, std::vector<Backend>& backends) {
+    if (!cmd.backends.empty() || cmd.suite == BenchSuite::Table51) return;
+    const std::optional<VulkanDeviceProperties> device = tracer.deviceProperties();
+    if (device && device->rayQuery) backends.push_back(Backend::RayQuery);
+    else if (device)
+        std::cerr << "dacrt bench: the Vulkan device has no ray query, so no rayquery rows (Mesa >= 24.1 has it)\n";
+}
+
 std::vector<BenchConfig> chooseConfigs(const BenchCommand& cmd, const std::vector<Backend>& backends,
-                                       const BackendDispatcher& dispatcher, unsigned hardwareThreads) {
-    unsigned gpuDefaultRegions = 16;
-    std::uint32_t gpuDefaultRayGroups = 1;
-    if (const gpu::Context* context = dispatcher.gpuContext()) {
-        gpuDefaultRegions = gpu::defaultGpuRegions(context->info());
-        gpuDefaultRayGroups = gpu::defaultRayGroups(context->info(), gpuDefaultRegions);
-    }
+                                       const Tracer& tracer, unsigned hardwareThreads) {
+    const Tracer::GpuDefaults gpu = tracer.gpuDefaults().value_or(Tracer::GpuDefaults{16, 1});
     std::vector<BenchConfig> configs;
     for (Backend b : backends) {
         const std::vector<BenchConfig> more =
-            cmd.suite == BenchSuite::Sweep    ? sweepConfigs(b, hardwareThreads, gpuDefaultRegions, gpuDefaultRayGroups)
+            cmd.suite == BenchSuite::Sweep    ? sweepConfigs(b, hardwareThreads, gpu.regions, gpu.rayGroups)
             : cmd.suite == BenchSuite::Peers  ? peerConfigs(b, hardwareThreads)
             : cmd.suite == BenchSuite::Skips  ? skipConfigs(b, hardwareThreads)
             : cmd.suite == BenchSuite::Passes ? passesConfigs(b, hardwareThreads)
@@ -140,23 +144,22 @@ struct Accumulator {
     double minSum = 0.0, medianSum = 0.0;
     std::map<std::string, double> partSums;
     std::vector<std::string> partOrder;
-    PeerScenes peers;
     std::vector<double> cameraMs;
-    FrameBuffers buffers;
+    std::vector<Ray> rays;  // the camera rays' memory, kept from frame to frame
 };
 
+// The rows of the scene, each peer's structure built before the frames.
 std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
-                                   BackendDispatcher& dispatcher) {
+                                   BenchRun& run) {
     std::vector<Accumulator> acc(configs.size());
     for (std::size_t c = 0; c < configs.size(); ++c) {
         BenchRow& row = acc[c].row;
         row.scene = s.name;
-        row.triangles = s.scene.triangleCount();
+        row.triangles = s.scene().triangleCount();
         row.raysPerFrame = std::size_t(cmd.width) * std::size_t(cmd.height);
         row.cameras = int(s.cameras.size());
         row.config = configs[c];
-        row.config.request.embree.imageWidth = std::uint32_t(cmd.width);
-        acc[c].peers = makePeerScenes(row.config, s.scene, dispatcher);
+        prepareStructure(run, row.config, s.traced);
     }
     return acc;
 }
@@ -165,27 +168,26 @@ std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd,
 // configuration), so that a slow spell of this shared machine lands on every configuration
 // alike instead of on whichever one happened to run then.
 void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, const std::string& cacheDir,
-                   std::vector<Accumulator>& acc, BackendDispatcher& dispatcher, unsigned hardwareThreads,
-                   Progress& progress) {
+                   std::vector<Accumulator>& acc, BenchRun& run, Progress& progress) {
     progress.stage(s.name + ": camera " + std::to_string(k + 1) + " of " + std::to_string(s.cameras.size()) + ", " +
                    std::to_string(acc.size()) + " configurations");
     progress.step(s.name + " float64 reference, camera " + std::to_string(k));
     const Camera& camera = s.cameras[k];
     const std::vector<Ray> rays = primaryRays(camera, cmd.width, cmd.height);
-    ThreadPool& pool = dispatcher.pool(hardwareThreads);
+    ThreadPool& pool = run.pools.of(run.hardwareThreads);
+    const Scene& scene = s.scene();
     const std::vector<ReferenceHit> reference =
-        cachedReference(s.scene, rays, referenceKey(s.trianglesDigest, rays, camera, cmd.width, cmd.height),
+        cachedReference(scene, rays, referenceKey(s.trianglesDigest, rays, camera, cmd.width, cmd.height),
                         cmd.useCache ? cacheDir : std::string(), pool);
     std::vector<Hit> asHits(rays.size());
     for (std::size_t i = 0; i < rays.size(); ++i) asHits[i] = Hit{float(reference[i].t), reference[i].prim, 0.0f, 0.0f};
-    const std::vector<std::uint8_t> referenceShaded = shadeImage(s.scene, HitImage{cmd.width, cmd.height, &rays, &asHits});
+    const std::vector<std::uint8_t> referenceShaded = shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &asHits});
     const std::size_t frames = s.cameras.size() * std::size_t(cmd.repeat);
     for (int w = 0; w < cmd.warmup + cmd.repeat; ++w) {
         for (Accumulator& a : acc) {
             const BenchConfig& config = a.row.config;
             progress.step(s.name + " " + config.series + " " + config.name + " camera " + std::to_string(k));
-            const FrameOutcome frame =
-                traceFrame(config, s.scene, camera, cmd.width, cmd.height, dispatcher, a.peers, a.buffers);
+            const FrameOutcome frame = traceStillFrame(config, s.traced, camera, cmd.width, cmd.height, run, a.rays);
             settleAfter(config.backend());
             if (w < cmd.warmup) continue;
             a.cameraMs.push_back(frame.ms);
@@ -194,12 +196,12 @@ void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, 
                 a.partSums[name] += ms / double(frames);
             }
             if (w != cmd.warmup) continue;  // every backend is deterministic: one frame's hits stand for all
-            const std::vector<std::uint8_t> shaded =
-                shadeImage(s.scene, HitImage{cmd.width, cmd.height, &rays, &frame.result.hits});
-            a.row.errors.add(measureErrors(s.scene.triangles, s.bounds, rays, reference, frame.result.hits,
-                                           referenceShaded, shaded, pool));
-            a.row.regions = frame.result.regions;
-            a.row.divisionAxis = frame.result.axis;
+            const std::vector<Hit> hits = hitsOf(frame.output.hits);
+            const std::vector<std::uint8_t> shaded = shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &hits});
+            a.row.errors.add(
+                measureErrors(scene.triangles, s.bounds, rays, reference, hits, referenceShaded, shaded, pool));
+            a.row.regions = frame.output.counters.regions;
+            a.row.divisionAxis = frame.output.counters.divisionAxis;
         }
     }
     for (Accumulator& a : acc) {
@@ -221,15 +223,14 @@ void finishRows(std::vector<Accumulator>& acc, std::size_t cameras, std::vector<
 }
 
 void measureScene(const std::string& path, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
-                  BackendDispatcher& dispatcher, unsigned hardwareThreads, std::vector<BenchRow>& rows) {
+                  BenchRun& run, std::vector<BenchRow>& rows) {
     std::vector<std::string> taken;
     for (const BenchRow& r : rows) taken.push_back(r.scene);
     const BenchScene s = loadBenchScene(path, cmd, taken);
-    std::vector<Accumulator> acc = startRows(s, cmd, configs, dispatcher);
+    std::vector<Accumulator> acc = startRows(s, cmd, configs, run);
     Progress progress("dacrt bench", s.cameras.size() * (1 + configs.size() * std::size_t(cmd.warmup + cmd.repeat)));
     const std::string cacheDir = cmd.cacheDir.empty() ? defaultCacheDir() : cmd.cacheDir;
-    for (std::size_t k = 0; k < s.cameras.size(); ++k)
-        measureCamera(s, k, cmd, cacheDir, acc, dispatcher, hardwareThreads, progress);
+    for (std::size_t k = 0; k < s.cameras.size(); ++k) measureCamera(s, k, cmd, cacheDir, acc, run, progress);
     finishRows(acc, s.cameras.size(), rows);
 }
 
@@ -243,9 +244,8 @@ void compareRows(std::vector<BenchRow>& rows) {
     markPareto(rows);
 }
 
-void writeJson(const BenchCommand& cmd, const std::vector<BenchRow>& rows, const BackendDispatcher& dispatcher,
-               unsigned hardwareThreads) {
-    nlohmann::ordered_json j = runJson(cmd, dispatcher, hardwareThreads);
+void writeJson(const BenchCommand& cmd, const std::vector<BenchRow>& rows, const BenchRun& run) {
+    nlohmann::ordered_json j = runJson(cmd, run.tracer, run.hardwareThreads);
     j["near_tie_tolerance_relative"] = kNearTieRelativeDepth;
     j["pareto_time_margin"] = kParetoTimeMargin;
     j["rows"] = nlohmann::ordered_json::array();
@@ -258,23 +258,23 @@ void writeJson(const BenchCommand& cmd, const std::vector<BenchRow>& rows, const
 int runBenchCommand(const BenchCommand& request) {
     const BenchCommand cmd = withOutputs(request);
     checkBenchCommand(cmd);
-    const unsigned hardwareThreads = std::max(1u, std::thread::hardware_concurrency());
-    const std::vector<Backend> backends = chooseBackends(cmd);
-    BackendDispatcher dispatcher(cmd.devices, backends);
-    const std::vector<BenchConfig> configs = chooseConfigs(cmd, backends, dispatcher, hardwareThreads);
-    if (cmd.suite == BenchSuite::Passes) return runPassesSuite(cmd, configs, dispatcher, hardwareThreads);
-    if (cmd.suite == BenchSuite::Animation) return runAnimationSuite(cmd, configs, dispatcher, hardwareThreads);
+    std::vector<Backend> backends = chooseBackends(cmd);
+    BenchRun run{openTracer(cmd, backends), {}, std::max(1u, std::thread::hardware_concurrency())};
+    addRayQuery(cmd, run.tracer, backends);
+    const std::vector<BenchConfig> configs = chooseConfigs(cmd, backends, run.tracer, run.hardwareThreads);
+    if (cmd.suite == BenchSuite::Passes) return runPassesSuite(cmd, configs, run);
+    if (cmd.suite == BenchSuite::Animation) return runAnimationSuite(cmd, configs, run);
 
     std::vector<BenchRow> rows;
-    for (const std::string& path : cmd.scenes) measureScene(path, cmd, configs, dispatcher, hardwareThreads, rows);
+    for (const std::string& path : cmd.scenes) measureScene(path, cmd, configs, run, rows);
     compareRows(rows);
 
     printSummary(rows);
     writeCsv(cmd.csvPath, rows);
-    writeJson(cmd, rows, dispatcher, hardwareThreads);
+    writeJson(cmd, rows, run);
     std::cerr << "dacrt bench: wrote " << cmd.csvPath << " and " << cmd.jsonPath
               << " (plot: python3 tools/bench/plot.py " << cmd.jsonPath << ")\n";
-    return dispatcher.reportValidationErrors(std::cerr) ? kExitValidation : kExitSuccess;
+    return reportValidationErrors(run.tracer, std::cerr) ? kExitValidation : kExitSuccess;
 }
 
 }  // namespace dacrt

@@ -4,10 +4,12 @@
 #include <string>
 #include <vector>
 
-#include "library/backend_dispatcher.hpp"
-#include "render/frame_range.hpp"
-#include "library/frame_passes.hpp"
+#include <dacrt/options.hpp>
+
+#include "core/camera.hpp"
 #include "core/enum_names.hpp"
+#include "library/pass_options.hpp"
+#include "render/frame_range.hpp"
 
 namespace dacrt {
 
@@ -49,7 +51,8 @@ struct BenchCommand {
     std::string jsonPath;
     std::string cacheDir;      // empty: $XDG_CACHE_HOME/dacrt or ~/.cache/dacrt
     bool useCache = true;
-    DeviceChoice devices;      // gpu
+    std::string device;        // gpu, rayquery: --device (index or part of the name; empty: the best)
+    bool validate = false;     // gpu, rayquery: --validate
     // --suite passes: the lights (render's --light) and the occlusion rays per hit (--ao).
     PassOptions passes{.lights = {}, .occlusionSamples = 4, .occlusionDistance = 0.0};
     // --suite animation: frames first..last (--frames, render's syntax), frame n at n / fps

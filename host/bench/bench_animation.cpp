@@ -12,6 +12,7 @@
 #include "bench/animated_frame.hpp"
 #include "bench/animation_report.hpp"
 #include "bench/bench_frame.hpp"
+#include "bench/bench_report.hpp"
 #include "app/exit_codes.hpp"
 #include "app/progress.hpp"
 #include "core/camera.hpp"
@@ -67,7 +68,7 @@ const AnimatedWork& medianRun(const std::vector<AnimatedWork>& runs) {
 }
 
 void measureScene(const std::string& path, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
-                  BackendDispatcher& dispatcher, std::vector<AnimationScene>& scenes, std::vector<AnimationFrameRow>& rows) {
+                  BenchRun& run, std::vector<AnimationScene>& scenes, std::vector<AnimationFrameRow>& rows) {
     const GltfDocument doc = GltfDocument::open(path);
     doc.checkAnimationChoice(cmd.animation.animation);
     AnimationScene info;
@@ -87,21 +88,20 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
     std::vector<std::int64_t> frames;
     for (std::int64_t k = 0; k < cmd.animation.frames.count(); ++k) frames.push_back(cmd.animation.frames.frameAt(k));
     selection.time = timeOfFrame(frames.front(), cmd.animation.fps);
-    const Scene first = doc.scene(selection);
+    Scene first = doc.scene(selection);
     // The view is fixed by the first frame (unless the scene's own camera moves): a default
     // view framing each frame's bounds would follow the motion and hide it.
     const Box firstBox = sceneBounds(first.triangles);
     CameraOptions view = cmd.camera;
     view.orbit = 0;
     const double aspect = double(cmd.width) / double(cmd.height);
-
-    std::vector<std::unique_ptr<AnimatedConfig>> states;
-    for (BenchConfig config : configs) {
-        config.request.embree.imageWidth = std::uint32_t(cmd.width);
-        states.push_back(startAnimatedConfig(config, first.triangles, dispatcher));
-    }
-    Progress progress("dacrt bench", frames.size() * configs.size() * std::size_t(cmd.warmup + cmd.repeat));
     std::size_t previousCount = first.triangleCount();
+    // The scene every configuration traces, each frame's triangles written into it.
+    TraceScene traced = adoptScene(std::move(first), firstBox);
+
+    std::vector<AnimatedConfig> states;
+    for (const BenchConfig& config : configs) states.push_back(startAnimatedConfig(config, traced, run));
+    Progress progress("dacrt bench", frames.size() * configs.size() * std::size_t(cmd.warmup + cmd.repeat));
     const std::size_t raysPerFrame = std::size_t(cmd.width) * std::size_t(cmd.height);
     for (std::size_t i = 0; i < frames.size(); ++i) {
         const std::int64_t f = frames[i];
@@ -132,18 +132,31 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
             const Camera camera = makeCameras(frame, firstBox, view, aspect).front();
             const bool timed = w >= cmd.warmup;
             if (timed) evaluateMs.push_back(evaluated);
+            // In place where the count stays, so that the peers update the structure they keep;
+            // a new scene where the topology changed (in every repeat of the frame: a refit
+            // cannot follow it, so the refit peers build anew, as the frame's one pass would).
+            const auto copyStart = Clock::now();
+            if (topologyChanged) {
+                const Box box = sceneBounds(frame.triangles);
+                traced = adoptScene(std::move(frame), box);
+            } else {
+                replaceScene(traced, std::move(frame));
+            }
+            const double copyMs = msSince(copyStart);
+            const Scene& posed = sceneOf(traced);
             std::vector<Bounds> bounds;  // for the peers' near ties, once per frame
             for (std::size_t c = 0; c < states.size(); ++c) {
-                AnimatedConfig& a = *states[c];
+                AnimatedConfig& a = states[c];
                 progress.step(info.name + " frame " + std::to_string(f) + " " + a.config.series);
-                AnimatedWork work = traceAnimatedFrame(a, frame, camera, cmd.width, cmd.height, topologyChanged, dispatcher);
+                AnimatedWork work =
+                    traceAnimatedFrame(a, traced, camera, cmd.width, cmd.height, topologyChanged, copyMs, run);
                 settleAfter(a.config.backend());
                 if (!timed) continue;
                 if (w == cmd.warmup && c > 0) {  // every backend is deterministic: one run's hits stand for all
                     const bool exact = !isPeer(a.config.backend());
-                    if (!exact && bounds.empty()) bounds = allTriangleBounds(frame.triangles);
-                    checkHits(perConfig[0].runs.front().hits, work.hits, exact, frame, bounds, a.buffers.rays,
-                              dispatcher.pool(a.config.threads()), perConfig[c]);
+                    if (!exact && bounds.empty()) bounds = allTriangleBounds(posed.triangles);
+                    checkHits(perConfig[0].runs.front().hits, work.hits, exact, posed, bounds, a.rays,
+                              run.pools.of(a.config.threads()), perConfig[c]);
                 }
                 perConfig[c].runs.push_back(std::move(work));
             }
@@ -159,7 +172,7 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
             row.timeS = selection.time;
             row.triangles = count;
             row.topologyChanged = topologyChanged;
-            row.config = states[c]->config;
+            row.config = states[c].config;
             row.rays = raysPerFrame;
             row.evaluateMs = evaluate;
             row.prepareMs = m.prepareMs;
@@ -173,7 +186,7 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
             row.nearTies = perConfig[c].nearTies;
             row.realErrors = perConfig[c].realErrors;
             row.exactRequired = !isPeer(row.config.backend());
-            row.initialBuildMs = states[c]->initialBuildMs;
+            row.initialBuildMs = states[c].initialBuildMs;
             rows.push_back(std::move(row));
         }
         previousCount = count;
@@ -183,18 +196,17 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
 
 }  // namespace
 
-int runAnimationSuite(const BenchCommand& cmd, const std::vector<BenchConfig>& configs, BackendDispatcher& dispatcher,
-                      unsigned hardwareThreads) {
+int runAnimationSuite(const BenchCommand& cmd, const std::vector<BenchConfig>& configs, BenchRun& run) {
     if (configs.empty() || configs.front().backend() != Backend::CpuSeq)
         throw InternalError("--suite animation needs cpu-seq's default first: every frame is checked against it");
     std::vector<AnimationScene> scenes;
     std::vector<AnimationFrameRow> rows;
-    for (const std::string& path : cmd.scenes) measureScene(path, cmd, configs, dispatcher, scenes, rows);
+    for (const std::string& path : cmd.scenes) measureScene(path, cmd, configs, run, scenes, rows);
 
     printAnimationTables(cmd, scenes, rows);
-    writeAnimationOutputs(cmd, scenes, rows, dispatcher, hardwareThreads);
+    writeAnimationOutputs(cmd, scenes, rows, run.tracer, run.hardwareThreads);
     std::cerr << "dacrt bench: wrote " << cmd.csvPath << " and " << cmd.jsonPath << "\n";
-    int code = (dispatcher.reportValidationErrors(std::cerr) ? kExitValidation : kExitSuccess);
+    int code = (reportValidationErrors(run.tracer, std::cerr) ? kExitValidation : kExitSuccess);
     for (const AnimationFrameRow& r : rows) {
         if (!r.exactRequired || r.differing == 0) continue;
         std::cerr << "dacrt bench: error: " << r.scene << ", frame " << r.frame << ", " << r.config.series << ": "

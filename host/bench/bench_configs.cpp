@@ -17,21 +17,21 @@ void recordConfig(nlohmann::ordered_json& row, const BenchConfig& c) {
 
 std::string optionText(const BenchConfig& c) {
     std::ostringstream s;
-    if (c.backend() == Backend::RayQuery) return "build=" + toString(c.request.rayQueryBuild);
+    if (c.backend() == Backend::RayQuery) return "build=" + toString(c.options.rayQueryBuild);
     if (c.backend() == Backend::Embree) {
-        s << "build=" << toString(c.request.embree.build) << " robust=" << (c.request.embree.robust ? "on" : "off")
-          << " rays=" << (c.request.embree.packets ? "rtcIntersect16_4x4" : "rtcIntersect1") << " threads=" << c.threads()
-          << " face_filter=" << (c.request.embree.faceFilter ? "on" : "off");
+        s << "build=" << toString(c.options.embree.build) << " robust=" << (c.options.embree.robust ? "on" : "off")
+          << " rays=" << (c.options.embree.packets ? "rtcIntersect16_4x4" : "rtcIntersect1") << " threads=" << c.threads()
+          << " face_filter=" << (c.options.embree.faceFilter ? "on" : "off");
         return s.str();
     }
-    const DacrtOptions d = c.request.trace.dacrt.resolvedFor(c.backend());
+    const DacrtOptions d = c.options.trace.dacrt.resolvedFor(c.backend());
     s << "intersector=" << toString(d.intersector) << " triangle_filter=" << toString(d.triangleFilter)
       << " precision=" << toString(d.precision) << " split=" << toString(d.split) << " ray_limit=" << d.rayLimit
-      << " tri_limit=" << d.triLimit << " axis=" << toString(c.request.trace.axis) << " regions=" << c.request.trace.regions
+      << " tri_limit=" << d.triLimit << " axis=" << toString(c.options.trace.axis) << " regions=" << c.options.trace.regions
       << " threads=" << c.threads();
     if (c.backend() == Backend::Gpu)
-        s << " ray_groups=" << (c.request.gpuTuning.rayGroups ? std::to_string(c.request.gpuTuning.rayGroups) : "auto");
-    const SkipSwitches& k = c.request.trace.skips;
+        s << " ray_groups=" << (c.options.gpu.rayGroups ? std::to_string(c.options.gpu.rayGroups) : "auto");
+    const SkipSwitches& k = c.options.trace.skips;
     if (!(k == SkipSwitches{}))
         s << " no_skip=" << (k.backFaces ? "" : "backfaces,") << (k.frustum ? "" : "frustum,") << (k.uploads ? "" : "uploads,") << (k.subScenes ? "" : "subscenes,");
     return s.str();
@@ -41,8 +41,10 @@ BenchConfig baseConfig(Backend b, unsigned hardwareThreads) {
     BenchConfig c;
     c.series = toString(b);
     c.name = "default";
-    c.request.trace.backend = b;
-    c.request.trace.threads = b == Backend::CpuSeq ? 1u : hardwareThreads;
+    c.options.trace.backend = b;
+    // cpu-seq runs on one thread; the ray queries run on the device, and take no thread count
+    // (they report every core's, as the threads their host work may use).
+    c.options.trace.threads = b == Backend::CpuSeq ? 1u : b == Backend::RayQuery ? 0u : hardwareThreads;
     c.isDefault = true;
     return c;
 }
@@ -63,7 +65,7 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         for (RayQueryBuild build : {RayQueryBuild::Dynamic, RayQueryBuild::Refit, RayQueryBuild::Static}) {
             BenchConfig c = base;
             c.series = "rayquery " + toString(build);
-            c.request.rayQueryBuild = build;
+            c.options.rayQueryBuild = build;
             c.isDefault = build == RayQueryBuild::Dynamic;
             out.push_back(c);
         }
@@ -75,18 +77,18 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         for (EmbreeBuild build : {EmbreeBuild::Dynamic, EmbreeBuild::Refit, EmbreeBuild::Static}) {
             BenchConfig c = base;
             c.series = "embree " + toString(build);
-            c.request.embree.build = build;
+            c.options.embree.build = build;
             c.isDefault = build == EmbreeBuild::Dynamic;
             out.push_back(c);
             c.isDefault = false;
             c.name = "robust=off";
-            c.request.embree.robust = false;
+            c.options.embree.robust = false;
             out.push_back(c);
         }
-        variant("rtcIntersect1", [](BenchConfig& c) { c.request.embree.packets = false; });
+        variant("rtcIntersect1", [](BenchConfig& c) { c.options.embree.packets = false; });
         out.back().series = "embree dynamic";
         // Without the face rule's filter: what a user whose meshes show no back face runs.
-        variant("face-filter=off", [](BenchConfig& c) { c.request.embree.faceFilter = false; });
+        variant("face-filter=off", [](BenchConfig& c) { c.options.embree.faceFilter = false; });
         out.back().series = "embree dynamic";
         return out;
     }
@@ -94,41 +96,41 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
     if (b == Backend::Brute) return out;
     const bool cpu = b == Backend::Cpu || b == Backend::CpuSeq;
     if (cpu) {
-        variant("intersector=moller-trumbore", [](BenchConfig& c) { c.request.trace.dacrt.intersector = Intersector::MollerTrumbore; });
-        variant("triangle-filter=sat", [](BenchConfig& c) { c.request.trace.dacrt.triangleFilter = TriangleFilter::Sat; });
-        variant("triangle-filter=mora", [](BenchConfig& c) { c.request.trace.dacrt.triangleFilter = TriangleFilter::Mora; });
-        variant("precision=f64", [](BenchConfig& c) { c.request.trace.dacrt.precision = Precision::F64; });
-        variant("split=centroid-mean", [](BenchConfig& c) { c.request.trace.dacrt.split = SplitMethod::CentroidMean; });
-        variant("split=sampled-mean", [](BenchConfig& c) { c.request.trace.dacrt.split = SplitMethod::SampledMean; });
+        variant("intersector=moller-trumbore", [](BenchConfig& c) { c.options.trace.dacrt.intersector = Intersector::MollerTrumbore; });
+        variant("triangle-filter=sat", [](BenchConfig& c) { c.options.trace.dacrt.triangleFilter = TriangleFilter::Sat; });
+        variant("triangle-filter=mora", [](BenchConfig& c) { c.options.trace.dacrt.triangleFilter = TriangleFilter::Mora; });
+        variant("precision=f64", [](BenchConfig& c) { c.options.trace.dacrt.precision = Precision::F64; });
+        variant("split=centroid-mean", [](BenchConfig& c) { c.options.trace.dacrt.split = SplitMethod::CentroidMean; });
+        variant("split=sampled-mean", [](BenchConfig& c) { c.options.trace.dacrt.split = SplitMethod::SampledMean; });
     }
-    const DacrtOptions defaults = base.request.trace.dacrt.resolvedFor(b);
+    const DacrtOptions defaults = base.options.trace.dacrt.resolvedFor(b);
     if (cpu) {
-        variant("packets=off", [](BenchConfig& c) { c.request.trace.dacrt.packets = false; });
+        variant("packets=off", [](BenchConfig& c) { c.options.trace.dacrt.packets = false; });
         for (std::uint32_t f : {4u, 64u, 256u})
             if (f != defaults.packetFlush)
-                variant("packet-flush=" + std::to_string(f), [f](BenchConfig& c) { c.request.trace.dacrt.packetFlush = f; });
+                variant("packet-flush=" + std::to_string(f), [f](BenchConfig& c) { c.options.trace.dacrt.packetFlush = f; });
         for (std::uint32_t l : {4u, 8u, 16u, 32u, 64u})
             if (l != defaults.rayLimit)
-                variant("ray-limit=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = l; });
+                variant("ray-limit=" + std::to_string(l), [l](BenchConfig& c) { c.options.trace.dacrt.rayLimit = l; });
         for (std::uint32_t l : {8u, 16u, 32u, 64u, 128u})
             if (l != defaults.triLimit)
-                variant("tri-limit=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.triLimit = l; });
+                variant("tri-limit=" + std::to_string(l), [l](BenchConfig& c) { c.options.trace.dacrt.triLimit = l; });
     } else {
         for (std::uint32_t l : {8u, 16u, 32u, 64u, 128u})
             if (l != defaults.rayLimit)
-                variant("leaf-limits=" + std::to_string(l), [l](BenchConfig& c) { c.request.trace.dacrt.rayLimit = c.request.trace.dacrt.triLimit = l; });
+                variant("leaf-limits=" + std::to_string(l), [l](BenchConfig& c) { c.options.trace.dacrt.rayLimit = c.options.trace.dacrt.triLimit = l; });
     }
     if (b == Backend::CpuSeq) return out;
     const unsigned defaultRegions = b == Backend::Cpu ? hardwareThreads : gpuDefaultRegions;
     for (unsigned r : {1u, 2u, 4u, 8u, 16u, 64u})
         if (r != defaultRegions)
-            variant("regions=" + std::to_string(r), [r](BenchConfig& c) { c.request.trace.regions = r; });
+            variant("regions=" + std::to_string(r), [r](BenchConfig& c) { c.options.trace.regions = r; });
     for (DivisionAxis a : {DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z})
-        variant("axis=" + toString(a), [a](BenchConfig& c) { c.request.trace.axis = a; });
+        variant("axis=" + toString(a), [a](BenchConfig& c) { c.options.trace.axis = a; });
     if (b == Backend::Gpu)
         for (std::uint32_t groups : {1u, 2u, 4u})
             if (groups != gpuDefaultRayGroups)
-                variant("ray-groups=" + std::to_string(groups), [groups](BenchConfig& c) { c.request.gpuTuning.rayGroups = groups; });
+                variant("ray-groups=" + std::to_string(groups), [groups](BenchConfig& c) { c.options.gpu.rayGroups = groups; });
     return out;
 }
 
@@ -137,7 +139,7 @@ std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads) {
         BenchConfig noFilter = baseConfig(b, hardwareThreads);
         noFilter.name = "face-filter=off";
         noFilter.isDefault = false;
-        noFilter.request.embree.faceFilter = false;
+        noFilter.options.embree.faceFilter = false;
         return {baseConfig(b, hardwareThreads), noFilter};
     }
     if (isPeer(b)) return {baseConfig(b, hardwareThreads)};
@@ -146,7 +148,7 @@ std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads) {
         BenchConfig c = out.front();
         c.name = "no-skip=" + name;
         c.isDefault = false;
-        change(c.request.trace.skips);
+        change(c.options.trace.skips);
         out.push_back(c);
     };
     off("backfaces", [](SkipSwitches& s) { s.backFaces = false; });
@@ -170,7 +172,6 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
         return out;
     }
     out.push_back(baseConfig(b, hardwareThreads));
-    out.back().request.keepForPasses = true;
     return out;
 }
 
@@ -178,8 +179,8 @@ std::vector<BenchConfig> animationConfigs(Backend b, unsigned hardwareThreads) {
     std::vector<BenchConfig> out;
     if (!isPeer(b)) return {baseConfig(b, hardwareThreads)};
     for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0)) {
-        const bool staticBuild = b == Backend::Embree ? c.request.embree.build == EmbreeBuild::Static
-                                                      : c.request.rayQueryBuild == RayQueryBuild::Static;
+        const bool staticBuild = b == Backend::Embree ? c.options.embree.build == EmbreeBuild::Static
+                                                      : c.options.rayQueryBuild == RayQueryBuild::Static;
         if (c.name == "default" && !staticBuild) out.push_back(c);
     }
     return out;
@@ -195,9 +196,9 @@ std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads) {
     auto config = [&](unsigned threads, unsigned regions, DivisionAxis axis) {
         BenchConfig c = baseConfig(b, hardwareThreads);
         c.isDefault = false;
-        c.request.trace.threads = b == Backend::Cpu ? threads : hardwareThreads;
-        c.request.trace.regions = regions;
-        c.request.trace.axis = axis;
+        c.options.trace.threads = b == Backend::Cpu ? threads : hardwareThreads;
+        c.options.trace.regions = regions;
+        c.options.trace.axis = axis;
         c.name = (b == Backend::Cpu ? "threads=" + std::to_string(threads) + " " : std::string()) +
                  "regions=" + std::to_string(regions) + " axis=" + toString(axis);
         out.push_back(c);

@@ -33,8 +33,7 @@ std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads);
 std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads);
 
 // passes: each DACRT backend's default and each build mode of the peers (their defaults
-// otherwise), as the peers suite configures them; dacrt's keep the primary pass for the
-// secondary ones (gpu: on the device).
+// otherwise), as the peers suite configures them.
 std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads);
 
 // animation: each DACRT backend's default, and each peer's per-frame modes with their defaults

@@ -11,10 +11,41 @@
 
 namespace dacrt {
 
-void addGpuTimestamps(const TraceResult& r, std::vector<std::pair<std::string, double>>& parts) {
-    if (!r.gpu) return;
+ThreadPool& ThreadPools::of(unsigned threads) {
+    std::unique_ptr<ThreadPool>& p = pools_[threads];
+    if (!p) p = std::make_unique<ThreadPool>(threads);
+    return *p;
+}
+
+void useConfig(Tracer& tracer, const BenchConfig& c) {
+    TracerOptions o = c.options;
+    o.device = tracer.options().device;
+    o.validate = tracer.options().validate;
+    tracer.setOptions(o);
+}
+
+double prepareStructure(BenchRun& run, const BenchConfig& c, const TraceScene& scene) {
+    if (!isPeer(c.backend())) return 0.0;
+    useConfig(run.tracer, c);
+    const std::vector<float> origin = {0.0f, 0.0f, 0.0f}, direction = {0.0f, 0.0f, -1.0f};
+    const RayBatch ray = RayBatch::fromArrays(origin, direction);
+    const auto start = Clock::now();
+    const TraceOutput built = run.tracer.trace(scene, ray);
+    return msSince(start) - built.timings.pipelineCompileMs;
+}
+
+std::vector<Hit> hitsOf(const std::vector<RayHit>& hits) {
+    std::vector<Hit> out;
+    out.reserve(hits.size());
+    for (const RayHit& h : hits) out.push_back(Hit{h.t, h.primitive, h.u, h.v});
+    return out;
+}
+
+void addTraceParts(const TraceOutput& out, std::vector<std::pair<std::string, double>>& parts) {
+    for (const TraceTimings::Phase& p : out.timings.phases) parts.emplace_back(p.name, p.ms);
+    if (!out.gpu) return;
     double gpuMs = 0.0;
-    for (const auto& [name, ms] : r.gpu->dispatchMs) gpuMs += ms;
+    for (const DeviceReport::Dispatch& d : out.gpu->dispatchTimes) gpuMs += d.gpuMs;
     parts.emplace_back("gpu timestamps", gpuMs);
 }
 
@@ -25,83 +56,46 @@ double median(std::vector<double> v) {
 }
 
 BenchScene loadBenchScene(const std::string& path, const BenchCommand& cmd, const std::vector<std::string>& taken) {
-    BenchScene s;
-    s.scene = loadGltf(path);
+    Scene scene = loadGltf(path);
     const std::string stem = std::filesystem::path(path).stem().string();
-    s.name = stem;
-    for (int copy = 2; std::find(taken.begin(), taken.end(), s.name) != taken.end(); ++copy)
-        s.name = stem + "_" + std::to_string(copy);
-    s.bounds = allTriangleBounds(s.scene.triangles);
-    s.box = sceneBounds(s.scene.triangles);
+    std::string name = stem;
+    for (int copy = 2; std::find(taken.begin(), taken.end(), name) != taken.end(); ++copy)
+        name = stem + "_" + std::to_string(copy);
+    const Box box = sceneBounds(scene.triangles);
+    BenchScene s{name, adoptScene(std::move(scene), box), {}, box, {}, {}};
+    const Scene& loaded = s.scene();
+    s.bounds = allTriangleBounds(loaded.triangles);
     CameraOptions orbit = cmd.camera;
     orbit.orbit = cmd.orbit;
-    s.cameras = makeCameras(s.scene, s.box, orbit, double(cmd.width) / double(cmd.height));
-    s.trianglesDigest = digestOf(s.scene.triangles.data(), s.scene.triangles.size() * sizeof(Triangle));
+    s.cameras = makeCameras(loaded, s.box, orbit, double(cmd.width) / double(cmd.height));
+    s.trianglesDigest = digestOf(loaded.triangles.data(), loaded.triangles.size() * sizeof(Triangle));
     return s;
 }
 
-PeerScenes makePeerScenes(const BenchConfig& config, const Scene& scene, BackendDispatcher& dispatcher) {
-    PeerScenes peers;
-    if (config.backend() == Backend::RayQuery) {
-        peers.rayQuery = std::make_unique<RayQueryScene>(*dispatcher.gpuContext(), *dispatcher.pipelines(),
-                                                         scene.triangles, config.request.rayQueryBuild);
-        // A static structure is built once, outside every frame, as Embree's static scene is
-        // (a scene builds at its first trace): without it a run with --warmup 0 would time the
-        // build in the first frame.
-        if (config.request.rayQueryBuild == RayQueryBuild::Static)
-            peers.rayQuery->trace({makeRay(glm::vec3(0.0f), glm::dvec3(0.0, 0.0, -1.0))});
-    }
-    if (config.backend() == Backend::Embree) {
-        EmbreeOptions embree = config.request.embree;
-        embree.threads = config.threads();
-        peers.embree = std::make_unique<EmbreeScene>(scene.triangles, embree);
-    }
-    return peers;
+RayBatch makeCameraRays(const Camera& camera, int width, int height, ThreadPool& pool, std::vector<Ray>& buffer) {
+    primaryRays(camera, width, height, pool, buffer);
+    return adoptCameraRays(std::move(buffer), std::uint32_t(width), viewFrustum(camera, width, height));
 }
 
-// Embree's scenes persist across frames as its users keep them: a dynamic one is rebuilt each
-// frame (vertex buffer updated, committed: a full LOW-quality build into the memory of the last
-// one), a refitted one refitted, a static one left alone. The rays and bounds are computed on
-// the configuration's threads.
-FrameOutcome traceFrame(const BenchConfig& c, const Scene& scene, const Camera& camera, int width, int height,
-                        BackendDispatcher& dispatcher, PeerScenes& peers, FrameBuffers& buffers) {
+// The peers' structures persist across frames inside the Tracer, as their users keep them: a
+// dynamic one is rebuilt each frame (a full LOW-quality build into the memory of the last one),
+// a refitted one refitted, a static one left alone (include/dacrt/tracer.hpp). The rays are
+// made on the configuration's threads; dacrt's backends compute the triangles' bounds within
+// the trace, on its threads.
+FrameOutcome traceStillFrame(const BenchConfig& c, const TraceScene& scene, const Camera& camera, int width, int height,
+                             BenchRun& run, std::vector<Ray>& rayBuffer) {
+    useConfig(run.tracer, c);
     FrameOutcome out;
     const auto start = Clock::now();
-    ThreadPool& pool = dispatcher.pool(c.threads());
-    std::vector<Ray>& rays = buffers.rays;
-    primaryRays(camera, width, height, pool, rays);
-    const bool peer = isPeer(c.backend());
-    // Only dacrt's backends read the frame geometry (bounds, scene box, the scan for a shared
-    // ray start): the peers' frames do not pay for it.
-    if (!peer) {
-        Box box;
-        triangleBoundsInParallel(scene.triangles, pool, buffers.bounds, box);
-        out.geometry = frameGeometry(scene.triangles, buffers.bounds, rays, box, std::uint32_t(width));
-        out.geometry.frustum = viewFrustum(camera, width, height);
-        out.geometry.trianglesVersion = scene.trianglesVersion;  // an orbit: the triangles stay as they are
-    }
-    const double prepareMs = msSince(start);
+    RayBatch rays = makeCameraRays(camera, width, height, run.pools.of(c.threads()), rayBuffer);
+    const double raysMs = msSince(start);
     const auto traceStart = Clock::now();
-    if (peers.rayQuery) {
-        out.result = peers.rayQuery->trace(rays);
-    } else if (peers.embree) {
-        const EmbreeBuild build = c.request.embree.build;
-        const double updateMs = build == EmbreeBuild::Static ? 0.0 : peers.embree->update();
-        out.result = peers.embree->trace(rays, pool);
-        if (build != EmbreeBuild::Static)
-            (build == EmbreeBuild::Refit ? out.result.phases.refit : out.result.phases.build) = updateMs;
-    } else {
-        out.result = dispatcher.trace(out.geometry, c.request);
-    }
+    out.output = run.tracer.trace(scene, rays);
     out.ms = msSince(start);
-    out.parts.emplace_back(peer ? "rays" : "rays and bounds", prepareMs);
+    out.parts.emplace_back("rays", raysMs);
     out.parts.emplace_back("tracer", msSince(traceStart));
-    for (const auto& p : out.result.phases.listed()) out.parts.push_back(p);
-    if (out.result.gpu) {
-        double gpuMs = 0.0;
-        for (const auto& [name, ms] : out.result.gpu->dispatchMs) gpuMs += ms;
-        out.parts.emplace_back("gpu timestamps", gpuMs);
-    }
+    addTraceParts(out.output, out.parts);
+    rayBuffer = releaseRays(std::move(rays));
     return out;
 }
 

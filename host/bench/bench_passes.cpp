@@ -14,13 +14,13 @@
 #include "bench/bench_frame.hpp"
 #include "bench/bench_report.hpp"
 #include "app/exit_codes.hpp"
-#include "library/frame_passes.hpp"
 #include "app/json_keys.hpp"
 #include "app/progress.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "core/lights.hpp"
 #include "core/timing.hpp"
+#include "library/pass_options.hpp"
 
 namespace dacrt {
 namespace {
@@ -30,95 +30,69 @@ struct PassFrame {
     double ms = 0.0;
     std::uint64_t rays = 0;
     std::vector<std::pair<std::string, double>> parts;
-    std::vector<Hit> hits;  // per slot (the primary pass: per pixel)
+    std::vector<RayHit> hits;  // per slot (the primary pass: per pixel)
 };
 
-// A dacrt backend's secondary pass: the dispatcher makes the rays from the primary hits (gpu:
-// on the device, from the primary pass it kept there) and traces them.
-PassFrame dacrtPass(const BenchConfig& c, const FrameOutcome& primary, const SecondaryPass& pass,
-                    BackendDispatcher& dispatcher) {
-    const auto start = Clock::now();
-    BackendDispatcher::PassTrace t = dispatcher.traceSecondary(primary.geometry, primary.result.hits, pass, c.request);
+// A secondary pass of the frame, as traceFrame traced it: its rays made from the primary hits
+// (gpu: on the device, where the primary pass left them; the others on the host, on the
+// configuration's threads) and traced for any hit (Embree: rtcOccluded16 on runs of 16 rays,
+// over the structure the primary pass left; ray queries: terminate on the first hit).
+PassFrame secondaryPassFrame(const BenchConfig& c, PassOutput& pass) {
     PassFrame f;
     // Pipeline compilation within a trace is a cost of the process, not of the pass (render
     // reports it apart too): with --warmup 0 the first frame would otherwise carry it.
-    f.ms = msSince(start) - t.result.phases.compileMs();
-    f.rays = t.rays;
-    f.parts = t.result.phases.listed();
-    addGpuTimestamps(t.result, f.parts);
-    f.hits = std::move(t.result.hits);
-    return f;
-}
-
-// A peer's secondary pass as its users make one: the rays made on the host from its own
-// primary hits (on the configuration's threads, as cpu makes them), traced for occlusion in
-// the scene the primary pass left (Embree: rtcOccluded16 on runs of 16 rays; ray queries:
-// terminate on the first hit).
-PassFrame peerPass(const BenchConfig& c, const Scene& scene, const std::vector<Ray>& primaryRays,
-                   const std::vector<Hit>& primaryHits, const SecondaryPass& pass, BackendDispatcher& dispatcher,
-                   PeerScenes& peers) {
-    const auto start = Clock::now();
-    ThreadPool& pool = dispatcher.pool(c.threads());
-    const SecondaryRays made = makeSecondaryRays(pass, primaryRays, primaryHits, scene.triangles, pool);
-    const double makeMs = msSince(start);
-    TraceResult traced;
-    if (!made.rays.empty())
-        traced = peers.embree ? peers.embree->trace(made.rays, pool, HitQuery::Any, 0u)
-                              : peers.rayQuery->trace(made.rays, HitQuery::Any);
-    PassFrame f;
-    f.hits = hitsPerSlot(made, traced.hits);
-    f.ms = msSince(start) - traced.phases.compileMs();
-    f.rays = made.rays.size();
-    f.parts.emplace_back("make rays", makeMs);
+    f.ms = pass.ms - pass.output.timings.pipelineCompileMs;
+    f.rays = pass.rays;
+    addTraceParts(pass.output, f.parts);
     // RayQueryScene::trace builds (dynamic) or refits (refit) its structure in every call: it
     // has no call that traces alone. The frame paid for that once, in its primary pass; the
     // repeat here is taken out of the pass's time by its GPU timestamps (the vertices' upload
     // before it, a copy in host memory on lavapipe, stays in).
-    traced.phases.forEach([&](const std::string& name, PhaseTimes::Field phase, double ms) {
-        if (peers.rayQuery && (phase == &PhaseTimes::build || phase == &PhaseTimes::refit)) {
-            f.ms -= ms;
-            f.parts.emplace_back("not counted: " + name + " repeated by the pass", ms);
-        } else {
-            f.parts.emplace_back(name, ms);
-        }
-    });
-    addGpuTimestamps(traced, f.parts);
+    if (c.backend() == Backend::RayQuery)
+        for (auto& [name, ms] : f.parts)
+            if (name == "build" || name == "refit") {
+                f.ms -= ms;
+                name = "not counted: " + name + " repeated by the pass";
+            }
+    f.hits = std::move(pass.output.hits);
     return f;
 }
 
-// One lit frame of a configuration: the primary pass, then each secondary pass from its hits.
-// After each pass of a Vulkan backend the bench pauses, untimed, as it does after a frame: the
-// next pass's host work (the peers make their rays there) runs on the cores lavapipe spins on.
+// One lit frame of a configuration: the camera's rays, then the Tracer's frame (traceFrame):
+// the primary pass, then each secondary pass from its hits, back to back as render runs them.
 std::vector<PassFrame> traceLitFrame(const BenchConfig& c, const BenchScene& s, const Camera& camera,
-                                     const BenchCommand& cmd, const std::vector<SecondaryPass>& passes,
-                                     BackendDispatcher& dispatcher, PeerScenes& peers, FrameBuffers& buffers) {
+                                     const BenchCommand& cmd, const std::vector<FramePass>& passes, BenchRun& run,
+                                     std::vector<Ray>& rayBuffer) {
+    useConfig(run.tracer, c);
+    const auto start = Clock::now();
+    RayBatch rays = makeCameraRays(camera, cmd.width, cmd.height, run.pools.of(c.threads()), rayBuffer);
+    const double raysMs = msSince(start);
+    FrameOutput out = run.tracer.traceFrame(s.traced, rays, passes);
+    if (out.passes.size() != passes.size()) throw InternalError("bench: a frame traced fewer passes than asked");
     std::vector<PassFrame> frame(1 + passes.size());
-    FrameOutcome primary = traceFrame(c, s.scene, camera, cmd.width, cmd.height, dispatcher, peers, buffers);
-    frame[0].ms = primary.ms - primary.result.phases.compileMs();
-    frame[0].rays = buffers.rays.size();
-    frame[0].parts = primary.parts;
-    settleAfter(c.backend());
-    for (std::size_t p = 0; p < passes.size(); ++p) {
-        frame[1 + p] = isPeer(c.backend())
-                           ? peerPass(c, s.scene, buffers.rays, primary.result.hits, passes[p], dispatcher, peers)
-                           : dacrtPass(c, primary, passes[p], dispatcher);
-        settleAfter(c.backend());
-    }
-    frame[0].hits = std::move(primary.result.hits);
+    TraceOutput& primary = out.primary;
+    frame[0].ms = raysMs + primary.timings.totalMs - primary.timings.pipelineCompileMs;
+    frame[0].rays = rays.size();
+    frame[0].parts = {{"rays", raysMs}, {"tracer", primary.timings.totalMs}};
+    addTraceParts(primary, frame[0].parts);
+    frame[0].hits = std::move(primary.hits);
+    for (std::size_t p = 0; p < passes.size(); ++p) frame[1 + p] = secondaryPassFrame(c, out.passes[p]);
+    rayBuffer = releaseRays(std::move(rays));
     return frame;
 }
 
 // A slot's visibility, all that an any-hit answer promises: no ray made, open, or blocked.
-int visibilityOf(const Hit& h) { return h.prim == kNotTracedPrim ? 0 : h.prim == kMissPrim ? 1 : 2; }
+int visibilityOf(const RayHit& h) { return h.primitive == kNotTracedPrimitive ? 0 : h.primitive == kNoPrimitive ? 1 : 2; }
 
-std::uint64_t mismatches(const std::vector<Hit>& reference, const std::vector<Hit>& got, bool primary, bool exactDepth) {
+std::uint64_t mismatches(const std::vector<RayHit>& reference, const std::vector<RayHit>& got, bool primary,
+                         bool exactDepth) {
     if (reference.size() != got.size())
         throw InternalError("a pass answered " + std::to_string(got.size()) + " slots, cpu-seq " +
                             std::to_string(reference.size()));
     std::uint64_t n = 0;
     for (std::size_t i = 0; i < got.size(); ++i) {
         if (primary)
-            n += reference[i].prim != got[i].prim ||
+            n += reference[i].primitive != got[i].primitive ||
                  (exactDepth && std::bit_cast<std::uint32_t>(reference[i].t) != std::bit_cast<std::uint32_t>(got[i].t));
         else
             n += visibilityOf(reference[i]) != visibilityOf(got[i]);
@@ -149,36 +123,34 @@ struct PassTotals {
     }
 };
 
-// A configuration over one scene: its peer scene, its buffers, and per pass (primary, each
-// secondary pass, then the whole frame) its totals.
+// A configuration over one scene: its rays' memory, and per pass (primary, each secondary
+// pass, then the whole frame) its totals.
 struct ConfigRun {
     BenchConfig config;
-    PeerScenes peers;
-    FrameBuffers buffers;
+    std::vector<Ray> rays;
     std::vector<PassTotals> totals;
 };
 
 struct SceneRun {
     const BenchScene& s;
-    std::vector<SecondaryPass> passes;
+    std::vector<FramePass> passes;
     std::vector<ConfigRun> runs;
 };
 
-void measureCamera(SceneRun& run, std::size_t k, const BenchCommand& cmd, BackendDispatcher& dispatcher,
-                   Progress& progress) {
+void measureCamera(SceneRun& run, std::size_t k, const BenchCommand& cmd, BenchRun& bench, Progress& progress) {
     const BenchScene& s = run.s;
     progress.stage(s.name + ": camera " + std::to_string(k + 1) + " of " + std::to_string(s.cameras.size()) + ", " +
                    std::to_string(run.runs.size()) + " configurations, " + std::to_string(1 + run.passes.size()) +
                    " passes each");
     const double frames = double(s.cameras.size() * std::size_t(cmd.repeat));
     const std::size_t passCount = 1 + run.passes.size();
-    std::vector<std::vector<Hit>> reference;  // cpu-seq's answers, the first configuration's
+    std::vector<std::vector<RayHit>> reference;  // cpu-seq's answers, the first configuration's
     for (int w = 0; w < cmd.warmup + cmd.repeat; ++w) {
         for (std::size_t c = 0; c < run.runs.size(); ++c) {
             ConfigRun& r = run.runs[c];
             progress.step(s.name + " " + r.config.series + " camera " + std::to_string(k));
-            std::vector<PassFrame> frame =
-                traceLitFrame(r.config, s, s.cameras[k], cmd, run.passes, dispatcher, r.peers, r.buffers);
+            std::vector<PassFrame> frame = traceLitFrame(r.config, s, s.cameras[k], cmd, run.passes, bench, r.rays);
+            settleAfter(r.config.backend());
             if (w < cmd.warmup) continue;
             double frameMs = 0.0;
             for (std::size_t p = 0; p < passCount; ++p) {
@@ -210,24 +182,23 @@ void measureCamera(SceneRun& run, std::size_t k, const BenchCommand& cmd, Backen
 }
 
 void measureScene(const std::string& path, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
-                  BackendDispatcher& dispatcher, std::vector<std::string>& taken, std::vector<PassRow>& rows) {
+                  BenchRun& bench, std::vector<std::string>& taken, std::vector<PassRow>& rows) {
     const BenchScene s = loadBenchScene(path, cmd, taken);
     taken.push_back(s.name);
     // The lights are fixed in the world, placed (a default key light) from the orbit's first
     // camera, as render places them.
     bool headlight = false;
-    const std::vector<Light> lights = frameLights(s.scene, s.cameras.front(), s.box, cmd.passes.lights, headlight);
-    SceneRun run{s, secondaryPasses(lights, cmd.passes, s.box, 0), {}};
+    const std::vector<Light> lights = frameLights(s.scene(), s.cameras.front(), s.box, cmd.passes.lights, headlight);
+    SceneRun run{s, framePasses(lights, cmd.passes, s.box, 0), {}};
     for (const BenchConfig& config : configs) {
         ConfigRun r;
         r.config = config;
-        r.config.request.embree.imageWidth = std::uint32_t(cmd.width);
-        r.peers = makePeerScenes(r.config, s.scene, dispatcher);
+        prepareStructure(bench, r.config, s.traced);
         r.totals.resize(run.passes.size() + 2);
         run.runs.push_back(std::move(r));
     }
     Progress progress("dacrt bench", s.cameras.size() * configs.size() * std::size_t(cmd.warmup + cmd.repeat));
-    for (std::size_t k = 0; k < s.cameras.size(); ++k) measureCamera(run, k, cmd, dispatcher, progress);
+    for (std::size_t k = 0; k < s.cameras.size(); ++k) measureCamera(run, k, cmd, bench, progress);
 
     const double cameras = double(s.cameras.size());
     const std::size_t passCount = 1 + run.passes.size();
@@ -236,7 +207,7 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
             const PassTotals& t = r.totals[p];
             PassRow row;
             row.scene = s.name;
-            row.triangles = s.scene.triangleCount();
+            row.triangles = s.scene().triangleCount();
             row.pixels = std::size_t(cmd.width) * std::size_t(cmd.height);
             row.cameras = int(s.cameras.size());
             row.config = r.config;
@@ -246,9 +217,9 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
             } else if (p == passCount) {
                 row.pass = row.kind = "frame";
             } else {
-                const SecondaryPass& pass = run.passes[p - 1];
+                const FramePass& pass = run.passes[p - 1];
                 row.pass = pass.name;
-                row.kind = pass.kind == shared::kPassShadow ? "shadow" : "occlusion";
+                row.kind = pass.kind == PassKind::Shadow ? "shadow" : "occlusion";
                 row.raysPerHit = pass.raysPerHit;
             }
             row.slotsPerFrame = t.slotsSum / cameras;
@@ -327,8 +298,7 @@ void printPassSummary(const std::vector<PassRow>& rows) {
                  "cameras; build: a peer's per-frame build or refit, within its primary pass)\n";
 }
 
-void writePassOutputs(const BenchCommand& cmd, const std::vector<PassRow>& rows, const BackendDispatcher& dispatcher,
-                      unsigned hardwareThreads) {
+void writePassOutputs(const BenchCommand& cmd, const std::vector<PassRow>& rows, const BenchRun& run) {
     std::vector<nlohmann::ordered_json> json;
     for (const PassRow& r : rows) json.push_back(passRowJson(r));
     writeCsvOf(cmd.csvPath,
@@ -337,7 +307,7 @@ void writePassOutputs(const BenchCommand& cmd, const std::vector<PassRow>& rows,
                 "ms_min", "ms_median", "ms_mean", "mrays_per_s", "build_ms", "checked_slots", "visibility_mismatches",
                 "mismatch_fraction", "exact_required"},
                json);
-    nlohmann::ordered_json j = runJson(cmd, dispatcher, hardwareThreads);
+    nlohmann::ordered_json j = runJson(cmd, run.tracer, run.hardwareThreads);
     j["rows"] = nlohmann::ordered_json::array();
     for (nlohmann::ordered_json& row : json) j["rows"].push_back(std::move(row));
     writeFileAtomically(cmd.jsonPath, j.dump(2) + "\n");
@@ -345,19 +315,18 @@ void writePassOutputs(const BenchCommand& cmd, const std::vector<PassRow>& rows,
 
 }  // namespace
 
-int runPassesSuite(const BenchCommand& cmd, const std::vector<BenchConfig>& configs, BackendDispatcher& dispatcher,
-                   unsigned hardwareThreads) {
+int runPassesSuite(const BenchCommand& cmd, const std::vector<BenchConfig>& configs, BenchRun& run) {
     if (configs.empty() || configs.front().backend() != Backend::CpuSeq)
         throw InternalError("--suite passes needs cpu-seq's default first: every pass is checked against it");
     std::vector<PassRow> rows;
     std::vector<std::string> taken;
-    for (const std::string& path : cmd.scenes) measureScene(path, cmd, configs, dispatcher, taken, rows);
+    for (const std::string& path : cmd.scenes) measureScene(path, cmd, configs, run, taken, rows);
 
     printPassSummary(rows);
-    writePassOutputs(cmd, rows, dispatcher, hardwareThreads);
+    writePassOutputs(cmd, rows, run);
     std::cerr << "dacrt bench: wrote " << cmd.csvPath << " and " << cmd.jsonPath
               << " (tables: python3 tools/bench/tables.py passes " << cmd.jsonPath << " SCENE)\n";
-    int code = (dispatcher.reportValidationErrors(std::cerr) ? kExitValidation : kExitSuccess);
+    int code = (reportValidationErrors(run.tracer, std::cerr) ? kExitValidation : kExitSuccess);
     for (const PassRow& r : rows) {
         if (!r.exactRequired || r.mismatches == 0 || r.kind == "frame") continue;
         std::cerr << "dacrt bench: error: " << r.scene << ", " << r.config.series << ", " << r.pass << ": "

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
+#include <ostream>
 #include <sstream>
 
 #include "bench/bench_configs.hpp"
@@ -31,7 +33,7 @@ void markPareto(std::vector<BenchRow>& rows) {
     }
 }
 
-nlohmann::ordered_json runJson(const BenchCommand& cmd, const BackendDispatcher& dispatcher, unsigned hardwareThreads) {
+nlohmann::ordered_json runJson(const BenchCommand& cmd, const Tracer& tracer, unsigned hardwareThreads) {
     nlohmann::ordered_json j;
     j["command"] = {{"orbit", cmd.orbit},
                     {"size", std::to_string(cmd.width) + "x" + std::to_string(cmd.height)},
@@ -49,16 +51,23 @@ nlohmann::ordered_json runJson(const BenchCommand& cmd, const BackendDispatcher&
         j["command"]["animation"] = cmd.animation.animation;
         j["command"].erase("orbit");
     }
-    const gpu::Context* context = dispatcher.gpuContext();
+    const std::optional<VulkanDeviceProperties> device = tracer.deviceProperties();
     const char* lpThreads = std::getenv("LP_NUM_THREADS");
     j["machine"] = {{"cpu", cpuModelName()},
                     {"simd_target", simd::activeTarget()},
                     {"hardware_threads", hardwareThreads},
-                    {"gpu_device", context ? context->info().name : std::string()},
-                    {"gpu_driver", context ? context->info().driver : std::string()},
+                    {"gpu_device", device ? device->name : std::string()},
+                    {"gpu_driver", device ? device->driver : std::string()},
                     {"lp_num_threads", lpThreads ? lpThreads : ""}};
-    j["validation_errors"] = dispatcher.validationErrors();
+    j["validation_errors"] = tracer.validationErrors();
     return j;
+}
+
+bool reportValidationErrors(const Tracer& tracer, std::ostream& err) {
+    if (!tracer.options().validate || tracer.validationErrors() == 0) return false;
+    for (const std::string& m : tracer.validationMessages()) err << "dacrt: validation " << m << "\n";
+    err << "dacrt: error: " << tracer.validationErrors() << " Vulkan validation errors\n";
+    return true;
 }
 
 nlohmann::ordered_json rowJson(const BenchRow& r) {

@@ -1,9 +1,12 @@
 #pragma once
 // What a bench run reports: the Pareto fronts, the table on stdout, the CSV and the JSON.
+#include <iosfwd>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include <dacrt/tracer.hpp>
 
 #include "bench/bench.hpp"
 #include "bench/bench_rows.hpp"
@@ -17,9 +20,12 @@ namespace dacrt {
 constexpr double kParetoTimeMargin = 0.05;
 
 void markPareto(std::vector<BenchRow>& rows);
-// What every run's JSON opens with: the command, the machine (CPU, SIMD target, driver) and
-// the validation error count.
-nlohmann::ordered_json runJson(const BenchCommand& cmd, const BackendDispatcher& dispatcher, unsigned hardwareThreads);
+// What every run's JSON opens with: the command, the machine (CPU, SIMD target, the Tracer's
+// device and driver) and the validation error count.
+nlohmann::ordered_json runJson(const BenchCommand& cmd, const Tracer& tracer, unsigned hardwareThreads);
+// Under --validate: every validation message of the run's device; true when there were errors
+// (the command then fails with its validation exit code).
+bool reportValidationErrors(const Tracer& tracer, std::ostream& err);
 nlohmann::ordered_json rowJson(const BenchRow& r);
 void writeCsv(const std::string& path, const std::vector<BenchRow>& rows);
 // A header line of `columns`, then per row its value of each (strings quoted where they hold

@@ -1,5 +1,5 @@
 #pragma once
-// What the bench command measures: a configuration (a backend request with a name) and the
+// What the bench command measures: a configuration (a Tracer's options with a name) and the
 // row it yields per scene.
 #include <cstddef>
 #include <cstdint>
@@ -8,7 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "library/backend_dispatcher.hpp"
+#include <dacrt/tracer.hpp>
+
+#include "cpu/options.hpp"  // the options' names
 #include "oracle/error_metrics.hpp"
 
 namespace dacrt {
@@ -16,10 +18,10 @@ namespace dacrt {
 struct BenchConfig {
     std::string series;  // backend, or "embree static"
     std::string name;    // "default" or the option values that differ from it
-    BackendRequest request;
+    TracerOptions options;  // the Vulkan device and validation are the run's (Tracer::setOptions)
     bool isDefault = false;
-    Backend backend() const { return request.trace.backend; }
-    unsigned threads() const { return BackendDispatcher::threadsOf(request.trace); }
+    Backend backend() const { return options.trace.backend; }
+    unsigned threads() const { return traceThreads(options.trace); }
 };
 
 struct BenchRow {
@@ -78,7 +80,7 @@ struct AnimationFrameRow {
     std::optional<double> buildMs;  // a peer's build or refit
     double traceMs = 0.0;
     double workMs = 0.0;            // prepare + build + trace: the backend's frame
-    double copyMs = 0.0;            // a peer's vertex copy, not counted
+    double copyMs = 0.0;            // the frame's vertex copy, not counted (reported for the peers)
     bool rebuilt = false;           // a refit peer rebuilt (the triangle count changed)
     std::vector<std::pair<std::string, double>> partsMs;
     // Pixels whose primitive differs from cpu-seq's (dacrt's backends: or whose depth differs

@@ -340,7 +340,6 @@ Subcommand addCompareCommand(CLI::App& app) {
 Subcommand addStressCommand(CLI::App& app) {
     struct State {
         StressCommand stress;
-        DeviceChoice devices;
         std::string size = "large";
         bool defaultsOnly = false, noDeterminism = false;
     };
@@ -358,10 +357,8 @@ Subcommand addStressCommand(CLI::App& app) {
     cmd->add_flag("--defaults-only", s->defaultsOnly, "run only each backend's default configuration");
     cmd->add_flag("--no-determinism", s->noDeterminism, "skip the determinism checks");
     cmd->add_option("--json", stress.jsonPath, "write the table and checks as JSON");
-    addDeviceOptions(cmd, s->devices.device, s->devices.validate);
+    addDeviceOptions(cmd, stress.device, stress.validate);
     return {cmd, [s] {
-                s->stress.device = s->devices.device;
-                s->stress.validate = s->devices.validate;
                 s->stress.size = s->size == "small" ? StressSize::Small : StressSize::Large;
                 s->stress.withOptions = !s->defaultsOnly;
                 s->stress.determinism = !s->noDeterminism;
@@ -421,7 +418,7 @@ Subcommand addBenchCommand(CLI::App& app) {
                     "the rows with their time parts (default OUT/bench.json); tools/bench/plot.py draws them");
     cmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
     cmd->add_flag("--no-cache", s->noCache, "always recompute the float64 reference");
-    addDeviceOptions(cmd, bench.devices.device, bench.devices.validate);
+    addDeviceOptions(cmd, bench.device, bench.validate);
     return {cmd, [s, cmd, light, ao, aoDistance, frames, fps, animation] {
                 if (s->bench.suite != BenchSuite::Passes && (light->count() || ao->count() || aoDistance->count()))
                     throw InputError("--light, --ao and --ao-distance light the frames of --suite passes; the other "

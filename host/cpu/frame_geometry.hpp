@@ -53,6 +53,10 @@ struct FrameGeometry {
     // Nonzero: frames with the same value have the same triangles and bounds, bit for bit (the
     // gpu keeps them on the device: gpu/resident_triangles.hpp). 0: unknown.
     std::uint64_t trianglesVersion = 0;
+    // Nonzero: the caller's scene whose `triangles` array this is, unique in the process and
+    // kept while the array keeps its address and size: the peers keep their structure over it
+    // from frame to frame (library/peer_scenes.hpp). 0: a structure for this frame alone.
+    std::uint64_t sceneId = 0;
 
     std::size_t tracedTriangleCount() const { return tracedTriangles ? tracedTriangles->size() : triangles->size(); }
     std::uint32_t tracedTriangle(std::size_t i) const { return tracedTriangles ? (*tracedTriangles)[i] : std::uint32_t(i); }

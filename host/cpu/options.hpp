@@ -62,11 +62,17 @@ struct EnumNames<Skip> {
                                                                              {Skip::SubScenes, "subscenes"}}};
 };
 
-// The Embree peer's build (public <dacrt/backend_tuning.hpp>), named as the command line gives it:
+// The peers' builds (public <dacrt/backend_tuning.hpp>), named as the command line and the
+// bench's series give them:
 template <>
 struct EnumNames<EmbreeBuild> {
     static constexpr std::array<std::pair<EmbreeBuild, std::string_view>, 3> table{
         {{EmbreeBuild::Dynamic, "dynamic"}, {EmbreeBuild::Refit, "refit"}, {EmbreeBuild::Static, "static"}}};
+};
+template <>
+struct EnumNames<RayQueryBuild> {
+    static constexpr std::array<std::pair<RayQueryBuild, std::string_view>, 3> table{
+        {{RayQueryBuild::Dynamic, "dynamic"}, {RayQueryBuild::Refit, "refit"}, {RayQueryBuild::Static, "static"}}};
 };
 
 }  // namespace dacrt

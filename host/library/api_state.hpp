@@ -23,14 +23,24 @@ struct TraceScene::Impl {
     // fromArrays where triangles with no area were dropped: the caller's number of each traced
     // triangle. Empty: the traced triangles' indices are the ids.
     std::vector<std::uint32_t> callerIds;
+    // fromArrays: the caller's indices and vertex count, from which setPositions gathers the
+    // triangles anew. Empty: a scene from a file (or the library's own), with no vertices to move.
+    std::vector<std::uint32_t> indices;
+    std::size_t vertices = 0;
+    // Unique in the process: the peers keep their structure over this scene's triangles, whose
+    // array keeps its address and size while the scene lives (FrameGeometry::sceneId).
+    const std::uint64_t id = newId();
 
     explicit Impl(Scene checked)
         : scene(std::move(checked)), box(sceneBounds(scene.triangles)) {}
     Impl(Scene checked, const Box& sceneBox) : scene(std::move(checked)), box(sceneBox) {}
 
+    static std::uint64_t newId();
+
     // The public scene around a prepared one (the library's own inputs, render_inputs.hpp).
     static TraceScene wrap(std::unique_ptr<Impl> impl) { return TraceScene(std::move(impl)); }
     static const Impl& of(const TraceScene& scene) { return *scene.impl_; }
+    static Impl& of(TraceScene& scene) { return *scene.impl_; }
 };
 
 struct RayBatch::Impl {
@@ -40,6 +50,7 @@ struct RayBatch::Impl {
 
     static RayBatch wrap(std::unique_ptr<Impl> impl) { return RayBatch(std::move(impl)); }
     static const Impl& of(const RayBatch& rays) { return *rays.impl_; }
+    static Impl& of(RayBatch& rays) { return *rays.impl_; }
 };
 
 }  // namespace dacrt

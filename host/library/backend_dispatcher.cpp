@@ -9,7 +9,6 @@
 #include "cpu/backend_options.hpp"
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/triangle_skips.hpp"
-#include "peers/embree_tracer.hpp"
 
 namespace dacrt {
 
@@ -59,7 +58,7 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
     checkBackendRequest(request);
     passSource_.reset();  // a later traceSecondary must not find an earlier frame's buffers
     ThreadPool& threadPool = pool(threadsOf(request.trace));
-    if (isPeer(request.trace.backend)) return traceOnBackend(geometry, request, onPlan, onProgress);
+    if (isPeer(request.trace.backend)) return traceOnBackend(geometry, request, onPlan, onProgress, PeerFrame::New);
 
     // dacrt's backends trace the triangles no skip dropped; the plan starts with the skips.
     const auto start = Clock::now();
@@ -86,11 +85,12 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
         return withSkipLines(std::move(r));
     }
     const FrameGeometry traced = withSkips(geometry, skips);
-    return withSkipLines(traceOnBackend(traced, request, planWithSkips, onProgress));
+    return withSkipLines(traceOnBackend(traced, request, planWithSkips, onProgress, PeerFrame::New));
 }
 
 TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request,
-                                              const PlanHook& onPlan, const ProgressHook& onProgress) {
+                                              const PlanHook& onPlan, const ProgressHook& onProgress,
+                                              PeerFrame frame) {
     const unsigned threads = threadsOf(request.trace);
     ThreadPool& threadPool = pool(threads);
     switch (request.trace.backend) {
@@ -99,18 +99,15 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
             return GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get())
                 .trace(geometry, onPlan,
                        request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
-        case Backend::Embree:
+        case Backend::Embree: {
             // Embree allocates its BVH itself: there is no plan to show or check.
-        {
-            // A single frame's trace: the BVH is built for it (the bench times refit and static
-            // scenes across frames).
             EmbreeOptions embree = request.embree;
             embree.threads = threads;
-            return traceEmbree(geometry, embree, threadPool);
+            return peers_.traceEmbree(geometry, embree, threadPool, frame);
         }
         case Backend::RayQuery:
             if (!gpu_) throw InternalError("the rayquery backend was asked for a trace without a device being opened");
-            return traceRayQuery(geometry, *gpu_, *pipelines_, onPlan);
+            return peers_.traceRayQuery(geometry, request.rayQueryBuild, *gpu_, *pipelines_, onPlan, frame);
         case Backend::Brute:
         case Backend::CpuSeq:
         case Backend::Cpu: return traceCpu(geometry, request.trace, threadPool, onPlan, onProgress);
@@ -148,7 +145,8 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     } else {
         FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays.rays, primary.sceneBox);
         g.trianglesVersion = primary.trianglesVersion;
-        out.result = traceOnBackend(g, request, onPlan, {});
+        g.sceneId = primary.sceneId;
+        out.result = traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass);
         if (out.result.hits.empty()) return out;  // stopped at the plan
         out.result.hits = hitsPerSlot(rays, out.result.hits);
     }

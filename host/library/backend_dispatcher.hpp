@@ -1,7 +1,8 @@
 #pragma once
-// The one place where a backend choice becomes a trace, for render, bench and stress: the
-// request checked against the backend, the devices and pipelines opened once per process,
-// the frame traced, and the validation epilogue with its exit code.
+// The one place where a backend choice becomes a trace, the engine of the public Tracer
+// (tracer.cpp): the request checked against the backend, the devices and pipelines opened
+// once, the peers' structures kept from frame to frame, the frame traced, and the validation
+// epilogue.
 #include <cstdint>
 #include <iosfwd>
 #include <map>
@@ -19,8 +20,7 @@
 #include "gpu/context.hpp"
 #include "gpu/gpu_tracer.hpp"
 #include "gpu/pipeline_cache.hpp"
-#include "peers/rayquery_tracer.hpp"
-#include "peers/embree_tracer.hpp"
+#include "library/peer_scenes.hpp"
 
 namespace dacrt {
 
@@ -30,7 +30,7 @@ struct BackendRequest {
     bool keepForPasses = false;
     GpuTuning gpuTuning;        // gpu only
     EmbreeOptions embree;       // embree only (threads: the request's)
-    RayQueryBuild rayQueryBuild = RayQueryBuild::Dynamic;  // rayquery only (bench: persistent scenes)
+    RayQueryBuild rayQueryBuild = RayQueryBuild::Dynamic;  // rayquery only
 };
 
 // Throws InputError, naming the command-line options, when the request gives a backend an
@@ -61,7 +61,8 @@ public:
 
     // Checks the request (checkBackendRequest), then traces one frame on its backend: for
     // dacrt's backends, after the triangle skips the request allows (triangle_skips.hpp),
-    // whose counts open the plan's work lines.
+    // whose counts open the plan's work lines; for the peers, over the structure they keep for
+    // the geometry's scene (PeerScenes: a new frame of it).
     // onProgress is called by the backends that report progress (brute force).
     TraceResult trace(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan = {},
                       const ProgressHook& onProgress = {});
@@ -71,7 +72,8 @@ public:
     // left them; on the host for the others, and for gpu where it kept nothing) and traced for
     // any hit by the same backend, over
     // every triangle (no skips: a shadow may fall from anywhere). `primary` is the frame as
-    // given to trace(). Returns one hit per slot (hitsPerSlot) and the rays made.
+    // given to trace(); the peers trace the structure it left. Returns one hit per slot
+    // (hitsPerSlot) and the rays made.
     struct PassTrace {
         TraceResult result;
         std::uint64_t rays = 0;
@@ -87,7 +89,7 @@ public:
 private:
     // The trace itself, on the triangles the skips left (dacrt's backends) or on every one.
     TraceResult traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan,
-                               const ProgressHook& onProgress);
+                               const ProgressHook& onProgress, PeerFrame frame);
 
     DeviceChoice devices_;
     std::map<unsigned, std::unique_ptr<ThreadPool>> pools_;
@@ -95,6 +97,7 @@ private:
     std::unique_ptr<gpu::PipelineCache> pipelines_;
     std::unique_ptr<gpu::ResidentTriangles> resident_;  // gpu: the triangles kept on the device
     GpuPassSourcePtr passSource_;                       // gpu: the last frame kept for its secondary passes
+    PeerScenes peers_;                                  // embree, rayquery: their structures
 };
 
 }  // namespace dacrt

@@ -1,7 +1,8 @@
 #pragma once
-// The render command's scene and camera rays, which it makes itself with core (a glTF document
-// posed at each instant, orbit cameras, antialiasing offsets), handed to the public API without
-// a copy: render keeps reading them (shading, stats) through the API's objects.
+// The scene and camera rays the render and bench commands make themselves with core (a glTF
+// document posed at each instant, orbit cameras, antialiasing offsets), handed to the public API
+// without a copy: the commands keep reading them (shading, stats, checks) through the API's
+// objects.
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -20,9 +21,18 @@ TraceScene adoptScene(Scene scene, const Box& box);
 const Scene& sceneOf(const TraceScene& scene);
 const Box& boxOf(const TraceScene& scene);
 
+// A scene made by adoptScene becomes `posed`, the same scene at another instant of its
+// animation, with as many triangles (InternalError otherwise): its triangles are copied into
+// the scene's own array, which keeps its address, so that a Tracer follows them as a dynamic
+// scene's next frame (the peers refit or rebuild the structure they keep over that array; the
+// gpu uploads them again: a new trianglesVersion). The box is its triangles'.
+void replaceScene(TraceScene& scene, Scene posed);
+
 // A camera's primary rays, one per pixel, row-major: imageWidth pixels a row; the frustum
 // (a perspective camera's) for the skip of the triangles outside it.
 RayBatch adoptCameraRays(std::vector<Ray> rays, std::uint32_t imageWidth, std::optional<ViewFrustum> frustum);
 const std::vector<Ray>& raysOf(const RayBatch& rays);
+// The rays moved out of the batch, for their memory to hold the next frame's.
+std::vector<Ray> releaseRays(RayBatch rays);
 
 }  // namespace dacrt

@@ -1,6 +1,7 @@
 // The public TraceScene: a glTF file's scene as `dacrt render` loads it, or triangles from the
 // caller's arrays, checked with messages that name the caller's element.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
 
@@ -58,7 +59,39 @@ glm::vec3 vertex(std::span<const float> positions, std::uint32_t index) {
             positions[3 * std::size_t(index) + 2]};
 }
 
+// Triangle k of the caller's arrays placed at `positions` (its face rule kept).
+void placeTriangle(Triangle& t, std::span<const float> positions, std::span<const std::uint32_t> indices,
+                   std::size_t k) {
+    t.v0 = vertex(positions, indices[3 * k]);
+    t.v1 = vertex(positions, indices[3 * k + 1]);
+    t.v2 = vertex(positions, indices[3 * k + 2]);
+}
+
+// setPositions keeps the triangles traced: one that fromArrays dropped for having no area must
+// still have none.
+void checkDroppedStayDropped(std::span<const float> positions, const TraceScene::Impl& s) {
+    if (s.callerIds.empty()) return;  // none was dropped
+    std::size_t traced = 0;
+    for (std::uint32_t k = 0; k < s.indices.size() / 3; ++k) {
+        if (traced < s.callerIds.size() && s.callerIds[traced] == k) {
+            ++traced;
+            continue;
+        }
+        Triangle t{};
+        placeTriangle(t, positions, s.indices, k);
+        if (!shared::triangleHasNoArea(t.v0, t.v1, t.v2))
+            throw InputError("positions: triangle " + std::to_string(k) + " had no area when the scene was made, so it "
+                             "is not traced, and has area now: setPositions keeps the triangles a scene traces; make "
+                             "the scene anew with fromArrays");
+    }
+}
+
 }  // namespace
+
+std::uint64_t TraceScene::Impl::newId() {
+    static std::atomic<std::uint64_t> next{1};
+    return next++;
+}
 
 TraceScene::TraceScene(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 TraceScene::TraceScene(TraceScene&&) noexcept = default;
@@ -87,9 +120,7 @@ TraceScene TraceScene::fromArrays(std::span<const float> positions, std::span<co
     std::vector<std::uint32_t> callerIds;
     for (std::uint32_t k = 0; k < indices.size() / 3; ++k) {
         Triangle t{};
-        t.v0 = vertex(positions, indices[3 * k]);
-        t.v1 = vertex(positions, indices[3 * k + 1]);
-        t.v2 = vertex(positions, indices[3 * k + 2]);
+        placeTriangle(t, positions, indices, k);
         t.cullBackFace = !singleSided.empty() && singleSided[k] != 0 ? 1u : 0u;
         // The loader's rule: no ray can hit a triangle with no area (docs/gltf-input.md).
         if (shared::triangleHasNoArea(t.v0, t.v1, t.v2)) {
@@ -104,7 +135,27 @@ TraceScene TraceScene::fromArrays(std::span<const float> positions, std::span<co
     touchTriangles(scene);
     auto impl = std::make_unique<Impl>(std::move(scene));
     if (impl->scene.degenerateTrianglesDropped != 0) impl->callerIds = std::move(callerIds);
+    impl->indices.assign(indices.begin(), indices.end());
+    impl->vertices = positions.size() / 3;
     return TraceScene(std::move(impl));
+}
+
+void TraceScene::setPositions(std::span<const float> positions) {
+    Impl& s = *impl_;
+    if (s.indices.empty())
+        throw InputError("setPositions moves the vertices of a scene made by fromArrays; this one was loaded from a "
+                         "file: load it again at the new instant (SceneLoadOptions::time)");
+    if (positions.size() != 3 * s.vertices)
+        throw InputError("positions: " + std::to_string(positions.size()) + " floats, but the scene has " +
+                         std::to_string(s.vertices) + " vertices (three floats each): setPositions moves them; "
+                         "fromArrays makes a scene with another count");
+    checkPositions(positions);
+    checkDroppedStayDropped(positions, s);
+    // In place: the peers' structures read this array where it is (tracer.hpp).
+    for (std::size_t i = 0; i < s.scene.triangles.size(); ++i)
+        placeTriangle(s.scene.triangles[i], positions, s.indices, s.callerIds.empty() ? i : s.callerIds[i]);
+    touchTriangles(s.scene);
+    s.box = sceneBounds(s.scene.triangles);
 }
 
 std::size_t TraceScene::triangleCount() const { return impl_->scene.triangles.size(); }

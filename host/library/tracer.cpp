@@ -1,5 +1,5 @@
 // The public Tracer: the options become a BackendRequest and a DeviceChoice, and every trace
-// goes through the BackendDispatcher, as the command line's do.
+// goes through the BackendDispatcher, which keeps the peers' structures from trace to trace.
 #include <dacrt/tracer.hpp>
 
 #include <optional>
@@ -8,6 +8,7 @@
 
 #include "core/system_memory.hpp"
 #include "core/timing.hpp"
+#include "gpu/device_defaults.hpp"
 #include "library/api_results.hpp"
 #include "library/api_state.hpp"
 #include "library/backend_dispatcher.hpp"
@@ -29,7 +30,7 @@ struct Tracer::Impl {
           dispatcher(checkedDevices(o), {o.trace.backend}) {}
 
     static BackendRequest checkedRequest(const TracerOptions& o) {
-        BackendRequest r{.trace = o.trace, .gpuTuning = o.gpu, .embree = o.embree};
+        BackendRequest r{.trace = o.trace, .gpuTuning = o.gpu, .embree = o.embree, .rayQueryBuild = o.rayQueryBuild};
         checkBackendRequest(r);
         return r;
     }
@@ -59,6 +60,7 @@ FrameGeometry frameOf(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch
                                              : frameGeometry(s.scene.triangles, t.bounds, r.rays, box, r.imageWidth);
     if (query == HitQuery::Closest) g.frustum = r.frustum;
     g.trianglesVersion = s.scene.trianglesVersion;
+    g.sceneId = s.id;
     return g;
 }
 
@@ -171,6 +173,19 @@ const TracerOptions& Tracer::options() const { return impl_->options; }
 std::string Tracer::device() const {
     const gpu::Context* gpu = impl_->dispatcher.gpuContext();
     return gpu ? gpu->info().name + " (" + gpu->info().driver + ")" : std::string();
+}
+
+std::optional<VulkanDeviceProperties> Tracer::deviceProperties() const {
+    const gpu::Context* gpu = impl_->dispatcher.gpuContext();
+    if (!gpu) return std::nullopt;
+    return static_cast<const VulkanDeviceProperties&>(gpu->info());
+}
+
+std::optional<Tracer::GpuDefaults> Tracer::gpuDefaults() const {
+    const gpu::Context* gpu = impl_->dispatcher.gpuContext();
+    if (!gpu) return std::nullopt;
+    const unsigned regions = gpu::defaultGpuRegions(gpu->info());
+    return GpuDefaults{regions, gpu::defaultRayGroups(gpu->info(), regions)};
 }
 
 std::uint32_t Tracer::validationErrors() const { return impl_->dispatcher.validationErrors(); }

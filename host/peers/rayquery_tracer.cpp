@@ -143,21 +143,19 @@ TraceResult RayQueryScene::trace(const std::vector<Ray>& rays, HitQuery query) {
     return result;
 }
 
+std::optional<TraceResult> stoppedAtPlan(const FrameGeometry& geometry, const PlanHook& onPlan) {
+    if (!onPlan) return std::nullopt;
+    TraceResult planned;
+    planned.memory.add("device: rayquery vertices", geometry.triangles->size() * sizeof(Triangle));
+    planned.memory.add("device: rays", geometry.rays->size() * sizeof(Ray));
+    planned.memory.add("device: hits", geometry.rays->size() * sizeof(Hit));
+    if (onPlan(planned.memory)) return std::nullopt;
+    return planned;
+}
+
 TraceResult traceRayQuery(const FrameGeometry& geometry, gpu::Context& context, gpu::PipelineCache& pipelines,
                           const PlanHook& onPlan) {
-    if (onPlan) {
-        // What the frame will hold besides the acceleration structure, whose size only the
-        // driver knows (it is in the stats' plan after the frame).
-        MemoryPlan plan;
-        plan.add("device: rayquery vertices", geometry.triangles->size() * sizeof(Triangle));
-        plan.add("device: rays", geometry.rays->size() * sizeof(Ray));
-        plan.add("device: hits", geometry.rays->size() * sizeof(Hit));
-        if (!onPlan(plan)) {
-            TraceResult planned;
-            planned.memory = plan;
-            return planned;
-        }
-    }
+    if (std::optional<TraceResult> planned = stoppedAtPlan(geometry, onPlan)) return *planned;
     const auto start = Clock::now();
     RayQueryScene scene(context, pipelines, *geometry.triangles, RayQueryBuild::Dynamic);
     const double allocateMs = msSince(start);

@@ -3,26 +3,17 @@
 // structure built on the device in the same command buffer as the trace. A peer, measured
 // like Embree: not watertight by specification (docs/benchmarks.md reports its error).
 #include <memory>
+#include <optional>
 #include <vector>
 
-#include "core/enum_names.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/memory_plan.hpp"
+#include "cpu/options.hpp"  // RayQueryBuild and its names
 #include "cpu/trace_result.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
 
 namespace dacrt {
-
-// As a Vulkan user builds for each case: dynamic (PREFER_FAST_BUILD, rebuilt every frame),
-// refit (ALLOW_UPDATE, updated every frame; valid while only vertices move), static
-// (PREFER_FAST_TRACE, built once).
-enum class RayQueryBuild { Dynamic, Refit, Static };
-template <>
-struct EnumNames<RayQueryBuild> {
-    static constexpr std::array<std::pair<RayQueryBuild, std::string_view>, 3> table{
-        {{RayQueryBuild::Dynamic, "dynamic"}, {RayQueryBuild::Refit, "refit"}, {RayQueryBuild::Static, "static"}}};
-};
 
 // The triangles on the device with their acceleration structure, kept across frames.
 class RayQueryScene {
@@ -48,6 +39,12 @@ private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
+
+// Shows onPlan what the frame will hold on the device besides the acceleration structure, whose
+// size only the driver knows (it is in the result's plan after the frame). Returns the result
+// of a frame stopped there (its plan, no hit) where onPlan says stop; nothing where the frame
+// goes on (or no hook is given).
+std::optional<TraceResult> stoppedAtPlan(const FrameGeometry& geometry, const PlanHook& onPlan);
 
 // A single frame: the scene built for it (dynamic), then traced for the frame's query.
 TraceResult traceRayQuery(const FrameGeometry& geometry, gpu::Context& context, gpu::PipelineCache& pipelines,

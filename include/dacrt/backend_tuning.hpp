@@ -1,6 +1,7 @@
 #pragma once
-// The tuning of the backends that take their own options: the gpu's dispatch shape and
-// Embree's build. Plain data, shared by the public API and the backends themselves.
+// The tuning of the backends that take their own options: the gpu's dispatch shape, Embree's
+// build and the ray queries' build. Plain data, shared by the public API and the backends
+// themselves.
 #include <cstdint>
 
 namespace dacrt {
@@ -35,6 +36,13 @@ struct EmbreeOptions {
     // which gives the same image wherever no back face is visible (closed meshes seen from
     // outside).
     bool faceFilter = true;
+
+    bool operator==(const EmbreeOptions&) const = default;
 };
+
+// How the ray queries' acceleration structure follows the frames, as a Vulkan user builds for
+// each case. Dynamic: PREFER_FAST_BUILD, rebuilt every frame. Refit: ALLOW_UPDATE, updated
+// every frame (valid while only vertices move). Static: PREFER_FAST_TRACE, built once.
+enum class RayQueryBuild { Dynamic, Refit, Static };
 
 }  // namespace dacrt

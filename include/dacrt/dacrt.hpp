@@ -16,7 +16,8 @@
 // The parts, one header each:
 //   scene.hpp           TraceScene: triangles from a glTF file (scene_options.hpp: which scene,
 //                       when, which camera, which face rule) or from arrays with a single-sided
-//                       flag per triangle; the hit triangles' geometric normals
+//                       flag per triangle, whose vertices may move between traces (setPositions);
+//                       the hit triangles' geometric normals
 //   rays.hpp            RayBatch: a camera's rays (as `dacrt render` makes them) or any rays
 //                       with their segments (tmin < t <= tmax), origins and directions apart
 //                       or six floats per ray (fromRays), t a distance or in units of the
@@ -39,7 +40,8 @@
 // brute, cpu-seq, cpu and gpu return the same primitive id and t, bit for bit, for every ray
 // (docs/correctness.md); embree and rayquery are peers with their own answers. A Tracer opens
 // its threads and device once: keep it for many traces (setOptions switches its options or
-// backend between them).
+// backend between them); the peers keep their acceleration structure in it from trace to trace
+// (tracer.hpp says what each trace costs).
 // A TraceScene, RayBatch or Tracer may be used from one thread at a time.
 #include <dacrt/backend_tuning.hpp>
 #include <dacrt/devices.hpp>

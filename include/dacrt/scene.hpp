@@ -1,6 +1,6 @@
 #pragma once
 // A scene to trace: triangles loaded from a glTF file or given as arrays, each with its face
-// rule, checked once and kept with the bounds every trace reads.
+// rule, checked once; the vertices of arrays can move from frame to frame (setPositions).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -37,6 +37,18 @@ public:
     // that can be hit, or more triangles than this machine's memory holds.
     static TraceScene fromArrays(std::span<const float> positions, std::span<const std::uint32_t> indices,
                                  std::span<const std::uint8_t> singleSided = {});
+
+    // Moves the vertices of a scene made by fromArrays, for the next frame of an animation:
+    // `positions` as fromArrays takes them, as many vertices; the indices and face rules stay,
+    // and so do the triangles traced (their ids too). A triangle that has no area now is still
+    // traced and never hit: every dacrt backend's intersection test rejects a triangle with no
+    // area (Embree's and the ray queries' tests are their own). The triangles stay where they
+    // are in memory, so a Tracer's next trace follows them as a dynamic scene's frame: the gpu
+    // uploads them again, a peer rebuilds or refits its structure (tracer.hpp). Throws
+    // InputError, changing nothing, on another vertex count, a coordinate fromArrays refuses, a
+    // triangle fromArrays dropped (no area) that has area now, and for a scene loaded from a file
+    // (load it again at the new instant: SceneLoadOptions::time).
+    void setPositions(std::span<const float> positions);
 
     TraceScene(TraceScene&&) noexcept;
     TraceScene& operator=(TraceScene&&) noexcept;

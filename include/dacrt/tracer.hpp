@@ -1,12 +1,28 @@
 #pragma once
 // A tracer: one backend with its options, its threads and (gpu, rayquery) its Vulkan device,
 // opened once and kept for every trace.
+//
+// What a trace costs. dacrt's backends keep nothing between traces: each one computes the
+// triangles' bounds (phase "bounds") and traces, what every frame of a dynamic scene needs (the
+// gpu keeps the triangles on the device while the scene's triangles do not change). The peers
+// keep their acceleration structure over the last scene they traced, as their users keep it
+// (one per option set, so that a sweep over their build modes keeps each): the first trace of
+// a scene builds it (phase "build"; rayquery "allocate" first); every later trace (or occluded)
+// of that scene is the next frame of a dynamic scene, which a dynamic structure rebuilds (into
+// the last one's memory, "build") and a refit one refits ("refit"), while a static one is only
+// traced, and built again once the scene's positions changed (TraceScene::setPositions). The
+// secondary passes of traceFrame trace the structure their frame left (the ray queries rebuild
+// or refit theirs in every trace, passes included: the device's build and trace share one
+// command buffer). A peer's trace of another scene frees what was kept for the last one; the
+// Tracer reads a scene only while tracing it.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <dacrt/backend_tuning.hpp>
+#include <dacrt/devices.hpp>
 #include <dacrt/frame.hpp>
 #include <dacrt/options.hpp>
 #include <dacrt/rays.hpp>
@@ -19,6 +35,7 @@ struct TracerOptions {
     TraceOptions trace;     // the backend, its threads and sub-scenes, the DACRT options, the skips
     GpuTuning gpu;          // gpu only
     EmbreeOptions embree;   // embree only (its build threads are the trace's)
+    RayQueryBuild rayQueryBuild = RayQueryBuild::Dynamic;  // rayquery only
     std::string device;     // gpu, rayquery: a device index or part of its name; empty: the best
     bool validate = false;  // gpu, rayquery: under the Vulkan validation layers (validationErrors())
 };
@@ -67,6 +84,15 @@ public:
     const TracerOptions& options() const;
     // gpu, rayquery: the Vulkan device opened, "name (driver)"; empty where none is open.
     std::string device() const;
+    // Its properties and limits (as listDevices() gives them); none where no device is open.
+    std::optional<VulkanDeviceProperties> deviceProperties() const;
+    // What the gpu backend chooses on that device where GpuTuning and TraceOptions leave it
+    // open (docs/gpu.md); none where no device is open.
+    struct GpuDefaults {
+        unsigned regions = 0;           // sub-scenes (TraceOptions::regions 0)
+        std::uint32_t rayGroups = 0;    // work items per sub-scene and round, with that many sub-scenes
+    };
+    std::optional<GpuDefaults> gpuDefaults() const;
     // Vulkan validation errors so far (with options.validate; 0 otherwise).
     std::uint32_t validationErrors() const;
     // Their messages, as the validation layers gave them.

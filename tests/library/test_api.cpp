@@ -3,7 +3,6 @@
 // the plan.
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <limits>
 #include <string>
 

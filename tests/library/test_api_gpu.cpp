@@ -1,5 +1,7 @@
 // The public API's gpu backend: the same hits as cpu-seq, bit for bit, for closest and any
-// hit and for a camera's rays, with no validation error. Skipped without a Vulkan device.
+// hit and for a camera's rays, and after the scene's vertices moved (the triangles kept on the
+// device are not reused); the ray queries' structure kept across traces. No validation error.
+// Skipped without a Vulkan device (the ray queries without one that has them: tools/mesa25.sh).
 #include <exception>
 #include <optional>
 #include <string>
@@ -14,6 +16,7 @@ namespace dacrt {
 namespace {
 
 using test::onBackend;
+using test::phaseNames;
 using test::sameHits;
 
 // The gpu tracer under the validation layers, or the reason there is none.
@@ -49,6 +52,76 @@ TEST(ApiGpu, SameHitsAsCpuSeq) {
     EXPECT_FALSE(image.counters.device.empty());
     EXPECT_GT(image.timings.dispatchMs, 0.0);
     EXPECT_FALSE(gpu->plan(scene, camera).memory.empty());
+    EXPECT_EQ(gpu->validationErrors(), 0u);
+}
+
+TEST(ApiGpu, ReportsItsDeviceAndTheGpuDefaultsThere) {
+    const Tracer cpu(onBackend(Backend::Cpu, 2));
+    EXPECT_FALSE(cpu.deviceProperties());
+    EXPECT_FALSE(cpu.gpuDefaults());
+    std::string why;
+    std::optional<Tracer> gpu = gpuTracer(why);
+    if (!gpu) GTEST_SKIP() << "no Vulkan device: " << why;
+    const std::optional<VulkanDeviceProperties> device = gpu->deviceProperties();
+    ASSERT_TRUE(device);
+    EXPECT_EQ(gpu->device(), device->name + " (" + device->driver + ")");
+    const std::optional<Tracer::GpuDefaults> defaults = gpu->gpuDefaults();
+    ASSERT_TRUE(defaults);
+    // What a trace with the options left open uses.
+    const test::SceneArrays s = test::randomSceneArrays(61, 500);
+    const TraceScene scene = TraceScene::fromArrays(s.positions, s.indices, s.singleSided);
+    const TraceOutput out = gpu->trace(scene, RayBatch::fromCamera(scene, {}, 64, 48));
+    EXPECT_EQ(out.counters.regions, defaults->regions);
+    ASSERT_TRUE(out.gpu);
+    EXPECT_EQ(out.gpu->rayGroups, defaults->rayGroups);
+}
+
+TEST(ApiGpu, MovedVerticesAreUploadedAgain) {
+    std::string why;
+    std::optional<Tracer> gpu = gpuTracer(why);
+    if (!gpu) GTEST_SKIP() << "no Vulkan device: " << why;
+    const test::SceneArrays s = test::randomSceneArrays(41, 2000);
+    const test::RayArrays r = test::randomRayArrays(42, 8000);
+    TraceScene scene = TraceScene::fromArrays(s.positions, s.indices, s.singleSided);
+    const RayBatch rays = RayBatch::fromArrays(r.origins, r.directions);
+    Tracer cpuSeq(onBackend(Backend::CpuSeq));
+    const std::vector<RayHit> before = cpuSeq.trace(scene, rays).hits;
+    EXPECT_TRUE(sameHits(gpu->trace(scene, rays).hits, before));
+    EXPECT_TRUE(sameHits(gpu->trace(scene, rays).hits, before));  // the triangles kept on the device
+    scene.setPositions(test::movedPositions(s.positions, 43, 0.05f));
+    const std::vector<RayHit> moved = cpuSeq.trace(scene, rays).hits;
+    EXPECT_FALSE(sameHits(moved, before));
+    EXPECT_TRUE(sameHits(gpu->trace(scene, rays).hits, moved));
+    EXPECT_EQ(gpu->validationErrors(), 0u);
+}
+
+TEST(ApiGpu, RayQueriesKeepTheirStructureAndFollowTheMove) {
+    std::string why;
+    std::optional<Tracer> gpu = gpuTracer(why);
+    if (!gpu) GTEST_SKIP() << "no Vulkan device: " << why;
+    if (!gpu->deviceProperties()->rayQuery) GTEST_SKIP() << "the device has no ray query (tools/mesa25.sh has)";
+    const test::SceneArrays s = test::randomSceneArrays(51, 1500);
+    const test::RayArrays r = test::randomRayArrays(52, 6000);
+    const std::vector<float> moved = test::movedPositions(s.positions, 53, 0.05f);
+    const RayBatch rays = RayBatch::fromArrays(r.origins, r.directions);
+    for (RayQueryBuild build : {RayQueryBuild::Dynamic, RayQueryBuild::Refit, RayQueryBuild::Static}) {
+        SCOPED_TRACE(int(build));
+        TracerOptions o = onBackend(Backend::RayQuery);
+        o.validate = true;
+        o.rayQueryBuild = build;
+        gpu->setOptions(o);
+        TraceScene scene = TraceScene::fromArrays(s.positions, s.indices, s.singleSided);
+        const TraceOutput first = gpu->trace(scene, rays);
+        EXPECT_EQ(phaseNames(first)[0], "allocate");
+        const TraceOutput again = gpu->trace(scene, rays);
+        EXPECT_NE(phaseNames(again)[0], "allocate");  // kept
+        EXPECT_TRUE(sameHits(again.hits, first.hits));
+        scene.setPositions(moved);
+        const TraceOutput followed = gpu->trace(scene, rays);
+        const TraceScene fresh = TraceScene::fromArrays(moved, s.indices, s.singleSided);
+        EXPECT_TRUE(sameHits(followed.hits, gpu->trace(fresh, rays).hits));
+        EXPECT_FALSE(sameHits(followed.hits, first.hits));
+    }
     EXPECT_EQ(gpu->validationErrors(), 0u);
 }
 

@@ -40,6 +40,21 @@ inline SceneArrays randomSceneArrays(std::uint64_t seed, std::uint32_t count) {
     return a;
 }
 
+// The positions each moved by up to `by` on each axis, as an animation's next frame moves them.
+inline std::vector<float> movedPositions(const std::vector<float>& positions, std::uint64_t seed, float by) {
+    Random random(seed);
+    std::vector<float> moved = positions;
+    for (float& c : moved) c += random.uniformFloat(-by, by);
+    return moved;
+}
+
+// The names of a trace's phases, in the order they ran.
+inline std::vector<std::string> phaseNames(const TraceOutput& out) {
+    std::vector<std::string> names;
+    for (const TraceTimings::Phase& p : out.timings.phases) names.push_back(p.name);
+    return names;
+}
+
 struct RayArrays {
     std::vector<float> origins;
     std::vector<float> directions;
@@ -87,6 +102,16 @@ inline std::size_t hitCount(const std::vector<RayHit>& hits) {
     std::size_t n = 0;
     for (const RayHit& h : hits) n += h.hit();
     return n;
+}
+
+// Expects `call` to throw InputError whose message contains `part`.
+inline void expectInputError(const std::function<void()>& call, const std::string& part) {
+    try {
+        call();
+        ADD_FAILURE() << "no InputError; expected one naming '" << part << "'";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "message: " << e.what();
+    }
 }
 
 inline TracerOptions onBackend(Backend backend, unsigned threads = 0) {
