@@ -319,6 +319,9 @@ Subcommand addCompareCommand(CLI::App& app) {
         ->check(CLI::IsMember({"differ", "any", "never"}))->default_str("never");
     cmd->add_option("--max-differing", s->maxDiffering,
                     "with --fail-on differ: pixels allowed to differ beyond near ties and tolerances")
+        // CLI11 reads -1 into the unsigned as 2^64 - 1: no limit at all.
+        ->check(CLI::Validator([](std::string& v) { return v.starts_with('-') ? "must not be negative, got " + v : std::string(); },
+                               "UINT"))
         ->default_str("0");
     cmd->add_option("--diff", s->diff, "PNG of a's surfaces with near ties in yellow and differences in red");
     return {cmd, [s] {

@@ -38,6 +38,16 @@ Camera lookAt(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3&
     return c;
 }
 
+// How far along z the default front view backs off from the scene's centre: `wanted` (the
+// scene's bounding sphere fits the view), within the coordinate limit the eye must keep too. A
+// scene within the limit but larger than the view from there is seen from the limit, in part,
+// rather than refused; behind it (a negative distance) where the other side has more room.
+double frontViewDistance(double centreZ, double wanted) {
+    if (centreZ + wanted <= kMaxCoordinate) return wanted;
+    const double front = kMaxCoordinate - centreZ, back = kMaxCoordinate + centreZ;
+    return front >= back ? front : -std::min(wanted, back);
+}
+
 }  // namespace
 
 std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const CameraOptions& options, double aspect) {
@@ -56,7 +66,7 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
         const double radius = 0.5 * glm::length(glm::dvec3(bounds.extent()));
         const double halfFov = 0.5 * std::min(yfov, 2.0 * std::atan(std::tan(0.5 * yfov) * aspect));
         const double distance = std::max(radius, 1e-6) / std::sin(halfFov) * 1.02;
-        eye = centre + glm::dvec3(0.0, 0.0, distance);
+        eye = centre + glm::dvec3(0.0, 0.0, frontViewDistance(centre.z, distance));
     }
     if (options.eye) eye = *options.eye;
     if (options.target) target = *options.target;
@@ -67,7 +77,17 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
             throw InputError("camera: the vertical field of view must lie strictly between 0 and 180 degrees, got " + std::to_string(deg));
         yfov = glm::radians(deg);
     }
-    Camera base = lookAt(eye, target, up, yfov);
+    Camera base;
+    try {
+        base = lookAt(eye, target, up, yfov);
+    } catch (const InputError& e) {  // the file's camera, or the view framing its scene: named
+        if (scene.name.empty()) throw;
+        const std::string source = options.eye || options.target ? "--eye and --target"
+                                   : fromScene ? "camera " + std::to_string(scene.camera->cameraIndex) + " of node " +
+                                                     std::to_string(scene.camera->node)
+                                               : "the front view framing the scene";
+        throw InputError(scene.name + ": " + e.what() + " (" + source + ")");
+    }
     if (fromScene && scene.camera->projection == Projection::Orthographic) {
         if (options.fovDegrees)
             throw InputError("camera: the scene's camera is orthographic, which has no field of view (--fov); give --eye or --target for a perspective view");

@@ -167,12 +167,26 @@ void AccessorReader::applySparse(const tinygltf::Accessor& acc, const Elements& 
     }
 }
 
+void AccessorReader::reserveDecoded(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const {
+    const std::uint64_t bytes = mul(count, elementBytes, what + " size");
+    const std::uint64_t total = add(decodedBytes_, bytes, what + " size");
+    if (byteLimit_ && total > byteLimit_)
+        fail(what + " has " + str(count) + " elements, which need " + str(bytes) + " bytes to read" +
+             (decodedBytes_ ? " (" + str(total) + " with the accessors read before it)" : std::string()) + ", more than the " +
+             str(byteLimit_) + "-byte limit");
+    decodedBytes_ = total;
+}
+
+bool AccessorReader::tryReserve(std::uint64_t bytes) const {
+    std::uint64_t total = 0;
+    if (__builtin_add_overflow(decodedBytes_, bytes, &total) || (byteLimit_ && total > byteLimit_)) return false;
+    decodedBytes_ = total;
+    return true;
+}
+
 std::vector<glm::dvec4> AccessorReader::readVectors(int index, std::initializer_list<int> types, const std::string& where) const {
     const Elements e = elements(index, types, where);
-    const std::uint64_t bytes = mul(e.count, sizeof(glm::dvec4), where + ": accessor " + std::to_string(index) + " size");
-    if (byteLimit_ && bytes > byteLimit_)
-        fail(where + ": accessor " + std::to_string(index) + " has " + str(e.count) + " elements, which need " + str(bytes) +
-             " bytes to read, more than the " + str(byteLimit_) + "-byte limit");
+    reserveDecoded(e.count, sizeof(glm::dvec4), where + ": accessor " + std::to_string(index));
     std::vector<glm::dvec4> out(e.count, glm::dvec4(0.0));
     if (e.data) {
         const std::uint64_t componentSize = std::uint64_t(tinygltf::GetComponentSizeInBytes(std::uint32_t(e.componentType)));
@@ -192,8 +206,7 @@ std::vector<glm::dmat4> AccessorReader::readMatrices(int index, const std::strin
     const std::string a = where + ": accessor " + std::to_string(index);
     if (e.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) fail(a + ": matrices must be float32");
     if (model_.accessors[std::size_t(index)].sparse.isSparse) fail(a + ": sparse matrices are not read");
-    const std::uint64_t bytes = mul(e.count, sizeof(glm::dmat4), a + " size");
-    if (byteLimit_ && bytes > byteLimit_) fail(a + " has " + str(e.count) + " matrices, more than the byte limit allows");
+    reserveDecoded(e.count, sizeof(glm::dmat4), a);
     std::vector<glm::dmat4> out(e.count, glm::dmat4(0.0));
     for (std::uint64_t i = 0; e.data && i < e.count; ++i)
         for (int c = 0; c < 16; ++c)
@@ -214,6 +227,7 @@ std::vector<std::uint32_t> AccessorReader::readIndices(int index, const std::str
         return out;
     }
     const Elements e = elements(index, {TINYGLTF_TYPE_SCALAR}, where);
+    reserveDecoded(e.count, sizeof(std::uint32_t), where + ": accessor " + std::to_string(index));
     std::vector<std::uint32_t> out(e.count);
     for (std::uint64_t i = 0; i < e.count; ++i)
         out[i] = std::uint32_t(readComponent(e.data + i * e.stride, e.componentType, false));

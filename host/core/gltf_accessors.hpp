@@ -48,9 +48,15 @@ public:
     // The bytes of a buffer view: the buffer's, or what EXT_meshopt_compression decoded.
     std::span<const unsigned char> viewBytes(int view, const std::string& where) const;
 
-    // The most bytes one accessor's decoded elements may take (each element is a dvec4, 32
-    // bytes); 0: no limit. A view-less accessor's count is bounded by nothing else.
+    // The most bytes the decoded elements of every accessor read may take together (a vector
+    // element is a dvec4, 32 bytes; the document keeps what it reads); 0: no limit. A view-less
+    // accessor's count is bounded by nothing else, and morph targets or joint sets may share
+    // one: each read counts.
     void setByteLimit(std::uint64_t bytes) { byteLimit_ = bytes; }
+    std::uint64_t byteLimit() const { return byteLimit_; }
+    // Counts `bytes` of other decoded data the document keeps (images) against the same limit;
+    // false, counting nothing, when they would pass it.
+    bool tryReserve(std::uint64_t bytes) const;
 
     // Decoded contents for a buffer view (EXT_meshopt_compression), used instead of its buffer.
     void setDecodedView(int view, std::vector<unsigned char> bytes) { decodedViews_[view] = std::move(bytes); }
@@ -69,6 +75,9 @@ private:
         bool normalized = false;
     };
     Elements elements(int index, std::initializer_list<int> types, const std::string& where) const;
+    // Counts `count` decoded elements of `elementBytes` against the byte limit, before they are
+    // allocated; refuses them, naming `what`, past it.
+    void reserveDecoded(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const;
     void applySparse(const tinygltf::Accessor& acc, const Elements& e, const std::string& where,
                      std::vector<glm::dvec4>& out) const;
 
@@ -77,6 +86,7 @@ private:
     const ContainerRewrites& rewrites_;
     std::map<int, std::vector<unsigned char>> decodedViews_;
     std::uint64_t byteLimit_ = 0;
+    mutable std::uint64_t decodedBytes_ = 0;  // by every read so far (reads are const: they change no model data)
 };
 
 // Members of extension objects, which tinygltf leaves as generic JSON values:

@@ -110,6 +110,19 @@ std::vector<AnimationChannel> readChannels(const AccessorReader& reader, const t
     return channels;
 }
 
+// Key times must increase strictly; an accessor without a view is zeros but for its sparse
+// values, so more than one key beyond those cannot increase. Refused before its declared count
+// is allocated.
+void checkKeyCount(const AccessorReader& reader, int input, const std::string& w) {
+    const std::uint64_t keys = reader.checkedCount(input, {TINYGLTF_TYPE_SCALAR}, w);
+    if (!reader.hasNoView(input)) return;  // its count is bounded by its view's bytes
+    const tinygltf::Accessor& acc = reader.model().accessors[std::size_t(input)];
+    const std::uint64_t set = acc.sparse.isSparse ? std::uint64_t(std::max(acc.sparse.count, 0)) : 0;
+    if (keys > set + 1)
+        reader.fail(w + ": accessor " + std::to_string(input) + " has no buffer view and " + str(set) + " sparse values, so its " +
+                    str(keys) + " key times cannot increase strictly");
+}
+
 // A sampler as its channels read it (`path`, `width` numbers per key): key times finite and
 // strictly increasing, as many finite values as the keys need.
 AnimationSampler readSampler(const AccessorReader& reader, const tinygltf::AnimationSampler& src, AnimatedPath path,
@@ -120,6 +133,7 @@ AnimationSampler readSampler(const AccessorReader& reader, const tinygltf::Anima
     else if (src.interpolation == "STEP") out.interpolation = Interpolation::Step;
     else if (src.interpolation == "CUBICSPLINE") out.interpolation = Interpolation::CubicSpline;
     else reader.fail(w + ": interpolation '" + src.interpolation + "' is none of STEP, LINEAR, CUBICSPLINE");
+    checkKeyCount(reader, src.input, w + " input");
     for (const glm::dvec4& v : reader.readVectors(src.input, {TINYGLTF_TYPE_SCALAR}, w + " input")) out.times.push_back(v.x);
     if (out.times.empty()) reader.fail(w + ": the input accessor has no keys");
     for (std::size_t k = 0; k < out.times.size(); ++k) {
@@ -130,11 +144,12 @@ AnimationSampler readSampler(const AccessorReader& reader, const tinygltf::Anima
     }
     const bool scalar = path == AnimatedPath::Weights;
     const int type = scalar ? TINYGLTF_TYPE_SCALAR : out.width == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3;
-    const std::vector<glm::dvec4> values = reader.readVectors(src.output, {type}, w + " output");
     const std::size_t perKey = (scalar ? out.width : 1) * (out.interpolation == Interpolation::CubicSpline ? 3 : 1);
-    if (values.size() != out.times.size() * perKey)
-        reader.fail(w + ": the output accessor has " + str(values.size()) + " elements; " + str(out.times.size()) +
-                    " keys need " + str(out.times.size() * perKey));
+    // Counted before read: a view-less output's count is declared, not bounded by its bytes.
+    if (const std::uint64_t count = reader.checkedCount(src.output, {type}, w + " output"); count != out.times.size() * perKey)
+        reader.fail(w + ": the output accessor has " + str(count) + " elements; " + str(out.times.size()) + " keys need " +
+                    str(out.times.size() * perKey));
+    const std::vector<glm::dvec4> values = reader.readVectors(src.output, {type}, w + " output");
     for (const glm::dvec4& v : values)
         for (std::size_t c = 0; c < (scalar ? 1 : out.width); ++c) {
             if (!std::isfinite(v[int(c)])) reader.fail(w + ": the output has a non-finite number");

@@ -65,12 +65,16 @@ bool hasMeshoptFallback(const json& buffer) {
 
 }  // namespace
 
-PreparedContainer prepareForParser(std::span<const unsigned char> bytes) {
+json parseGltfJson(std::span<const unsigned char> bytes) {
+    GlbParts glb;
+    const std::string_view text = splitGlb(bytes, glb) ? glb.json : std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    return json::parse(text.begin(), text.end(), nullptr, false);
+}
+
+PreparedContainer prepareForParser(std::span<const unsigned char> bytes, json doc) {
     PreparedContainer prepared;
     GlbParts glb;
     const bool isGlb = splitGlb(bytes, glb);
-    const std::string_view text = isGlb ? glb.json : std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-    json doc = json::parse(text.begin(), text.end(), nullptr, false);
     if (doc.is_discarded() || !doc.is_object()) return prepared;
 
     bool changed = false;

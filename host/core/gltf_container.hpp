@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 namespace dacrt::gltf {
 
 struct ContainerRewrites {
@@ -19,8 +21,12 @@ struct PreparedContainer {
     ContainerRewrites rewrites;
 };
 
-// bytes: a .glb or the text of a .gltf whose JSON parses (anything else is left for the parser
-// to refuse: nothing is rewritten).
-PreparedContainer prepareForParser(std::span<const unsigned char> bytes);
+// The JSON of a .glb (its first chunk, when the header is consistent) or of a .gltf's text;
+// discarded when it does not parse (the parser then says why).
+nlohmann::json parseGltfJson(std::span<const unsigned char> bytes);
+
+// bytes: a .glb or the text of a .gltf, and `doc`, its JSON (parseGltfJson); a file whose JSON
+// does not parse is left for the parser to refuse: nothing is rewritten.
+PreparedContainer prepareForParser(std::span<const unsigned char> bytes, nlohmann::json doc);
 
 }  // namespace dacrt::gltf

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string_view>
 
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -23,6 +24,7 @@
 #include "core/gltf_animation.hpp"
 #include "core/gltf_compression.hpp"
 #include "core/gltf_container.hpp"
+#include "core/gltf_json_rules.hpp"
 #include "core/gltf_materials.hpp"
 #include "core/input_file.hpp"
 #include "core/json_nesting.hpp"
@@ -76,6 +78,13 @@ void checkJsonNesting(std::span<const unsigned char> bytes, const std::string& n
     if (n.depth > limits.maxJsonNesting)
         throw InputError(name + ": the JSON nests objects and arrays more than " + str(limits.maxJsonNesting) +
                          " levels deep (at byte " + str(n.offset) + "); no glTF needs that many");
+}
+
+// tinygltf reads a .glb's version and ignores it; a version other than 2 is another format.
+void checkGlbVersion(std::span<const unsigned char> bytes, const std::string& name) {
+    if (!isBinaryGltf(bytes) || bytes.size() < 8) return;  // a short header is the parser's to refuse
+    if (const std::uint32_t version = readU32(bytes, 4); version != 2)
+        throw InputError(name + ": the GLB header's version is " + str(version) + ", not 2 (glTF 2.0's binary container)");
 }
 
 // ---- parsing ----------------------------------------------------------------------------
@@ -618,10 +627,11 @@ private:
                 auto a = prim.targets[t].find(name);
                 if (a == prim.targets[t].end()) continue;
                 const std::string w = where + " morph target " + str(t) + " " + name;
-                std::vector<glm::dvec4> offsets = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3}, w);
-                if (offsets.size() != vertices)
-                    check_.fail(w + ": accessor " + std::to_string(a->second) + " has " + str(offsets.size()) +
+                // Counted before read: a target's count is declared, not bounded by its bytes.
+                if (const std::uint64_t count = reader_.checkedCount(a->second, {TINYGLTF_TYPE_VEC3}, w); count != vertices)
+                    check_.fail(w + ": accessor " + std::to_string(a->second) + " has " + str(count) +
                                 " elements, POSITION has " + str(vertices));
+                std::vector<glm::dvec4> offsets = reader_.readVectors(a->second, {TINYGLTF_TYPE_VEC3}, w);
                 data.attributes["TARGET" + std::to_string(t) + ":" + name] = std::move(offsets);
             }
         return document_.primitives.emplace(key, std::move(data)).first->second;
@@ -669,13 +679,18 @@ private:
         return out;
     }
 
-    // Any node's world transform at this instant (a joint may lie outside the loaded scene).
+    // Any node's world transform at this instant (a joint may lie outside the loaded scene, so
+    // its chain of ancestors is unbounded by the scene's depth limit): up the chain to the first
+    // ancestor already known, then down it, without recursion.
     const glm::dmat4& nodeWorld(std::size_t node) {
         if (worlds_.empty()) worlds_.resize(model_.nodes.size());
-        if (!worlds_[node]) {
-            const glm::dmat4 local = localTransform(model_.nodes[node], pose_[node]);
-            const int parent = document_.parent[node];
-            worlds_[node] = parent < 0 ? glm::dmat4(1.0) * local : nodeWorld(std::size_t(parent)) * local;
+        std::vector<std::size_t> chain;  // the node and its ancestors not yet known, nearest first
+        for (int at = int(node); at >= 0 && !worlds_[std::size_t(at)]; at = document_.parent[std::size_t(at)])
+            chain.push_back(std::size_t(at));
+        for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+            const glm::dmat4 local = localTransform(model_.nodes[*it], pose_[*it]);
+            const int parent = document_.parent[*it];
+            worlds_[*it] = parent < 0 ? glm::dmat4(1.0) * local : *worlds_[std::size_t(parent)] * local;
         }
         return *worlds_[node];
     }
@@ -1012,7 +1027,10 @@ std::unique_ptr<GltfDocument::Impl> openDocument(std::span<const unsigned char> 
     auto d = std::make_unique<GltfDocument::Impl>();
     d->name = name;
     d->limits = limits;
-    d->prepared = gltf::prepareForParser(bytes);
+    checkGlbVersion(bytes, name);
+    nlohmann::json json = gltf::parseGltfJson(bytes);
+    if (!json.is_discarded()) gltf::checkJsonRules(json, name);
+    d->prepared = gltf::prepareForParser(bytes, std::move(json));
     d->model = parseGltf(d->prepared.bytes.empty() ? bytes : std::span<const unsigned char>(d->prepared.bytes), name, baseDir,
                          readFiles);
     d->prepared.bytes = {};  // parsed: only the rewrites are read from here on

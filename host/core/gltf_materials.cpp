@@ -46,8 +46,11 @@ std::string percentDecoded(const std::string& uri) {
 }
 
 // Decodes to 8-bit RGBA (grey expands to RGB, alpha 255 where absent); empty with `why` set
-// when it cannot.
-Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mimeType, std::string& why) {
+// when it cannot. Its RGBA bytes are counted against the reader's limit (with every accessor
+// and image decoded before it) before its pixels are read: many images, each under the
+// per-image limit, are as many allocations.
+Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mimeType, const AccessorReader& budget,
+                    std::string& why) {
     Texture t;
     const char* ext = formatExtension(bytes, mimeType);
     if (!*ext) {
@@ -71,6 +74,11 @@ Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mim
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || texels * 4 > kMaxTextureBytes) {
         why = "its size " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " is empty or over the " +
               std::to_string(kMaxTextureBytes >> 20) + " MiB texture limit";
+        return t;
+    }
+    if (!budget.tryReserve(texels * 4)) {
+        why = "its " + std::to_string(texels * 4) + " bytes decoded, with the file's data decoded before it, are more than the " +
+              std::to_string(budget.byteLimit()) + "-byte memory limit";
         return t;
     }
     const int channels = spec.nchannels;
@@ -213,7 +221,7 @@ private:
         }
         int result = -1;
         if (why.empty()) {
-            Texture t = decodeImage(bytes, img.mimeType, why);
+            Texture t = decodeImage(bytes, img.mimeType, reader_, why);
             if (why.empty()) {
                 t.name = img.name.empty() ? "image " + std::to_string(image) : img.name;
                 result = int(scene_.textures.size());

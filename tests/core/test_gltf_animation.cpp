@@ -304,7 +304,7 @@ TEST(GltfAnimation, BrokenAnimationsAreRefusedWithWhatIsWrong) {
     refused([](Document& d) { animate(d, "a", 0, "translation", "SMOOTH", {0, 1}, {0, 0, 0, 1, 0, 0}); },
             "interpolation 'SMOOTH' is none of STEP, LINEAR, CUBICSPLINE");
     refused([](Document& d) { animate(d, "a", 3, "translation", "LINEAR", {0, 1}, {0, 0, 0, 1, 0, 0}); },
-            "targets node 3, which does not exist");
+            "animations[0].channels[0].target.node 3 is out of range (1 node)");
     refused([](Document& d) { animate(d, "a", 0, "weights", "LINEAR", {0, 1}, {0, 1}); },
             "whose mesh has no morph targets");
     refused([](Document& d) { animate(d, "a", 0, "rotation", "LINEAR", {0, 1}, {0, 0, 0, 1, 0, 0, 0, 2}); },
@@ -322,12 +322,53 @@ TEST(GltfAnimation, BrokenAnimationsAreRefusedWithWhatIsWrong) {
 TEST(GltfAnimation, BrokenSkinsAreRefusedWithWhatIsWrong) {
     Document d = skinnedDocument({0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0});
     d["skins"][0]["joints"] = {1, 9};
-    EXPECT_NE(refusal(d.finish()).find("skin 0 names joint node 9, which does not exist"), std::string::npos) << refusal(d.finish());
+    EXPECT_NE(refusal(d.finish()).find("skins[0].joints[1] 9 is out of range (3 nodes)"), std::string::npos) << refusal(d.finish());
     Document j = skinnedDocument({0, 0, 1, 0, 0, 1, 0, 0, 0, 1, 0, 0});  // the first vertex's weight on joint slot 2 (joint 0)
     j["skins"][0]["joints"] = {1};
     EXPECT_NE(refusal(j.finish()).find("names joint 1.000000; the skin has 1"), std::string::npos) << refusal(j.finish());
     Document n = skinnedDocument({0, -1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0});
     EXPECT_NE(refusal(n.finish()).find("vertex 0 has a negative or non-finite skin weight"), std::string::npos) << refusal(n.finish());
+}
+
+TEST(GltfAnimation, AJointAtTheEndOfADeepChainOutsideTheSceneIsPlacedWithoutRecursion) {
+    // Joint 1 hangs below 200,000 nodes that no scene lists (a skin's joints need not be in the
+    // scene): its world transform is the chain's, here the identity, so the rest pose holds.
+    Document d = skinnedDocument({0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0});
+    constexpr int kChain = 200000;
+    for (int i = 0; i < kChain; ++i) d["nodes"].push_back({{"children", {i + 1 < kChain ? 3 + i + 1 : 1}}});
+    d["scenes"] = {{{"nodes", {0}}}};
+    d["animations"] = json::array();
+    const Scene s = sceneAt(d.finish(), 0.0);
+    expectVertex(s.triangles[0].v0, 0, 2, 0, 1e-6);
+}
+
+TEST(GltfAnimation, DeclaredCountsWithoutBytesAreRefusedBeforeTheyAreRead) {
+    // Key times in an accessor without a view are zeros: a billion of them cannot increase.
+    Document keys = triangleDocument();
+    animate(keys, "a", 0, "translation", "LINEAR", {0, 1}, {0, 0, 0, 1, 0, 0});
+    json doc = keys.finish();
+    doc["accessors"].push_back({{"componentType", 5126}, {"count", 1000000000}, {"type", "SCALAR"}});
+    doc["animations"][0]["samplers"][0]["input"] = doc["accessors"].size() - 1;
+    EXPECT_NE(refusal(doc).find("has no buffer view and 0 sparse values, so its 1000000000 key times cannot increase strictly"),
+              std::string::npos)
+        << refusal(doc);
+    // 1,000 morph targets sharing one view-less accessor of the vertex count: each read counts
+    // against the limit, which one alone would pass.
+    Document morph = triangleDocument();
+    json many = morph.finish();
+    many["accessors"].push_back({{"componentType", 5126}, {"count", 3}, {"type", "VEC3"}});
+    many["meshes"][0]["primitives"][0]["targets"] = json::array();
+    for (int t = 0; t < 1000; ++t) many["meshes"][0]["primitives"][0]["targets"].push_back({{"POSITION", many["accessors"].size() - 1}});
+    const std::string text = many.dump();
+    GltfLimits limits;
+    limits.maxBytes = 20000;  // the scene's plan and any one target fit
+    try {
+        loadGltfFromMemory({reinterpret_cast<const unsigned char*>(text.data()), text.size()}, "morph.gltf", limits);
+        FAIL() << "1,000 targets were read past the limit";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("with the accessors read before it), more than the 20000-byte limit"), std::string::npos)
+            << e.what();
+    }
 }
 
 TEST(GltfAnimation, ATimeThatIsNotFiniteIsRefused) {

@@ -407,6 +407,30 @@ TEST(GltfFeatures, OrthographicRaysShareADirectionAndStartOnTheViewPlane) {
     EXPECT_THROW(makeCameras(s, sceneBounds(s.triangles), fov, 1.0), InputError);
 }
 
+TEST(GltfFeatures, ViewsOfAScenesCoordinatesStayWithinTheLimitOrNameTheFile) {
+    // A flat quad 1.8e9 across, within the 1e9 limit: the front view framing it would stand at
+    // z = 3.4e9; it stands at the limit instead.
+    std::ifstream quad(fixture("quad_u8_camera.gltf"));
+    nlohmann::json j = nlohmann::json::parse(quad);
+    j["nodes"] = {{{"mesh", 0}, {"scale", {9e8, 9e8, 1}}}};
+    j["scenes"] = {{{"nodes", {0}}}};
+    j.erase("cameras");
+    const Scene flat = loadJson(j, "flat.gltf");
+    const std::vector<Camera> front = makeCameras(flat, sceneBounds(flat.triangles), {}, 4.0 / 3.0);
+    EXPECT_EQ(front[0].eye.z, kMaxCoordinate);
+    // The scene's own camera beyond the limit: refused naming the file and the camera.
+    j = nlohmann::json::parse(std::ifstream(fixture("quad_u8_camera.gltf")));
+    j["nodes"][1]["translation"] = {0, 0, 3e9};
+    const Scene far = loadJson(j, "far.gltf");
+    try {
+        makeCameras(far, sceneBounds(far.triangles), {}, 1.0);
+        FAIL() << "a camera outside the coordinate limit was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("far.gltf: camera: eye (0, 0, 3e+09) lies outside +-1e9"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("(camera 0 of node 1)"), std::string::npos) << e.what();
+    }
+}
+
 TEST(GltfFeatures, SpecularGlossinessMaterialsShowTheirDiffuseColour) {
     // Older files (Khronos' glTF-pbrSpecularGlossiness samples) require the archived
     // extension; its diffuse texture and factor are the preview's base colour.

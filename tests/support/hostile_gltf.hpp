@@ -55,7 +55,7 @@ inline std::vector<HostileGltf> hostileGltfFiles() {
              j["cameras"][0]["perspective"]["znear"] = 2.0;
              j["cameras"][0]["perspective"]["zfar"] = 1.0;
          })},
-        {"NodeNamesAMissingCamera", "names camera 7, which does not exist",
+        {"NodeNamesAMissingCamera", "nodes[1].camera 7 is out of range (1 camera)",
          changed([](nlohmann::json& j) { j["nodes"][1]["camera"] = 7; })},
         {"ByteStrideBelowTheElement", "smaller than the 12-byte elements",
          changed([](nlohmann::json& j) { j["bufferViews"][0]["byteStride"] = 4; })},
@@ -100,7 +100,7 @@ inline std::vector<HostileGltf> hostileGltfFiles() {
              j["bufferViews"][0]["extensions"] = {{"EXT_meshopt_compression",
                                                    {{"buffer", 0}, {"byteLength", 48}, {"byteStride", 12}, {"count", 4}, {"mode", "ATTRIBUTES"}}}};
          })},
-        {"DracoViewMissing", "buffer view 9 does not exist", changed([](nlohmann::json& j) {
+        {"DracoViewMissing", "KHR_draco_mesh_compression.bufferView 9 is out of range (2 bufferViews)", changed([](nlohmann::json& j) {
              j["extensionsUsed"] = {"KHR_draco_mesh_compression"};
              j["meshes"][0]["primitives"][0]["extensions"] = {
                  {"KHR_draco_mesh_compression", {{"bufferView", 9}, {"attributes", {{"POSITION", 0}}}}}};
@@ -110,7 +110,7 @@ inline std::vector<HostileGltf> hostileGltfFiles() {
              j["meshes"][0]["primitives"][0]["extensions"] = {
                  {"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", 0}}}}}};
          })},
-        {"TextureNamesAMissingImage", "names image 4, which does not exist", changed([](nlohmann::json& j) {
+        {"TextureNamesAMissingImage", "textures[0].source 4 is out of range (0 images)", changed([](nlohmann::json& j) {
              j["textures"] = {{{"source", 4}}};
              j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
          })},
@@ -120,9 +120,56 @@ inline std::vector<HostileGltf> hostileGltfFiles() {
              j["textures"] = {{{"source", 0}}};
              j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
          })},
-        {"LightThatDoesNotExist", "names a light that does not exist", changed([](nlohmann::json& j) {
+        {"LightThatDoesNotExist", "nodes[1].extensions.KHR_lights_punctual.light 3 is out of range (0 lights)", changed([](nlohmann::json& j) {
              j["nodes"][1]["extensions"] = {{"KHR_lights_punctual", {{"light", 3}}}};
          })},
+        // The specification's index, integer and type rules, checked on the JSON (tinygltf casts
+        // an index to int, so 2^32 read as 0, and skips a member of the wrong type).
+        {"MaterialTextureOutOfRange", "materials[0].pbrMetallicRoughness.baseColorTexture.index 7 is out of range (1 texture)",
+         changed([](nlohmann::json& j) {
+             j["textures"] = {{{"source", 0}}};
+             j["images"] = {{{"uri", "missing.png"}}};
+             j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 7}};
+         })},
+        {"NormalTextureOutOfRange", "materials[0].normalTexture.index 2 is out of range (0 textures)",
+         changed([](nlohmann::json& j) { j["materials"][0]["normalTexture"] = {{"index", 2}}; })},
+        {"TextureSamplerOutOfRange", "textures[0].sampler 1 is out of range (0 samplers)",
+         changed([](nlohmann::json& j) { j["textures"] = {{{"sampler", 1}}}; })},
+        {"LightIndexFractional", "nodes[1].extensions.KHR_lights_punctual.light 0.5 is not an integer",
+         changed([](nlohmann::json& j) {
+             j["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "point"}}}}}}};
+             j["nodes"][1]["extensions"] = {{"KHR_lights_punctual", {{"light", 0.5}}}};
+         })},
+        {"MeshIndex2To32", "nodes[0].mesh 4294967296 is out of range (1 mesh)",
+         changed([](nlohmann::json& j) { j["nodes"][0]["mesh"] = std::uint64_t(1) << 32; })},
+        {"MeshIndexFractional", "nodes[0].mesh 0.5 is not an integer", changed([](nlohmann::json& j) { j["nodes"][0]["mesh"] = 0.5; })},
+        {"ByteOffsetNegative", "bufferViews[1].byteOffset -48 is negative",
+         changed([](nlohmann::json& j) { j["bufferViews"][1]["byteOffset"] = -48; })},
+        {"ComponentTypeWraps", "accessors[1].componentType 4294972417 is larger than 2147483647",
+         changed([](nlohmann::json& j) { j["accessors"][1]["componentType"] = (std::uint64_t(1) << 32) + 5121; })},
+        {"ExtensionsRequiredNotAnArray", "extensionsRequired is not an array",
+         changed([](nlohmann::json& j) { j["extensionsRequired"] = "EXT_unheard_of_geometry"; })},
+        {"ExtensionsUsedHoldsANumber", "extensionsUsed[0] 7 is not a string",
+         changed([](nlohmann::json& j) { j["extensionsUsed"] = {7}; })},
+        {"EmptyScenesWithADefault", "scene 0 is out of range (0 scenes)", changed([](nlohmann::json& j) {
+             j["scenes"] = nlohmann::json::array();
+             j["scene"] = 0;
+         })},
+        {"AnimationTargetsAMissingNode", "animations[0].channels[0].target.node 9 is out of range (2 nodes)",
+         changed([](nlohmann::json& j) {
+             j["animations"] = {{{"channels", {{{"sampler", 0}, {"target", {{"node", 9}, {"path", "translation"}}}}}},
+                                 {"samplers", {{{"input", 0}, {"output", 0}}}}}};
+         })},
+        {"AnimationChannelNamesAMissingSampler", "animations[0].channels[0].sampler 1 is out of range (1 sampler)",
+         changed([](nlohmann::json& j) {
+             j["animations"] = {{{"channels", {{{"sampler", 1}, {"target", {{"node", 0}, {"path", "translation"}}}}}},
+                                 {"samplers", {{{"input", 0}, {"output", 0}}}}}};
+         })},
+        {"GlbVersion1", "the GLB header's version is 1, not 2", [] {
+             const std::string json = quadGltf().dump() + std::string((4 - quadGltf().dump().size() % 4) % 4, ' ');
+             auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+             return "glTF" + u32(1) + u32(std::uint32_t(20 + json.size())) + u32(std::uint32_t(json.size())) + "JSON" + json;
+         }},
         {"SceneListsANodeTwice", "twice", changed([](nlohmann::json& j) { j["scenes"][0]["nodes"] = {0, 0, 1}; })},
         {"RootIsAChild", "is a root of scene 0 but a child",
          changed([](nlohmann::json& j) { j["nodes"][1]["children"] = {0}; })},

@@ -1,0 +1,389 @@
+#!/usr/bin/env python3
+"""The hostile corpus of issue 29: malformed glTF files and command lines, made here from
+tests/scenes/quad_u8_camera.gltf, each run through `dacrt` and checked to end as documented
+(docs/gltf-input.md, README "Exit codes"):
+
+- bad input: exit 2, exactly one "dacrt: error:" line, nothing traced ("trace" never printed)
+  and no output file;
+- bad command line (refused by the option parser): exit 2, nothing traced, no output file;
+- failed writes (a full device, the file size limit): a non-zero exit naming the file, and no
+  output file or temporary left behind;
+- files that must load (a joint below a deep chain outside the scene, a flat scene as large as
+  the coordinate limit): exit 0 and the image written.
+
+    tests/hostile/run_corpus.py --dacrt build/dacrt [--work DIR] [--keep] [--list]
+
+Each case is reported by name; the exit status is 1 when any case fails. Cases are small
+(8x6 pixels) and run two at a time.
+"""
+import argparse
+import base64
+import concurrent.futures
+import copy
+import json
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+QUAD = os.path.join(HERE, "..", "scenes", "quad_u8_camera.gltf")
+SIZE = ["--size", "8x6"]
+
+
+class Case:
+    """One run: `files` (name -> bytes) written to its own folder, `args` for dacrt (the folder's
+    paths written as {dir}/NAME), and how it must end: 'input', 'usage', 'write' or 'ok'."""
+
+    def __init__(self, name, kind, args, files=None, shell_prefix="", setup=None, outputs=("out.png",)):
+        self.name, self.kind, self.args = name, kind, args
+        self.files = files or {}
+        self.shell_prefix = shell_prefix  # e.g. "ulimit -f 1;" run through bash
+        self.setup = setup                # called with the folder before the run (FIFOs, links, folders)
+        self.outputs = outputs            # names that must not exist after a refused run
+
+
+# ---- the base documents ---------------------------------------------------------------------
+
+def quad():
+    with open(QUAD) as f:
+        return json.load(f)
+
+
+def rich():
+    """The quad with one of everything an index can name: a texture with its sampler and image
+    (missing: a warning), every textureInfo, a light, a skin, an animation, a morph target."""
+    j = quad()
+    j["samplers"] = [{"magFilter": 9728}]
+    j["images"] = [{"uri": "missing.png"}]
+    j["textures"] = [{"sampler": 0, "source": 0}]
+    m = j["materials"][0]
+    m["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+    m["pbrMetallicRoughness"]["metallicRoughnessTexture"] = {"index": 0}
+    for t in ("normalTexture", "occlusionTexture", "emissiveTexture"):
+        m[t] = {"index": 0}
+    j["extensionsUsed"] = ["KHR_lights_punctual"]
+    j["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1}]}}
+    j["nodes"][1].setdefault("extensions", {})["KHR_lights_punctual"] = {"light": 0}
+    # One key (the first float of the positions, -1 s) translating node 0 by the first vertex.
+    j["accessors"].append({"bufferView": 0, "componentType": 5126, "count": 1, "type": "SCALAR"})
+    j["accessors"].append({"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC3"})
+    j["animations"] = [{"channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+                        "samplers": [{"input": 2, "output": 3}]}]
+    j["skins"] = [{"joints": [0], "skeleton": 0}]
+    j["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": 0}]
+    j["meshes"][0]["weights"] = [0.0]
+    return j
+
+
+def dump(j):
+    return json.dumps(j).encode()
+
+
+def glb(j, version=2):
+    text = json.dumps(j).encode()
+    text += b" " * ((4 - len(text) % 4) % 4)
+    return b"glTF" + struct.pack("<III", version, 20 + len(text), len(text)) + struct.pack("<I", 0x4E4F534A) + text
+
+
+def render(scene="scene.gltf", *extra):
+    return ["render", "{dir}/" + scene] + SIZE + ["-o", "{dir}/out.png"] + list(extra)
+
+
+def at(j, path):
+    """The container of the member `path` ("a.0.b") names, and the member's key."""
+    parts = [int(p) if p.isdigit() else p for p in path.split(".")]
+    for p in parts[:-1]:
+        j = j[p]
+    return j, parts[-1]
+
+
+def with_value(base, path, value):
+    j = copy.deepcopy(base)
+    container, key = at(j, path)
+    container[key] = value
+    return dump(j)
+
+
+# ---- the classes ----------------------------------------------------------------------------
+
+# Every index the rich document holds, with the size of the array it names.
+INDEX_FIELDS = [
+    "scene", "scenes.0.nodes.0", "nodes.0.mesh", "nodes.1.camera", "nodes.1.extensions.KHR_lights_punctual.light",
+    "meshes.0.primitives.0.indices", "meshes.0.primitives.0.material", "meshes.0.primitives.0.attributes.POSITION",
+    "meshes.0.primitives.0.targets.0.POSITION", "accessors.0.bufferView", "accessors.1.bufferView", "bufferViews.0.buffer",
+    "bufferViews.1.buffer", "textures.0.sampler", "textures.0.source", "materials.0.pbrMetallicRoughness.baseColorTexture.index",
+    "materials.0.pbrMetallicRoughness.metallicRoughnessTexture.index", "materials.0.normalTexture.index",
+    "materials.0.occlusionTexture.index", "materials.0.emissiveTexture.index", "skins.0.joints.0", "skins.0.skeleton",
+    "animations.0.channels.0.sampler", "animations.0.channels.0.target.node", "animations.0.samplers.0.input",
+    "animations.0.samplers.0.output",
+]
+# Indices that the rich document leaves absent, added (out of range) one at a time.
+ADDED_INDEX_FIELDS = {
+    "nodes.0.skin": None, "nodes.0.children": "list", "skins.0.inverseBindMatrices": None, "images.0.bufferView": None,
+    "textures.0.extensions": {"EXT_texture_webp": "source"},
+}
+# Integers that are not indices: (path, C++ type the parser keeps it in).
+INTEGER_FIELDS = [
+    "accessors.0.byteOffset", "accessors.0.count", "accessors.0.componentType", "accessors.1.count",
+    "bufferViews.0.byteOffset", "bufferViews.0.byteLength", "bufferViews.0.byteStride", "bufferViews.1.byteLength",
+    "buffers.0.byteLength", "meshes.0.primitives.0.mode", "samplers.0.magFilter", "samplers.0.wrapS",
+    "materials.0.pbrMetallicRoughness.baseColorTexture.texCoord", "materials.0.normalTexture.texCoord",
+]
+COLLECTIONS = ["accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials", "meshes", "nodes",
+               "samplers", "scenes", "skins", "textures"]
+
+
+def spec_rule_cases():
+    base = rich()
+    cases = [Case("base_document_with_every_indexed_object_renders", "ok", render(), {"scene.gltf": dump(base)})]
+    for path in INDEX_FIELDS:
+        slug = path.replace(".", "_")
+        target_size = 1000  # past any array of the rich document
+        for label, value in [("OutOfRange", target_size), ("Negative", -1), ("Fractional", 0.5), ("Wraps2To32", 2 ** 32),
+                             ("String", "0")]:
+            cases.append(Case(f"index_{slug}_{label}", "input", render(),
+                              {"scene.gltf": with_value(base, path, value)}))
+    for path, shape in ADDED_INDEX_FIELDS.items():
+        slug = path.replace(".", "_")
+        for label, value in [("OutOfRange", 1000), ("Wraps2To32", 2 ** 32 + 1)]:
+            if shape == "list":
+                v = [value]
+            elif isinstance(shape, dict):
+                v = {ext: {member: value} for ext, member in shape.items()}
+            else:
+                v = value
+            cases.append(Case(f"index_{slug}_{label}", "input", render(), {"scene.gltf": with_value(base, path, v)}))
+    for path in INTEGER_FIELDS:
+        slug = path.replace(".", "_")
+        for label, value in [("Negative", -4), ("Fractional", 4.5), ("Past2To64", 2.0 ** 70), ("String", "4")]:
+            cases.append(Case(f"integer_{slug}_{label}", "input", render(), {"scene.gltf": with_value(base, path, value)}))
+    for c in COLLECTIONS:
+        for label, value in [("Object", {}), ("Number", 3), ("ArrayOfNumbers", [1, 2])]:
+            cases.append(Case(f"type_{c}_{label}", "input", render(), {"scene.gltf": with_value(base, c, value)}))
+    for member in ("extensionsUsed", "extensionsRequired"):
+        for label, value in [("String", "KHR_lights_punctual"), ("Object", {"a": 1}), ("ArrayOfNumbers", [7])]:
+            cases.append(Case(f"type_{member}_{label}", "input", render(), {"scene.gltf": with_value(base, member, value)}))
+    cases.append(Case("type_material_pbr_is_array", "input", render(),
+                      {"scene.gltf": with_value(base, "materials.0.pbrMetallicRoughness", [])}))
+    cases.append(Case("type_primitive_attributes_is_array", "input", render(),
+                      {"scene.gltf": with_value(base, "meshes.0.primitives.0.attributes", [0])}))
+    empty = copy.deepcopy(base)
+    empty["scenes"], empty["scene"] = [], 0
+    cases.append(Case("scenes_empty_with_default", "input", render(), {"scene.gltf": dump(empty)}))
+    for version in (0, 1, 3, 2 ** 32 - 1):
+        cases.append(Case(f"glb_version_{version}", "input", render("scene.glb"), {"scene.glb": glb(quad(), version)}))
+    return cases
+
+
+def declared_size_cases():
+    cases = []
+    # A billion key times in an accessor without a view: zeros, which cannot increase.
+    j = rich()
+    j["accessors"].append({"componentType": 5126, "count": 1000000000, "type": "SCALAR"})
+    j["animations"][0]["samplers"][0]["input"] = len(j["accessors"]) - 1
+    cases.append(Case("declared_viewless_animation_keys", "input", render(), {"scene.gltf": dump(j)}))
+    # An output accessor of a billion elements for one key.
+    j = rich()
+    j["accessors"].append({"componentType": 5126, "count": 1000000000, "type": "VEC3"})
+    j["animations"][0]["samplers"][0]["output"] = len(j["accessors"]) - 1
+    cases.append(Case("declared_viewless_animation_outputs", "input", render(), {"scene.gltf": dump(j)}))
+    # A morph target of a billion elements (the positions have 4).
+    j = rich()
+    j["accessors"].append({"componentType": 5126, "count": 1000000000, "type": "VEC3"})
+    j["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": len(j["accessors"]) - 1}]
+    cases.append(Case("declared_viewless_morph_target", "input", render(), {"scene.gltf": dump(j)}))
+    # A joint 100,000 nodes below a root no scene lists: placed without recursion.
+    j = quad()
+    chain = 100000
+    first = len(j["nodes"])
+    for i in range(chain):
+        j["nodes"].append({"children": [first + i + 1]} if i + 1 < chain else {})
+    j["skins"] = [{"joints": [first + chain - 1]}]
+    j["accessors"].append({"componentType": 5121, "count": 4, "type": "VEC4"})  # joints: zeros
+    j["bufferViews"].append({"buffer": 1, "byteLength": 64})  # weights: every vertex on its joint 0
+    j["accessors"].append({"componentType": 5126, "count": 4, "type": "VEC4", "bufferView": len(j["bufferViews"]) - 1})
+    weights = struct.pack("<16f", *([1, 0, 0, 0] * 4))
+    j["buffers"].append({"byteLength": 64, "uri": "data:application/octet-stream;base64," + base64.b64encode(weights).decode()})
+    prim = j["meshes"][0]["primitives"][0]
+    prim["attributes"]["JOINTS_0"] = len(j["accessors"]) - 2
+    prim["attributes"]["WEIGHTS_0"] = len(j["accessors"]) - 1
+    j["nodes"][0]["skin"] = 0
+    cases.append(Case("deep_joint_chain_outside_the_scene_loads", "ok", render(), {"scene.gltf": dump(j)}))
+    # A flat scene 1.8e9 across, within the 1e9 coordinate limit: the default view stays inside it.
+    j = quad()
+    j["nodes"] = [{"mesh": 0, "scale": [9e8, 9e8, 1]}]
+    j["scenes"] = [{"nodes": [0]}]
+    del j["cameras"]
+    cases.append(Case("flat_scene_at_the_coordinate_limit_loads", "ok", render(), {"scene.gltf": dump(j)}))
+    # The scene's own camera outside the limit: refused naming the file.
+    j = quad()
+    j["nodes"][1]["translation"] = [0, 0, 3e9]
+    cases.append(Case("scene_camera_outside_the_coordinate_limit", "input", render(), {"scene.gltf": dump(j)}))
+    return cases
+
+
+def command_line_cases():
+    q = dump(quad())
+    cases = [
+        Case("compare_max_differing_negative", "usage",
+             ["compare", "{dir}/a.exr", "{dir}/b.exr", "--fail-on", "differ", "--max-differing", "-1"], {}),
+        Case("render_size_zero", "usage", render("scene.gltf") + ["--size", "0x6"], {"scene.gltf": q}),
+        Case("render_size_not_a_size", "usage", render("scene.gltf") + ["--size", "eight"], {"scene.gltf": q}),
+        Case("render_time_not_finite", "input", render("scene.gltf", "--time", "nan"), {"scene.gltf": q}),
+        Case("render_scene_missing", "input", render("scene.gltf", "--scene", "7"), {"scene.gltf": q}),
+        Case("render_camera_missing", "input", render("scene.gltf", "--camera", "7"), {"scene.gltf": q}),
+        Case("render_animation_missing", "input", render("scene.gltf", "--animation", "7"), {"scene.gltf": q}),
+        Case("render_frames_reversed", "input",
+             ["render", "{dir}/scene.gltf"] + SIZE + ["-o", "{dir}/out_%04d.png", "--frames", "5:1"], {"scene.gltf": q},
+             outputs=("out_0001.png", "out_0005.png")),
+        Case("render_eye_outside_the_limit", "input", render("scene.gltf", "--eye", "2e9,0,0"), {"scene.gltf": q}),
+    ]
+    return cases
+
+
+def special_file_cases():
+    q = dump(quad())
+
+    def fifo(d):
+        os.mkfifo(os.path.join(d, "scene.gltf"))
+
+    def folder(name):
+        return lambda d: os.makedirs(os.path.join(d, name))
+
+    def link(name, to):
+        return lambda d: os.symlink(to, os.path.join(d, name))
+
+    return [
+        Case("input_is_a_fifo", "input", render(), setup=fifo),
+        Case("input_is_dev_zero", "input", ["render", "/dev/zero"] + SIZE + ["-o", "{dir}/out.png"]),
+        Case("input_is_a_folder", "input", render(), setup=folder("scene.gltf")),
+        Case("input_is_missing", "input", render()),
+        Case("input_is_a_dangling_link", "input", render(), setup=link("scene.gltf", "nowhere.gltf")),
+        Case("input_is_empty", "input", render(), {"scene.gltf": b""}),
+        Case("compare_input_is_a_fifo", "input", ["compare", "{dir}/a.exr", "{dir}/a.exr"],
+             setup=lambda d: os.mkfifo(os.path.join(d, "a.exr")), outputs=()),
+        Case("output_is_a_folder", "input", render(), {"scene.gltf": q}, setup=folder("out.png"), outputs=()),
+        Case("output_is_a_dangling_link", "input", render(), {"scene.gltf": q},
+             setup=link("out.png", "missing/x.png"), outputs=()),
+        Case("output_is_the_input", "input", ["render", "{dir}/scene.gltf"] + SIZE + ["-o", "{dir}/scene.gltf"],
+             {"scene.gltf": q}, outputs=()),
+        Case("output_and_aov_collide", "input", render("scene.gltf", "--aov", "{dir}/out.png"), {"scene.gltf": q}),
+        Case("frames_outputs_collide", "input",
+             ["render", "{dir}/scene.gltf"] + SIZE + ["-o", "{dir}/f_%04d.png", "--aov", "{dir}/f_%04d.png", "--frames", "0:2"],
+             {"scene.gltf": q}, outputs=("f_0000.png",)),
+        Case("frames_folder_at_a_later_frame", "input",
+             ["render", "{dir}/scene.gltf"] + SIZE + ["-o", "{dir}/f_%04d.png", "--frames", "0:3"], {"scene.gltf": q},
+             setup=folder("f_0002.png"), outputs=("f_0000.png", "f_0001.png")),
+        Case("frames_output_names_the_input", "input",
+             ["render", "{dir}/f_0001.gltf"] + SIZE + ["-o", "{dir}/f_%04d.gltf", "--frames", "0:2"],
+             {"f_0001.gltf": q}, outputs=("f_0000.gltf",)),
+        Case("orbit_camera_name_collides_with_the_input", "input",
+             ["render", "{dir}/out_cam1.gltf"] + SIZE + ["-o", "{dir}/out.gltf", "--orbit", "3"], {"out_cam1.gltf": q},
+             outputs=("out_cam0.gltf", "out_cam2.gltf")),
+        # Failed writes: the device is full, the file size limit is reached.
+        Case("write_to_dev_full", "write", ["render", "{dir}/scene.gltf"] + SIZE + ["-o", "/dev/full"], {"scene.gltf": q},
+             outputs=()),
+        Case("aov_to_dev_full_leaves_no_image", "write", render("scene.gltf", "--aov", "/dev/full"), {"scene.gltf": q}),
+        Case("stats_to_dev_full_leaves_no_image", "write", render("scene.gltf", "--stats", "/dev/full"), {"scene.gltf": q}),
+        # (an AOV of 160x120 is some 100 KB; the limit is 1 KiB)
+        Case("write_past_ulimit_f", "write",
+             ["render", "{dir}/scene.gltf", "--size", "160x120", "-o", "{dir}/out.png", "--aov", "{dir}/out.exr"],
+             {"scene.gltf": q}, shell_prefix="ulimit -f 1; ", outputs=("out.png", "out.exr")),
+        Case("frames_write_past_ulimit_f", "write",
+             ["render", "{dir}/scene.gltf", "--size", "160x120", "-o", "{dir}/f_%04d.png", "--aov", "{dir}/f_%04d.exr",
+              "--frames", "0:1"],
+             {"scene.gltf": q}, shell_prefix="ulimit -f 1; ", outputs=("f_0000.png", "f_0000.exr", "f_0001.png", "f_0001.exr")),
+    ]
+
+
+def all_cases():
+    cases = spec_rule_cases() + declared_size_cases() + command_line_cases() + special_file_cases()
+    names = [c.name for c in cases]
+    assert len(names) == len(set(names)), "case names repeat"
+    return cases
+
+
+# ---- running --------------------------------------------------------------------------------
+
+def leftovers(folder, case):
+    """Output files, and temporaries beside them, that a refused or failed run left."""
+    bad = [n for n in case.outputs if os.path.lexists(os.path.join(folder, n)) and not os.path.isdir(os.path.join(folder, n))]
+    bad += [n for n in os.listdir(folder) if n not in case.files and n not in case.outputs and ".tmp" in n]
+    return bad
+
+
+def run_case(dacrt, work, case):
+    folder = os.path.join(work, case.name)
+    os.makedirs(folder)
+    for name, data in case.files.items():
+        with open(os.path.join(folder, name), "wb") as f:
+            f.write(data)
+    if case.setup:
+        case.setup(folder)
+    args = [a.replace("{dir}", folder) for a in case.args]
+    command = [dacrt] + args
+    if case.shell_prefix:
+        command = ["bash", "-c", case.shell_prefix + " ".join("'" + a + "'" for a in command)]
+    try:
+        r = subprocess.run(command, capture_output=True, text=True, timeout=60, stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        return "did not end within 60 s"
+    text = r.stdout + r.stderr
+    errors = [line for line in r.stderr.splitlines() if line.startswith("dacrt: error:")]
+    traced = [line for line in text.splitlines() if " trace " in line or line.startswith("work plan")]
+    if case.kind == "ok":
+        if r.returncode != 0 or not os.path.exists(os.path.join(folder, "out.png")):
+            return f"exit {r.returncode}, expected 0 and out.png: {text.strip()[-300:]}"
+        return None
+    if case.kind == "write":
+        if r.returncode == 0 or not errors:
+            return f"exit {r.returncode} with {len(errors)} error lines, expected non-zero and an error: {text.strip()[-300:]}"
+    else:
+        if r.returncode != 2:
+            return f"exit {r.returncode}, expected 2: {text.strip()[-300:]}"
+        if traced:
+            return f"refused after work began: {traced[0]}"
+        if case.kind == "input" and len(errors) != 1:
+            return f"{len(errors)} 'dacrt: error:' lines, expected 1: {text.strip()[-300:]}"
+    left = leftovers(folder, case)
+    if left:
+        return "left behind: " + ", ".join(left)
+    return None
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--dacrt", required=True)
+    parser.add_argument("--work", help="folder for the cases (default: a temporary one, removed)")
+    parser.add_argument("--keep", action="store_true", help="keep the work folder")
+    parser.add_argument("--list", action="store_true", help="list the cases and stop")
+    parser.add_argument("--jobs", type=int, default=2)
+    a = parser.parse_args()
+    cases = all_cases()
+    if a.list:
+        for c in cases:
+            print(c.kind, c.name)
+        print(len(cases), "cases")
+        return 0
+    work = a.work or tempfile.mkdtemp(prefix="dacrt_hostile_")
+    if a.work:
+        shutil.rmtree(work, ignore_errors=True)
+        os.makedirs(work)
+    dacrt = os.path.abspath(a.dacrt)
+    with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
+        results = list(pool.map(lambda c: (c, run_case(dacrt, work, c)), cases))
+    failed = 0
+    for c, problem in results:
+        print(("FAIL " if problem else "ok   ") + f"{c.kind:5} {c.name}" + (f": {problem}" if problem else ""))
+        failed += bool(problem)
+    print(f"{len(cases) - failed} of {len(cases)} cases ended as documented")
+    if not a.keep and not a.work:
+        shutil.rmtree(work, ignore_errors=True)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
