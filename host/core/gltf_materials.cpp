@@ -5,10 +5,12 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <string_view>
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include "core/data_uri.hpp"
 #include "core/errors.hpp"
 #include "core/input_file.hpp"
 
@@ -18,18 +20,46 @@ namespace {
 // Decoded images larger than this are refused with a warning (a 16k x 16k RGBA8 texture).
 constexpr std::uint64_t kMaxTextureBytes = std::uint64_t(1) << 30;
 
-// OpenImageIO picks its reader from the name's extension; the bytes say which format they are.
-const char* formatExtension(std::span<const unsigned char> b, const std::string& mimeType) {
-    auto starts = [&](const char* magic, std::size_t at = 0) {
-        const std::size_t n = std::strlen(magic);
-        return b.size() >= at + n && std::memcmp(b.data() + at, magic, n) == 0;
-    };
-    if (starts("\x89PNG")) return ".png";
-    if (b.size() >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) return ".jpg";
-    if (starts("RIFF") && starts("WEBP", 8)) return ".webp";
-    if (mimeType == "image/png") return ".png";
-    if (mimeType == "image/jpeg") return ".jpg";
-    return "";
+// The formats dacrt decodes, told apart by their first bytes (a mimeType may contradict them):
+// each is read by its own OpenImageIO reader alone. Given a file name, OpenImageIO would try
+// every reader it has on bytes its named one refuses (GIF, TIFF, OpenEXR, FITS, ...), readers
+// that this input need not reach (a GIF of 65535 x 65535 made one of them throw).
+struct ImageFormat {
+    std::string_view magic;
+    std::size_t at;       // where the magic lies
+    const char* reader;   // OpenImageIO's format name; null: a format dacrt does not decode
+    const char* name;
+};
+using namespace std::string_view_literals;
+constexpr ImageFormat kImageFormats[] = {
+    {"\x89PNG"sv, 0, "png", "PNG"},
+    {"\xFF\xD8\xFF"sv, 0, "jpeg", "JPEG"},
+    {"WEBP"sv, 8, "webp", "WebP"},  // after "RIFF" and the size
+    {"GIF8"sv, 0, nullptr, "GIF"},
+    {"BM"sv, 0, nullptr, "BMP"},
+    {"II*\0"sv, 0, nullptr, "TIFF"},
+    {"MM\0*"sv, 0, nullptr, "TIFF"},
+    {"\xABKTX 20"sv, 0, nullptr, "KTX2 (KHR_texture_basisu)"},
+    {"DDS "sv, 0, nullptr, "DDS (MSFT_texture_dds)"},
+    {"v/1\x01"sv, 0, nullptr, "OpenEXR"},
+    {"#?RADIANCE"sv, 0, nullptr, "Radiance HDR"},
+};
+
+const ImageFormat* formatOf(std::span<const unsigned char> b) {
+    for (const ImageFormat& f : kImageFormats) {
+        const std::size_t n = f.magic.size();
+        if (b.size() >= f.at + n && std::memcmp(b.data() + f.at, f.magic.data(), n) == 0 &&
+            (f.at == 0 || std::memcmp(b.data(), "RIFF", 4) == 0))
+            return &f;
+    }
+    return nullptr;
+}
+
+// Why bytes are not decoded: what they are, where their first bytes say.
+std::string unsupportedFormat(const ImageFormat* f, const std::string& mimeType) {
+    const std::string declared = mimeType.empty() ? std::string() : ", declared " + mimeType;
+    if (f) return "it is " + std::string(f->name) + declared + "; dacrt decodes PNG, JPEG and WebP";
+    return "its bytes are neither PNG, JPEG nor WebP" + declared;
 }
 
 std::string percentDecoded(const std::string& uri) {
@@ -49,14 +79,9 @@ std::string percentDecoded(const std::string& uri) {
 // when it cannot. Its RGBA bytes are counted against the reader's limit (with every accessor
 // and image decoded before it) before its pixels are read: many images, each under the
 // per-image limit, are as many allocations.
-Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mimeType, const AccessorReader& budget,
-                    std::string& why) {
+Texture decodeWith(const ImageFormat& format, std::span<const unsigned char> bytes, const AccessorReader& budget,
+                   std::string& why) {
     Texture t;
-    const char* ext = formatExtension(bytes, mimeType);
-    if (!*ext) {
-        why = "its format" + (mimeType.empty() ? std::string() : " (" + mimeType + ")") + " is neither PNG, JPEG nor WebP";
-        return t;
-    }
     OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
     // glTF colours are not premultiplied by alpha; OpenImageIO's PNG reader would otherwise
     // associate them.
@@ -64,9 +89,10 @@ Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mim
     config.attribute("oiio:UnassociatedAlpha", 1);
     OIIO::Filesystem::IOProxy* proxy = &memory;  // with a config, the reader takes its proxy from it
     config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-    auto in = OIIO::ImageInput::open(std::string("image") + ext, &config, &memory);
-    if (!in) {
-        why = "it does not decode (" + OIIO::geterror() + ")";
+    auto in = OIIO::ImageInput::create(format.reader, false, &config, &memory);
+    OIIO::ImageSpec opened;
+    if (!in || !in->open(std::string("image.") + format.reader, opened, config)) {
+        why = "it does not decode (" + (in ? in->geterror() : OIIO::geterror()) + ")";
         return t;
     }
     const OIIO::ImageSpec& spec = in->spec();
@@ -100,6 +126,23 @@ Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mim
         q[3] = channels == 2 ? p[1] : channels >= 4 ? p[3] : 255;
     }
     return t;
+}
+
+// The image's format from its first bytes, then its own reader; empty, with `why` set, where
+// it is not decoded.
+Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mimeType, const AccessorReader& budget,
+                    std::string& why) {
+    const ImageFormat* format = formatOf(bytes);
+    if (!format || !format->reader) {
+        why = unsupportedFormat(format, mimeType);
+        return {};
+    }
+    try {
+        return decodeWith(*format, bytes, budget, why);
+    } catch (const std::exception& e) {  // a reader's own failure (an allocation, a bad length)
+        why = "its " + std::string(format->name) + " reader failed (" + e.what() + ")";
+        return {};
+    }
 }
 
 TextureWrap wrapOf(int mode) {
@@ -208,6 +251,9 @@ private:
             bytes = reader_.viewBytes(img.bufferView, label);
         } else if (!img.image.empty()) {
             bytes = img.image;
+        } else if (img.uri.starts_with("data:")) {
+            fileBytes = dataUriBytes(img.uri, why);
+            bytes = fileBytes;
         } else if (!img.uri.empty() && source_.readFiles) {
             const std::filesystem::path path = std::filesystem::path(source_.baseDir) / percentDecoded(img.uri);
             try {

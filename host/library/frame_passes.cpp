@@ -152,4 +152,18 @@ FramePlan passPlanBound(const FramePass& pass, std::uint64_t primaryRays, Backen
     return framePlanOf(secondaryPassBound(secondaryPassOf(pass), primaryRays, backend));
 }
 
+FramePlan frameMemoryBound(std::uint64_t primaryRays, const std::vector<FramePass>& passes) {
+    MemoryPlan plan;
+    plan.add("rays", primaryRays * sizeof(Ray));
+    plan.add("hits", primaryRays * sizeof(Hit));
+    plan.addWork("rays", primaryRays, "one per pixel");
+    for (const FramePass& pass : passes) {
+        const std::uint64_t slots = secondarySlots(secondaryPassOf(pass), primaryRays);
+        plan.add("hits per slot: " + pass.name, slots * sizeof(Hit));
+        plan.addWork("slots: " + pass.name, slots,
+                     std::to_string(primaryRays) + " primary rays x " + std::to_string(pass.raysPerHit));
+    }
+    return framePlanOf(plan);
+}
+
 }  // namespace dacrt

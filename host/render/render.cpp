@@ -409,6 +409,26 @@ void printPassBounds(const RenderOptions& o, const PreparedScene& p, std::size_t
     }
 }
 
+// The frame's least memory from the counts alone (frameMemoryBound), checked before its rays
+// are made: a size this machine cannot hold is refused at once instead of after its rays have
+// filled the memory. Under --plan the bound is printed before the refusal.
+void checkFrameBound(const RenderOptions& o, const std::vector<FramePass>& passes) {
+    const std::uint64_t pixels = std::uint64_t(o.width) * std::uint64_t(o.height);
+    const FramePlan bound = frameMemoryBound(pixels, passes);
+    const std::string frame = "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " frame (" +
+                              std::to_string(pixels) + " rays) with " + std::to_string(passes.size()) +
+                              (passes.size() == 1 ? " secondary pass" : " secondary passes");
+    try {
+        checkFitsInMemory(frame + ", in its rays and hits alone,", bound.totalBytes(),
+                          "lower --size" + std::string(o.passes.occlusionSamples ? " or --ao" : ""));
+    } catch (const InputError&) {
+        if (o.planOnly)
+            std::cout << "memory plan (at least, from the counts alone: " << frame << "; no ray was made):\n"
+                      << describeMemory(bound);
+        throw;
+    }
+}
+
 // The stages of a frame, in ms, in the order --stats and the summary list them.
 struct StageTimes {
     double evaluate = 0.0, prepare = 0.0, trace = 0.0, secondary = 0.0, write = 0.0, total = 0.0;
@@ -446,8 +466,10 @@ StageTimes renderCamera(const RenderOptions& o, const PreparedScene& p, int k, c
     const auto cameraStart = Clock::now();
     const std::size_t pixels = std::size_t(o.width) * std::size_t(o.height);
     const bool brute = o.tracer.trace.backend == Backend::Brute;
+    const std::vector<FramePass> passes = framePasses(p.lights, o.passes, p.box, 0);
+    checkFrameBound(o, passes);
     std::size_t frameRays = pixels;
-    for (const FramePass& pass : framePasses(p.lights, o.passes, p.box, 0)) frameRays += pixels * pass.raysPerHit;
+    for (const FramePass& pass : passes) frameRays += pixels * pass.raysPerHit;
     if (brute && !o.planOnly && !tally.bruteAnnounced) {
         announceBruteForce(p.scene.triangleCount(), frameRays, traceThreads(o.tracer.trace));
         tally.bruteAnnounced = true;

@@ -60,4 +60,13 @@ using ProgressCallback = std::function<void(double)>;
 // rays it makes).
 FramePlan passPlanBound(const FramePass& pass, std::uint64_t primaryRays, Backend backend);
 
+// The least memory a camera frame of `primaryRays` rays with these passes holds at once,
+// whatever the backend and its division into sub-scenes, from the counts alone (no ray made):
+// the rays and their hits (the caller holds the rays; every backend's plan of the primary pass
+// counts both) and each pass's hit per slot (primary ray x raysPerHit; made whatever the
+// primary hits, and kept until the frame is shaded). The frame's detailed plans add their
+// working buffers to it: a frame whose bound exceeds the memory can be refused before its rays
+// are made. Throws InputError where a pass would hold more slots than it can (as traceFrame).
+FramePlan frameMemoryBound(std::uint64_t primaryRays, const std::vector<FramePass>& passes);
+
 }  // namespace dacrt

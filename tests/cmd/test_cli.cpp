@@ -9,6 +9,8 @@
 #include <map>
 #include <sstream>
 
+#include <dacrt/frame.hpp>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -16,6 +18,7 @@
 #include "support/hostile_gltf.hpp"
 #include "support/frames.hpp"
 #include "core/image_io.hpp"
+#include "core/system_memory.hpp"
 #include "core/procedural.hpp"
 #include "cpu/backend_options.hpp"
 
@@ -83,6 +86,35 @@ TEST(Cli, PlanPrintsEveryBufferAndTracesNothing) {
     EXPECT_NE(r.output.find("memory plan"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("triangle ids (with straddlers)"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("total"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(png));
+}
+
+// A frame whose rays and hits alone exceed the memory is refused from its counts, before a
+// ray is made: exit 2, one message with what was asked, the limit and by how much; --plan
+// prints the count-only bound instead of the plan it cannot make.
+TEST(Cli, AFrameLargerThanTheMemoryIsRefusedBeforeItsRaysAreMade) {
+    const std::uint64_t pixels = std::uint64_t(16384) * 16384;
+    const dacrt::FramePass keyLight{.name = "shadow: key light (default)"};
+    const dacrt::FramePass occlusion{.name = "occlusion", .kind = dacrt::PassKind::Occlusion, .raysPerHit = 8};
+    const std::uint64_t bound = dacrt::frameMemoryBound(pixels, {keyLight, occlusion}).totalBytes();
+    const std::uint64_t memory = dacrt::physicalMemoryBytes();
+    if (memory == 0 || memory >= bound) GTEST_SKIP() << "this machine holds " << memory << " bytes, the frame " << bound;
+    const std::string png = temp("too_large.png");
+    std::filesystem::remove(png);
+    const std::string args = "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 16384x16384 --ao 8";
+    for (const std::string& mode : {std::string(" --plan"), " -o " + png}) {
+        const CommandResult r = run(args + mode);
+        EXPECT_EQ(r.code, 2) << mode << "\n" << r.output;
+        const std::string expected = "dacrt: error: a 16384x16384 frame (" + std::to_string(pixels) +
+                                     " rays) with 2 secondary passes, in its rays and hits alone, needs " +
+                                     std::to_string(bound) + " bytes but this machine has " + std::to_string(memory) +
+                                     " bytes of memory (over by " + std::to_string(bound - memory) +
+                                     " bytes); lower --size or --ao\n";
+        EXPECT_NE(r.output.find(expected), std::string::npos) << mode << "\n" << r.output;
+        EXPECT_EQ(r.output.find("work plan"), std::string::npos) << mode << "\n" << r.output;
+        EXPECT_EQ(r.output.find(" trace "), std::string::npos) << mode << "\n" << r.output;
+        EXPECT_EQ(r.output.find("memory plan (at least") != std::string::npos, mode == " --plan") << r.output;
+    }
     EXPECT_FALSE(std::filesystem::exists(png));
 }
 

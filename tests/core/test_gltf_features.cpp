@@ -144,6 +144,59 @@ TEST(GltfFeatures, AnImageThatDoesNotDecodeIsAWarningAndTheFactorShades) {
     expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 0.5f, 0.25f, 1);
 }
 
+// Images of a format dacrt does not decode (whatever their mimeType), data URIs that are not
+// base64, and bytes a reader fails on: one warning naming the image and what is wrong, the
+// factor shades. (A GIF of 65535 x 65535 declared image/png once reached OpenImageIO's GIF
+// reader, which threw: an internal error.)
+TEST(GltfFeatures, ImagesDacrtDoesNotDecodeAreWarningsNamingTheImage) {
+    const std::string gif = std::string("GIF89a\xFF\xFF\xFF\xFF\0\0\0,\0\0\0\0\xFF\xFF\xFF\xFF\0\x02\x02\x44\x01\0;", 29);
+    const std::vector<std::tuple<std::string, std::string>> cases = {
+        {"data:image/png;base64," + base64(gif), "it is GIF, declared image/png"},
+        {"data:image/png;base64," + base64(std::string("v/1\x01\x02\0\0\0", 8)), "it is OpenEXR"},
+        {"data:image/ktx2;base64," + base64(std::string("\xABKTX 20\xBB\r\n\x1A\n", 12)), "it is KTX2"},
+        {"data:image/png;base64," + base64("#?RADIANCE\n"), "it is Radiance HDR"},
+        {"data:image/jpeg;base64," + base64("<svg xmlns=\"http://www.w3.org/2000/svg\"/>"), "neither PNG, JPEG nor WebP"},
+        {"data:image/webp;base64,UklG@kZ", "base64 has '@' at character 4"},
+        {"data:image/webp;base64,UklGR", "a group of 4 cut short"},
+        {"data:image/webp,RIFF", "is not base64"},
+    };
+    std::ifstream in(fixture("quad_texture_data_uri.gltf"));
+    nlohmann::json doc = nlohmann::json::parse(in);
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {0.5, 0.25, 1, 1};
+    for (const auto& [uri, why] : cases) {
+        SCOPED_TRACE(why);
+        doc["images"][0]["uri"] = uri;
+        const Scene s = loadJson(doc, "other_format.gltf");
+        ASSERT_EQ(s.warnings.size(), 1u);
+        EXPECT_NE(s.warnings[0].find("image 0"), std::string::npos) << s.warnings[0];
+        EXPECT_NE(s.warnings[0].find(why), std::string::npos) << s.warnings[0];
+        EXPECT_EQ(s.warnings[0].find(uri), std::string::npos) << "the URI is not repeated: " << s.warnings[0];
+        EXPECT_TRUE(s.textures.empty());
+        expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 0.5f, 0.25f, 1);
+    }
+}
+
+// tinygltf decodes data URIs of a few media types only; any other base64 one (image/webp for
+// EXT_texture_webp, a made-up one) is decoded by dacrt, padded or not, and its bytes decide
+// the format.
+TEST(GltfFeatures, AnImageDataUriOfAnyMediaTypeDecodes) {
+    std::ifstream in(fixture("quad_texture_data_uri.gltf"));
+    nlohmann::json doc = nlohmann::json::parse(in);
+    const std::string png = doc["images"][0]["uri"].get<std::string>().substr(std::string("data:image/png;base64,").size());
+    std::string unpadded = png;
+    while (unpadded.ends_with('=')) unpadded.pop_back();
+    for (const std::string& uri : {"data:image/webp;base64," + png, "data:application/x-made-up;base64," + unpadded,
+                                   "data:;base64," + png}) {
+        SCOPED_TRACE(uri.substr(0, 40));
+        doc["images"][0]["uri"] = uri;
+        const Scene s = loadJson(doc, "webp_uri.gltf");
+        EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+        ASSERT_EQ(s.textures.size(), 1u);
+        expectColor(surfaceAt(s, quadHit(s, -0.5, 0.5)).albedo, 1, 0, 0);
+        expectColor(surfaceAt(s, quadHit(s, 0.5, -0.5)).albedo, 1, 1, 1);
+    }
+}
+
 TEST(GltfFeatures, TextureTransformAndWrapModes) {
     std::ifstream in(fixture("quad_texture_data_uri.gltf"));
     nlohmann::json doc = nlohmann::json::parse(in);

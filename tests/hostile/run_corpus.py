@@ -9,7 +9,10 @@ tests/scenes/quad_u8_camera.gltf, each run through `dacrt` and checked to end as
 - failed writes (a full device, the file size limit): a non-zero exit naming the file, and no
   output file or temporary left behind;
 - files that must load (a joint below a deep chain outside the scene, a flat scene as large as
-  the coordinate limit): exit 0 and the image written.
+  the coordinate limit, base colour images of every PNG kind): exit 0 and the image written;
+- images dacrt does not decode (other formats, broken bytes, data URIs that are not base64,
+  files that are not regular): exit 0, the image written, and exactly one warning naming the
+  image and what is wrong (the material is shaded with its base colour factor).
 
     tests/hostile/run_corpus.py --dacrt build/dacrt [--work DIR] [--keep] [--list]
 
@@ -27,9 +30,11 @@ import struct
 import subprocess
 import sys
 import tempfile
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 QUAD = os.path.join(HERE, "..", "scenes", "quad_u8_camera.gltf")
+TEXTURED = os.path.join(HERE, "..", "scenes", "quad_texture_data_uri.gltf")
 SIZE = ["--size", "8x6"]
 
 
@@ -37,8 +42,9 @@ class Case:
     """One run: `files` (name -> bytes) written to its own folder, `args` for dacrt (the folder's
     paths written as {dir}/NAME), and how it must end: 'input', 'usage', 'write' or 'ok'."""
 
-    def __init__(self, name, kind, args, files=None, shell_prefix="", setup=None, outputs=("out.png",)):
+    def __init__(self, name, kind, args, files=None, shell_prefix="", setup=None, outputs=("out.png",), warning=None):
         self.name, self.kind, self.args = name, kind, args
+        self.warning = warning            # 'ok': text the one warning holds; "": no warning; None: unchecked
         self.files = files or {}
         self.shell_prefix = shell_prefix  # e.g. "ulimit -f 1;" run through bash
         self.setup = setup                # called with the folder before the run (FIFOs, links, folders)
@@ -225,6 +231,83 @@ def declared_size_cases():
     return cases
 
 
+# ---- images ----------------------------------------------------------------------------------
+
+def png_chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+
+def png(width, height, depth, colour, rows, extra=b""):
+    """A PNG of the given IHDR and rows (each a filter byte 0 and its bytes); extra: chunks before IDAT."""
+    ihdr = struct.pack(">IIBBBBB", width, height, depth, colour, 0, 0, 0)
+    data = zlib.compress(b"".join(b"\0" + r for r in rows))
+    return b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", ihdr) + extra + png_chunk(b"IDAT", data) + png_chunk(b"IEND", b"")
+
+
+def textured(image):
+    j = json.load(open(TEXTURED))
+    j["images"] = [image]
+    return j
+
+
+def data_image(data, mime="image/png"):
+    return dump(textured({"uri": f"data:{mime};base64," + base64.b64encode(data).decode()}))
+
+
+def image_cases():
+    rgb = png(2, 2, 8, 2, [b"\xff\0\0\0\xff\0"] * 2)
+    valid = {
+        "png_16_bit": png(2, 2, 16, 2, [b"\xff\xff\0\0\0\0" * 2] * 2),
+        "png_grey_alpha": png(2, 2, 8, 4, [b"\x80\xff" * 2] * 2),
+        "png_palette": png(2, 2, 8, 3, [b"\0\1"] * 2, png_chunk(b"PLTE", b"\xff\0\0\0\xff\0")),
+        "png_grey_1_bit": png(2, 2, 1, 0, [b"\x80"] * 2),
+        "png_1x1": png(1, 1, 8, 2, [b"\xff\0\0"]),
+    }
+    cases = [Case(f"image_{n}_renders", "ok", render(), {"scene.gltf": data_image(d)}, warning="") for n, d in valid.items()]
+    cases.append(Case("image_png_declared_jpeg_renders", "ok", render(), {"scene.gltf": data_image(rgb, "image/jpeg")},
+                      warning=""))
+    # (a GIF of 65535 x 65535 declared image/png reached OpenImageIO's GIF reader, which threw)
+    gif = b"GIF89a" + struct.pack("<HHBBB", 65535, 65535, 0, 0, 0) + b"," + struct.pack("<HHHHB", 0, 0, 65535, 65535, 0)
+    gif += b"\x02\x02D\x01\0;"
+    ihdr_0x0 = b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", struct.pack(">IIBBBBB", 0, 0, 8, 2, 0, 0, 0))
+    short_idat = b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", struct.pack(">IIBBBBB", 64, 64, 8, 2, 0, 0, 0)) + \
+        png_chunk(b"IDAT", zlib.compress(b"\0" * 10)) + png_chunk(b"IEND", b"")
+    huge = png(100000, 100000, 8, 2, [b"\xff\0\0"])
+    undecoded = [
+        ("gif_huge_declared_png", data_image(gif), "it is GIF, declared image/png"),
+        ("bmp", data_image(b"BM" + b"\0" * 60, "image/bmp"), "it is BMP"),
+        ("tiff", data_image(b"II*\0" + b"\0" * 60, "image/tiff"), "it is TIFF"),
+        ("ktx2", data_image(b"\xabKTX 20\xbb\r\n\x1a\n" + b"\0" * 64, "image/ktx2"), "it is KTX2"),
+        ("openexr_declared_png", data_image(b"v/1\x01\2\0\0\0" + b"\0" * 60), "it is OpenEXR, declared image/png"),
+        ("radiance_hdr", data_image(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n" + b"\x80" * 16), "it is Radiance HDR"),
+        ("svg_declared_png", data_image(b'<svg xmlns="http://www.w3.org/2000/svg"/>'), "neither PNG, JPEG nor WebP"),
+        ("png_0x0", data_image(ihdr_0x0), "does not decode"),
+        ("png_truncated", data_image(rgb[:40]), "does not decode"),
+        ("png_short_pixel_data", data_image(short_idat), "pixels do not decode"),
+        ("png_100000_square", data_image(huge), "texture limit"),
+        ("jpeg_start_only", data_image(b"\xff\xd8\xff", "image/jpeg"), "does not decode"),
+        ("webp_header_only", data_image(b"RIFF\0\0\0\0WEBP", "image/webp"), "does not decode"),
+        ("webp_bad_base64", dump(textured({"uri": "data:image/webp;base64,UklG@kZ"})), "base64 has '@'"),
+        ("data_uri_not_base64", dump(textured({"uri": "data:image/webp,RIFF"})), "is not base64"),
+    ]
+    for name, scene, why in undecoded:
+        cases.append(Case(f"image_{name}_warns", "ok", render(), {"scene.gltf": scene}, warning=why))
+    by_uri = [
+        ("svg_file_named_png", {"image.png": b"<svg/>"}, None, "neither PNG, JPEG nor WebP"),
+        ("uri_is_a_folder", {}, lambda d: os.makedirs(os.path.join(d, "image.png")), "is a folder"),
+        ("uri_is_missing", {}, None, "no such file"),
+    ]
+    for name, files, setup, why in by_uri:
+        files = dict(files, **{"scene.gltf": dump(textured({"uri": "image.png"}))})
+        cases.append(Case(f"image_{name}_warns", "ok", render(), files, setup=setup, warning=why))
+    cases.append(Case("image_uri_is_dev_zero_warns", "ok", render(), {"scene.gltf": dump(textured({"uri": "/dev/zero"}))},
+                      warning="regular files only"))
+    # tinygltf decodes image/png data URIs itself and refuses one that does not decode.
+    cases.append(Case("image_png_data_uri_bad_base64", "input", render(),
+                      {"scene.gltf": dump(textured({"uri": "data:image/png;base64,!!!notbase64"}))}))
+    return cases
+
+
 def command_line_cases():
     q = dump(quad())
     cases = [
@@ -241,6 +324,16 @@ def command_line_cases():
              outputs=("out_0001.png", "out_0005.png")),
         Case("render_eye_outside_the_limit", "input", render("scene.gltf", "--eye", "2e9,0,0"), {"scene.gltf": q}),
     ]
+    # Frames refused from their counts, before a ray is made: 2^28 pixels x 16 occlusion rays are
+    # more slots than a pass holds; with 15 rays their hits alone need 90 GiB (a case only where
+    # the machine has less).
+    big = ["render", "{dir}/scene.gltf", "--size", "16384x16384"]
+    memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    for mode, extra in (("plan", ["--plan"]), ("render", ["-o", "{dir}/out.png"])):
+        cases.append(Case(f"{mode}_more_slots_than_a_pass_holds", "input", big + ["--ao", "16"] + extra, {"scene.gltf": q}))
+        if 0 < memory < (2 ** 28) * (64 + 16 + 16 + 15 * 16):
+            cases.append(Case(f"{mode}_frame_larger_than_the_memory", "input", big + ["--ao", "15"] + extra,
+                              {"scene.gltf": q}))
     return cases
 
 
@@ -300,7 +393,7 @@ def special_file_cases():
 
 
 def all_cases():
-    cases = spec_rule_cases() + declared_size_cases() + command_line_cases() + special_file_cases()
+    cases = spec_rule_cases() + declared_size_cases() + image_cases() + command_line_cases() + special_file_cases()
     names = [c.name for c in cases]
     assert len(names) == len(set(names)), "case names repeat"
     return cases
@@ -337,6 +430,11 @@ def run_case(dacrt, work, case):
     if case.kind == "ok":
         if r.returncode != 0 or not os.path.exists(os.path.join(folder, "out.png")):
             return f"exit {r.returncode}, expected 0 and out.png: {text.strip()[-300:]}"
+        warnings = [line for line in r.stderr.splitlines() if line.startswith("dacrt: warning:")]
+        if case.warning == "" and warnings:
+            return f"warned: {warnings[0]}"
+        if case.warning and (len(warnings) != 1 or case.warning not in warnings[0]):
+            return f"{len(warnings)} warnings, expected one naming '{case.warning}': {text.strip()[-300:]}"
         return None
     if case.kind == "write":
         if r.returncode == 0 or not errors:

@@ -102,5 +102,54 @@ TEST(ApiFrame, PassBoundCountsEveryPossibleRay) {
     EXPECT_GT(bound.totalBytes(), 3u * 4800u * 32u);  // a ray alone takes 32 bytes or more
 }
 
+// The bytes of the plan's buffer of that name; 0 where it has none.
+std::uint64_t bytesOf(const FramePlan& plan, const std::string& name) {
+    for (const FramePlan::Buffer& b : plan.memory)
+        if (b.name == name) return b.bytes;
+    return 0;
+}
+
+TEST(ApiFrame, CountBoundIsALowerBoundOfTheFramesPlans) {
+    const TraceScene scene = TraceScene::load(test::kRoomScene);
+    const RayBatch rays = RayBatch::fromCamera(scene, {}, 40, 30);
+    const std::vector<FramePass> passes = lightAndOcclusion(scene);
+    const FramePlan bound = frameMemoryBound(rays.size(), passes);
+    ASSERT_EQ(bound.memory.size(), 2 + passes.size());
+    ASSERT_FALSE(bound.work.empty());
+    EXPECT_EQ(bound.work[0].count, rays.size());
+    for (const Backend backend : {Backend::Cpu, Backend::CpuSeq, Backend::Brute}) {
+        std::vector<FramePlan> seen;
+        Tracer tracer(test::onBackend(backend, 2));
+        const FrameOutput frame = tracer.traceFrame(scene, rays, passes, [&seen](const FramePlan& plan) {
+            seen.push_back(plan);
+            return true;
+        });
+        ASSERT_FALSE(frame.stoppedAtPlan) << backendName(backend);
+        ASSERT_GE(seen.size(), 1 + passes.size()) << backendName(backend);
+        // The primary pass's plan holds the bound's rays and hits, byte for byte.
+        EXPECT_EQ(bytesOf(seen[0], "rays"), bytesOf(bound, "rays")) << backendName(backend);
+        EXPECT_EQ(bytesOf(seen[0], "hits"), bytesOf(bound, "hits")) << backendName(backend);
+        EXPECT_LE(bound.memory[0].bytes + bound.memory[1].bytes, seen[0].totalBytes()) << backendName(backend);
+        // Each pass plans its hits per slot, the bound's line of that pass, before its rays.
+        std::uint64_t planned = 0;
+        for (const FramePlan& plan : seen) planned += plan.totalBytes();
+        for (std::size_t k = 0; k < passes.size(); ++k) {
+            const std::uint64_t slotHits = bytesOf(bound, "hits per slot: " + passes[k].name);
+            EXPECT_GT(slotHits, 0u) << passes[k].name;
+            EXPECT_EQ(slotHits, frame.passes[k].output.hits.size() * 16) << passes[k].name;  // a Hit: t, id, u, v
+            EXPECT_TRUE(std::any_of(seen.begin() + 1, seen.end(), [&](const FramePlan& plan) {
+                return bytesOf(plan, "hits per slot") == slotHits;
+            })) << backendName(backend) << ", " << passes[k].name;
+        }
+        EXPECT_LE(bound.totalBytes(), planned) << backendName(backend);
+    }
+}
+
+TEST(ApiFrame, CountBoundRefusesMoreSlotsThanAPassHolds) {
+    FramePass occlusion{.name = "occlusion", .kind = PassKind::Occlusion, .raysPerHit = 1024, .occlusionDistance = 1.0f};
+    EXPECT_THROW(frameMemoryBound(std::uint64_t(16384) * 16384, {occlusion}), InputError);
+    EXPECT_EQ(frameMemoryBound(0, {occlusion}).totalBytes(), 0u);
+}
+
 }  // namespace
 }  // namespace dacrt
