@@ -1,7 +1,5 @@
 #include "core/gltf_compression.hpp"
 
-#include "core/gltf_draco_header.hpp"
-
 #include <algorithm>
 #include <cstring>
 #include <span>
@@ -10,10 +8,12 @@
 #include <draco/core/decoder_buffer.h>
 #include <meshoptimizer.h>
 
+#include "core/gltf_draco_header.hpp"
+
 namespace dacrt::gltf {
 namespace {
 
-// What Draco's decoder allocates, at most, per triangle corner (the mesh's faces, its corner
+// About what Draco's decoder allocates per triangle corner (the mesh's faces, its corner
 // table with opposite corners, the traversal's bookkeeping, an attribute's corner-to-point
 // map) and per point of each attribute (its values, their portable integers and the point
 // map): estimates from version 1.5's tables, rounded up. Checked against what is left of
@@ -130,7 +130,6 @@ int componentTypeOf(draco::DataType t) {
         default: return 0;
     }
 }
-
 
 // The corners the primitive's accessors declare: its indices' count, else its POSITION's.
 std::uint64_t declaredCorners(const AccessorReader& reader, const tinygltf::Primitive& primitive, const std::string& w) {
