@@ -306,7 +306,13 @@ def decoder_stream_cases():
         # tinygltf would read 2^32 + 3 as 3: refused by the JSON's rules
         "meshopt_count_past_an_int": meshopt_quad(b"\xd0" + bytes(39), 2**32 + 3, 4, "INDICES"),
     }
-    return [Case(name, "input", render(), {"scene.gltf": text}) for name, text in {**draco, **meshopt}.items()]
+    cases = [Case(name, "input", render(), {"scene.gltf": text}) for name, text in {**draco, **meshopt}.items()]
+    # An AOV whose OpenEXR header declares a 2 GB string attribute in a 60-byte file: refused
+    # before OpenEXR allocates it (the exr fuzzer's finding).
+    exr = struct.pack("<II", 20000630, 2) + b"capDate\x00string\x00" + struct.pack("<i", 2003788819) + bytes(33)
+    cases.append(Case("aov_header_attribute_past_the_file", "input", ["compare", "{dir}/a.exr", "{dir}/a.exr"],
+                      {"a.exr": exr}))
+    return cases
 
 
 def command_line_cases():
