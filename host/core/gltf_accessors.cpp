@@ -167,14 +167,22 @@ void AccessorReader::applySparse(const tinygltf::Accessor& acc, const Elements& 
     }
 }
 
-void AccessorReader::reserveDecoded(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const {
+std::uint64_t AccessorReader::totalWith(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const {
     const std::uint64_t bytes = mul(count, elementBytes, what + " size");
     const std::uint64_t total = add(decodedBytes_, bytes, what + " size");
     if (byteLimit_ && total > byteLimit_)
         fail(what + " has " + str(count) + " elements, which need " + str(bytes) + " bytes to read" +
              (decodedBytes_ ? " (" + str(total) + " with the accessors read before it)" : std::string()) + ", more than the " +
-             str(byteLimit_) + "-byte limit");
-    decodedBytes_ = total;
+             str(byteLimit_) + "-byte limit (over by " + str(total - byteLimit_) + ")");
+    return total;
+}
+
+void AccessorReader::reserveDecoded(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const {
+    decodedBytes_ = totalWith(count, elementBytes, what);
+}
+
+void AccessorReader::fitsDecoded(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const {
+    totalWith(count, elementBytes, what);
 }
 
 bool AccessorReader::tryReserve(std::uint64_t bytes) const {

@@ -57,6 +57,12 @@ public:
     // Counts `bytes` of other decoded data the document keeps (images) against the same limit;
     // false, counting nothing, when they would pass it.
     bool tryReserve(std::uint64_t bytes) const;
+    // Counts `count` decoded elements of `elementBytes` against the byte limit, before they are
+    // allocated; refuses them, naming `what` and the numbers, past it.
+    void reserveDecoded(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const;
+    // The same check for memory a decoder needs only while it runs: refused past what is left
+    // of the limit, counted by nothing.
+    void fitsDecoded(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const;
 
     // Decoded contents for a buffer view (EXT_meshopt_compression), used instead of its buffer.
     void setDecodedView(int view, std::vector<unsigned char> bytes) { decodedViews_[view] = std::move(bytes); }
@@ -75,9 +81,8 @@ private:
         bool normalized = false;
     };
     Elements elements(int index, std::initializer_list<int> types, const std::string& where) const;
-    // Counts `count` decoded elements of `elementBytes` against the byte limit, before they are
-    // allocated; refuses them, naming `what`, past it.
-    void reserveDecoded(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const;
+    // The total with `count` elements of `elementBytes` more; refused past the limit.
+    std::uint64_t totalWith(std::uint64_t count, std::uint64_t elementBytes, const std::string& what) const;
     void applySparse(const tinygltf::Accessor& acc, const Elements& e, const std::string& where,
                      std::vector<glm::dvec4>& out) const;
 

@@ -22,8 +22,9 @@ struct PrimitiveData {
 };
 
 // Decodes every buffer view carrying EXT_meshopt_compression (or its ratified twin
-// KHR_meshopt_compression) into reader, checking every range; at most byteLimit bytes in all.
-void decodeMeshoptViews(AccessorReader& reader, std::uint64_t byteLimit);
+// KHR_meshopt_compression) into reader, checking every range and every declared size against
+// the compressed bytes, and counting what it decodes against the reader's memory limit.
+void decodeMeshoptViews(AccessorReader& reader);
 
 bool usesDraco(const tinygltf::Primitive& primitive);
 // The primitive's KHR_draco_mesh_compression data: indices and the wanted attributes that

@@ -107,10 +107,11 @@ const std::vector<Rule>& rules() {
         auto add = [&](std::string path, Kind kind, std::string_view target = {}) {
             r.push_back({paths.emplace_back(std::move(path)), kind, target});
         };
+        // tinygltf keeps an extension's numbers in an int (2^32 + 3 would be read as 3).
         for (const char* ext : {"EXT_meshopt_compression", "KHR_meshopt_compression"}) {
             const std::string at = std::string("bufferViews[].extensions.") + ext + ".";
             add(at + "buffer", Kind::Index, "buffers");
-            for (const char* member : {"byteOffset", "byteLength", "byteStride", "count"}) add(at + member, Kind::Size);
+            for (const char* member : {"byteOffset", "byteLength", "byteStride", "count"}) add(at + member, Kind::Int);
         }
         for (std::string_view info : kTextureInfos) {
             add(std::string(info) + ".index", Kind::Index, "textures");

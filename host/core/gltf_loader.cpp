@@ -1040,7 +1040,7 @@ std::unique_ptr<GltfDocument::Impl> openDocument(std::span<const unsigned char> 
     check.checkExtensions(d->shared.warnings);
     check.checkCameras();
     d->parent = check.checkNodes(d->shared.warnings);
-    gltf::decodeMeshoptViews(*d->reader, d->memoryLimit());
+    gltf::decodeMeshoptViews(*d->reader);
     gltf::readMaterials(*d->reader, gltf::ImageSource{baseDir, readFiles}, d->shared);
     Material fallback;
     fallback.name = "(default)";

@@ -9,6 +9,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/errors.hpp"
+#include "core/exr_header.hpp"
 #include "core/input_file.hpp"
 #include "core/system_memory.hpp"
 
@@ -87,8 +88,9 @@ std::string encodeAov(const std::string& path, const Scene& scene, const HitImag
     return encodePixels(path, spec, OIIO::TypeDesc::UNKNOWN, packed.data());
 }
 
-Aov readAov(const std::string& path) {
-    regularInputSize(path, 0);  // OpenImageIO would wait on a FIFO or read a device without end
+Aov readAov(const std::string& path, std::uint64_t maxBytes) {
+    const std::uint64_t fileSize = regularInputSize(path, 0);  // OpenImageIO would wait on a FIFO or read a device without end
+    checkExrHeaderSizes(path, fileSize);
     auto in = OIIO::ImageInput::open(path);
     if (!in) throw InputError(path + ": cannot read image: " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
@@ -100,10 +102,11 @@ Aov readAov(const std::string& path) {
                          " pixels of " + std::to_string(spec.nchannels) +
                          " channels; dacrt's AOVs have 1..16384 pixels a side and at most 1024 channels");
     const std::uint64_t needed = std::uint64_t(spec.width) * std::uint64_t(spec.height) * (12 + std::uint64_t(spec.nchannels)) * 4;
-    if (const std::uint64_t memory = physicalMemoryBytes(); memory && needed > memory)
+    if (const std::uint64_t memory = maxBytes ? maxBytes : physicalMemoryBytes(); memory && needed > memory)
         throw InputError(path + ": reading its " + std::to_string(spec.width) + " x " + std::to_string(spec.height) +
-                         " pixels needs " + std::to_string(needed) + " bytes, more than this machine's " +
-                         std::to_string(memory) + " bytes of memory");
+                         " pixels needs " + std::to_string(needed) + " bytes, more than " +
+                         (maxBytes ? "the limit of " : "this machine's ") + std::to_string(memory) + " bytes" +
+                         (maxBytes ? std::string() : std::string(" of memory")));
     Aov aov;
     aov.width = spec.width;
     aov.height = spec.height;

@@ -44,8 +44,9 @@ struct Aov {
     std::vector<AovChannel> extra;  // the float channels after albedo.B, in the file's order
 };
 
-// Reads an AOV written by encodeAov; throws InputError on a missing file, a non-image, or
-// missing channels.
-Aov readAov(const std::string& path);
+// Reads an AOV written by encodeAov; throws InputError on a missing file, a non-image,
+// missing channels, or a header whose pixels need more than `maxBytes` to read (0: this
+// machine's memory).
+Aov readAov(const std::string& path, std::uint64_t maxBytes = 0);
 
 }  // namespace dacrt

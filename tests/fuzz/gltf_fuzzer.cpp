@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -26,23 +27,17 @@
 #include "core/scene.hpp"
 #include "core/thread_pool.hpp"
 #include "cpu/cpu_tracers.hpp"
+#include "fuzz_support.hpp"
 
 namespace {
 
 using namespace dacrt;
+using fuzz::verbose;
 
 constexpr int kWidth = 8;
 constexpr int kHeight = 6;
 // Tracing cost cap: brute force is triangles x rays tests per frame.
 constexpr std::size_t kMaxTriangles = 2000;
-
-// The loader's own memory limit, far below libFuzzer's -malloc_limit_mb (run_fuzz.sh passes
-// 2048): a file that asks for more must be refused by the loader, not by the allocator.
-GltfLimits fuzzLimits() {
-    GltfLimits limits;
-    limits.maxBytes = 256ull << 20;
-    return limits;
-}
 
 [[noreturn]] void finding(const char* what, std::size_t pixel, const Hit& a, const Hit& b) {
     std::fprintf(stderr, "gltf_fuzzer: %s differ at pixel %zu: prim %u t %a vs prim %u t %a\n", what, pixel,
@@ -57,12 +52,6 @@ void compare(const char* what, const std::vector<Hit>& a, const std::vector<Hit>
     }
     for (std::size_t i = 0; i < a.size(); ++i)
         if (a[i].prim != b[i].prim || std::memcmp(&a[i].t, &b[i].t, sizeof(float)) != 0) finding(what, i, a[i], b[i]);
-}
-
-// DACRT_FUZZ_VERBOSE=1: one line per load saying what became of it (for replaying a corpus).
-bool verbose() {
-    static const bool v = std::getenv("DACRT_FUZZ_VERBOSE") != nullptr;
-    return v;
 }
 
 ThreadPool& pool() {
@@ -110,40 +99,15 @@ void traceFrame(const Scene& scene) {
 }
 
 void loadAndTrace(std::span<const unsigned char> bytes, const char* name) {
-    Scene scene;
-    try {
-        scene = loadGltfFromMemory(bytes, name, fuzzLimits());
-    } catch (const InputError& e) {
-        if (verbose()) std::fprintf(stderr, "%s: refused: %s\n", name, e.what());
-        return;
-    }
-    if (verbose()) std::fprintf(stderr, "%s: loaded %zu triangles%s\n", name, scene.triangles.size(),
-                                scene.camera ? " and a camera" : "");
+    std::optional<Scene> loaded = fuzz::load(bytes, name);
+    if (!loaded) return;
+    Scene& scene = *loaded;
     if (scene.triangles.empty() || scene.triangles.size() > kMaxTriangles) return;
     traceFrame(scene);
     if (scene.camera) {  // and the default front view, which frames the triangles
         scene.camera.reset();
         traceFrame(scene);
     }
-}
-
-void put32(std::vector<unsigned char>& out, std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) out.push_back(static_cast<unsigned char>(v >> (8 * i)));
-}
-
-// A .glb with the text as its only (JSON) chunk, padded with spaces as the format asks.
-std::vector<unsigned char> wrapAsGlb(std::span<const unsigned char> json) {
-    const std::size_t padded = (json.size() + 3) / 4 * 4;
-    std::vector<unsigned char> glb;
-    glb.reserve(20 + padded);
-    glb.insert(glb.end(), {'g', 'l', 'T', 'F'});
-    put32(glb, 2);
-    put32(glb, std::uint32_t(20 + padded));
-    put32(glb, std::uint32_t(padded));
-    glb.insert(glb.end(), {'J', 'S', 'O', 'N'});
-    glb.insert(glb.end(), json.begin(), json.end());
-    glb.resize(20 + padded, ' ');
-    return glb;
 }
 
 }  // namespace
@@ -153,7 +117,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
     loadAndTrace(bytes, binary ? "fuzz.glb" : "fuzz.gltf");
     if (!binary) {
-        const std::vector<unsigned char> glb = wrapAsGlb(bytes);
+        const std::vector<unsigned char> glb = fuzz::glbWithHeader(fuzz::glbChunks(bytes, {}));
         loadAndTrace(glb, "fuzz-wrapped.glb");
     }
     return 0;

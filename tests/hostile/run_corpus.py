@@ -308,6 +308,96 @@ def image_cases():
     return cases
 
 
+def uri(data):
+    return "data:application/octet-stream;base64," + base64.b64encode(data).decode()
+
+
+def varints(*values):
+    out = b""
+    for v in values:
+        while v >= 0x80:
+            out += bytes([v & 0x7F | 0x80])
+            v >>= 7
+        out += bytes([v])
+    return out
+
+
+def draco_quad(stream, positions=4, indices=6, normals=False):
+    """The quad as a Draco primitive whose stream is `stream`, its accessors view-less with the
+    counts given."""
+    j = quad()
+    j["extensionsUsed"] = ["KHR_draco_mesh_compression"]
+    j["buffers"].append({"byteLength": len(stream), "uri": uri(stream)})
+    j["bufferViews"].append({"buffer": 1, "byteLength": len(stream)})
+    j["accessors"] = [{"componentType": 5126, "count": positions, "type": "VEC3"},
+                      {"componentType": 5125, "count": indices, "type": "SCALAR"}]
+    prim = j["meshes"][0]["primitives"][0]
+    ids = {"POSITION": 0}
+    if normals:
+        j["accessors"].append({"componentType": 5126, "count": positions, "type": "VEC3"})
+        prim["attributes"]["NORMAL"] = 2
+        ids["NORMAL"] = 1
+    prim["extensions"] = {"KHR_draco_mesh_compression": {"bufferView": len(j["bufferViews"]) - 1, "attributes": ids}}
+    return dump(j)
+
+
+def draco_stream(method, counts, encoder_type=1, version=(2, 2)):
+    """A Draco mesh header (method 0: sequential, 1: edgebreaker) and its counts: sequential
+    faces, points; edgebreaker encoded vertices, faces, symbols, split symbols."""
+    head = b"DRACO" + bytes([version[0], version[1], encoder_type, method, 0, 0])
+    if method == 1:
+        return head + b"\x00" + varints(*counts[:2]) + b"\x00" + varints(*counts[2:]) + bytes(16)
+    return head + varints(*counts) + bytes(16)
+
+
+def meshopt_quad(compressed, count, stride, mode, filter_="NONE"):
+    """The quad with one more buffer view, unused, compressed by EXT_meshopt_compression into
+    `compressed` bytes (every such view is decoded when the file opens)."""
+    j = quad()
+    j["extensionsUsed"] = ["EXT_meshopt_compression"]
+    j["buffers"].append({"byteLength": len(compressed), "uri": uri(compressed)})
+    j["buffers"].append({"byteLength": count * stride, "extensions": {"EXT_meshopt_compression": {"fallback": True}}})
+    j["bufferViews"].append({"buffer": 2, "byteLength": count * stride, "extensions": {"EXT_meshopt_compression": {
+        "buffer": 1, "byteLength": len(compressed), "byteStride": stride, "count": count, "mode": mode, "filter": filter_}}})
+    return dump(j)
+
+
+def decoder_stream_cases():
+    """Sizes the compressed streams declare, refused before a decoder allocates for them."""
+    draco = {
+        # sequential: 2 faces and 2^32 - 1 points for the 4 positions declared
+        "draco_stream_points_past_the_accessors": draco_quad(draco_stream(0, [2, 2**32 - 1])),
+        "draco_stream_faces_past_the_accessors": draco_quad(draco_stream(0, [2**30, 4])),
+        "draco_edgebreaker_vertices_past_its_faces": draco_quad(draco_stream(1, [2**32 - 16, 2, 2, 0])),
+        "draco_edgebreaker_symbols_past_its_faces": draco_quad(draco_stream(1, [4, 2, 2**31, 0])),
+        "draco_edgebreaker_faces_past_the_accessors": draco_quad(draco_stream(1, [4, 2**28, 2**28, 0])),
+        "draco_stream_point_cloud": draco_quad(draco_stream(0, [2, 4], encoder_type=0)),
+        "draco_stream_unknown_version": draco_quad(draco_stream(0, [2, 4], version=(9, 0))),
+        "draco_stream_ends_in_its_counts": draco_quad(b"DRACO\x02\x02\x01\x00\x00\x00\x80"),
+        # counts that agree with view-less accessors of 2^32 - 1 points, two attributes: what
+        # Draco would size for them is past this machine's memory
+        "draco_stream_points_past_memory": draco_quad(draco_stream(0, [2, 2**32 - 1]), positions=2**32 - 1, normals=True),
+    }
+    meshopt = {
+        # version 0: 2^30 12-byte vertices need 201,326,625 compressed bytes at least
+        "meshopt_vertices_past_the_compressed_bytes": meshopt_quad(b"\xa0" + bytes(39), 2**30, 12, "ATTRIBUTES"),
+        "meshopt_vertices_of_a_later_version_past_the_compressed_bytes": meshopt_quad(b"\xa1" + bytes(39), 2**30, 12, "ATTRIBUTES"),
+        "meshopt_triangles_past_the_compressed_bytes": meshopt_quad(b"\xe0" + bytes(39), 3 * 2**28, 4, "TRIANGLES"),
+        "meshopt_index_sequence_past_the_compressed_bytes": meshopt_quad(b"\xd0" + bytes(39), 2**30, 4, "INDICES"),
+        "meshopt_unknown_filter": meshopt_quad(b"\xa0" + bytes(39), 2**30, 12, "ATTRIBUTES", "MADE_UP"),
+        "meshopt_quaternion_filter_on_indices": meshopt_quad(b"\xe0" + bytes(39), 3 * 2**28, 4, "TRIANGLES", "QUATERNION"),
+        # tinygltf would read 2^32 + 3 as 3: refused by the JSON's rules
+        "meshopt_count_past_an_int": meshopt_quad(b"\xd0" + bytes(39), 2**32 + 3, 4, "INDICES"),
+    }
+    cases = [Case(name, "input", render(), {"scene.gltf": text}) for name, text in {**draco, **meshopt}.items()]
+    # An AOV whose OpenEXR header declares a 2 GB string attribute in a 60-byte file: refused
+    # before OpenEXR allocates it (the exr fuzzer's finding).
+    exr = struct.pack("<II", 20000630, 2) + b"capDate\x00string\x00" + struct.pack("<i", 2003788819) + bytes(33)
+    cases.append(Case("aov_header_attribute_past_the_file", "input", ["compare", "{dir}/a.exr", "{dir}/a.exr"],
+                      {"a.exr": exr}))
+    return cases
+
+
 def command_line_cases():
     q = dump(quad())
     cases = [
@@ -393,7 +483,8 @@ def special_file_cases():
 
 
 def all_cases():
-    cases = spec_rule_cases() + declared_size_cases() + image_cases() + command_line_cases() + special_file_cases()
+    cases = (spec_rule_cases() + declared_size_cases() + decoder_stream_cases() + image_cases() + command_line_cases()
+             + special_file_cases())
     names = [c.name for c in cases]
     assert len(names) == len(set(names)), "case names repeat"
     return cases
