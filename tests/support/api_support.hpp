@@ -104,16 +104,6 @@ inline std::size_t hitCount(const std::vector<RayHit>& hits) {
     return n;
 }
 
-// Expects `call` to throw InputError whose message contains `part`.
-inline void expectInputError(const std::function<void()>& call, const std::string& part) {
-    try {
-        call();
-        ADD_FAILURE() << "no InputError; expected one naming '" << part << "'";
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << "message: " << e.what();
-    }
-}
-
 inline TracerOptions onBackend(Backend backend, unsigned threads = 0) {
     TracerOptions o;
     o.trace.backend = backend;
