@@ -53,6 +53,8 @@ struct Slice {
     uint stalls;
     uint leafNext;     // a leaf running in slices: its next ray, else 0
     uint spent;        // loop iterations this slice has used
+    uint costBefore;   // loop iterations the earlier slices of the work item used
+    uint stackSlot;    // TraversalState::stackSlot
     bool progressed;   // this slice did some work (else the work item cannot fit a slice)
 };
 
@@ -112,6 +114,8 @@ void markFinished(ItemContext c) {
 bool startAtRoot(ItemContext c, inout Slice s) {
     if (c.lane == 0) atomicAdd(counters.workItemsRun, 1u);
     s.spent = partitionCost(c.rayEnd - s.terminated);
+    s.costBefore = 0u;
+    s.stackSlot = 0u;
     if (overBudget(s.spent, c.retireCost)) {
         if (c.lane == 0) atomicAdd(counters.tooLarge, 1u);
         return false;
@@ -141,7 +145,10 @@ void resumeSaved(ItemContext c, TraversalState state, inout Slice s) {
     s.stalls = state.stalls;
     s.leafNext = state.leafNext;
     s.progressed = false;
-    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) sStack[i] = stacks[c.index * kStackCapacity + i];
+    s.costBefore = state.cost;
+    s.stackSlot = state.stackSlot;
+    uint from = (s.stackSlot - 1u) * kStackCapacity;  // a saved work item has its slot
+    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) sStack[i] = stacks[from + i];
     s.spent = s.stackSize / kWorkgroupSize + 1u;
     workgroupSync();
 }
@@ -266,11 +273,21 @@ uint stepTraversal(ItemContext c, inout Slice s) {
     return isLeaf ? runLeaf(c, s, rayCount, triCount) : splitNode(c, s, axis, split, rayCount, triCount);
 }
 
-// Out of budget: the node and the stack are saved, and a later dispatch resumes here.
+// Out of budget: the node and the stack are saved, and a later dispatch resumes here. A work
+// item's first save takes the next free stack slot: few work items ever save, so the buffer
+// holds fewer stacks than there are work items; past its last slot nothing is written, and
+// the host fails the frame (stackSlotsTaken).
 void saveSlice(ItemContext c, Slice s) {
     if (!s.progressed && c.lane == 0) atomicAdd(counters.tooLarge, 1u);
+    if (s.stackSlot == 0u) {
+        if (c.lane == 0) sStackSlot = atomicAdd(counters.stackSlotsTaken, 1u) + 1u;
+        memoryBarrierShared();
+        barrier();
+        s.stackSlot = sStackSlot;
+    }
     workgroupSync();
-    for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) stacks[c.index * kStackCapacity + i] = sStack[i];
+    if (s.stackSlot <= push.stackSlots)
+        for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) stacks[(s.stackSlot - 1u) * kStackCapacity + i] = sStack[i];
     bool cutShort = loopLimiterFired(push.loopProbe);
     if (c.lane == 0) {
         TraversalState saved;
@@ -284,6 +301,8 @@ void saveSlice(ItemContext c, Slice s) {
         saved.stackSize = s.stackSize;
         saved.stalls = s.stalls;
         saved.leafNext = s.leafNext;
+        saved.cost = s.costBefore + s.spent;
+        saved.stackSlot = s.stackSlot;
         states[c.index] = saved;
         regions[c.item.rayRegion].terminated = s.terminated;
         if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
@@ -302,6 +321,9 @@ void retireRays(ItemContext c, Slice s) {
         if (c.item.retire == 0u) atomicAdd(counters.terminatedStep1, terminated - regions[c.item.rayRegion].rayBegin);
         regions[c.item.rayRegion].terminated = terminated;
         if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
+        // The work item's cost, read back for the work item report (the final partition and
+        // the probe as the slice reserved them).
+        states[c.index].cost = s.costBefore + s.spent + c.retireCost;
         markFinished(c);
     }
 }

@@ -53,5 +53,6 @@ shared bool sReady;                           // this work item may run now
 // waiting child, or two where rays are classified per split (kOrderPerRay).
 const uint kStackCapacity = 2u * kMaxDepth + 1u;
 shared StackEntry sStack[kStackCapacity];
+shared uint sStackSlot;                       // the slot a work item's first save takes
 
 #endif

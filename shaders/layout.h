@@ -100,8 +100,8 @@ struct TraversalState {
     uint stackSize;
     uint stalls;       // splits in a row that kept every ray and triangle (DACRT_MAX_STALLED_SPLITS)
     uint leafNext;     // a leaf in progress: its rays before this were tested; 0 when none
-    uint pad0;
-    uint pad1;
+    uint cost;         // loop iterations of the kernel's cost model spent so far, over every slice
+    uint stackSlot;    // where its stack waits between slices: slot stackSlot - 1 of `stacks`; 0: none yet
 };
 
 struct StackEntry {   // a child waiting, with its parent's ranges
@@ -130,7 +130,7 @@ struct DacrtPush {
     uint loopProbe;        // 2; a loop of this many iterations at the end detects a loop limiter
     float rayTmin;         // every ray's tmin, where DACRT_SPEC_SHARED_START says they share it
     uint order;            // kOrder*
-    uint pad2;
+    uint stackSlots;       // traversal stacks the stack buffer holds (taken in turn by work items that save one)
 };
 
 // A light as a secondary pass traces it (from Scene::lights or --light), in float32.
@@ -188,6 +188,7 @@ struct GpuCounters {
     uint notReady;       // work item launches that found an earlier one still running
     uint tooLarge;       // work items with a single step beyond the loop budget
     uint terminatedStep1;  // rays finished by Step 1 work items (hit or retired), as the cpu backend counts them
+    uint stackSlotsTaken;  // work items that saved a stack (more than DacrtPush::stackSlots: the frame fails)
 };
 
 // Push constants of workgroup_test.comp, which runs one building block of the DACRT kernel
@@ -244,11 +245,13 @@ static_assert(offsetof(WorkItem, triRegion) == 4 && offsetof(WorkItem, retire) =
 static_assert(offsetof(WorkItem, raySeq) == 12 && offsetof(WorkItem, triSeq) == 16);
 static_assert(sizeof(TraversalState) == 64 && offsetof(TraversalState, phase) == 12);
 static_assert(offsetof(TraversalState, stalls) == 48 && offsetof(TraversalState, leafNext) == 52);
+static_assert(offsetof(TraversalState, cost) == 56 && offsetof(TraversalState, stackSlot) == 60);
 static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalState, stackSize) == 44);
 static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depth) == 36);
 static_assert(offsetof(StackEntry, stalls) == 40 && offsetof(StackEntry, rayRule) == 44);
 static_assert(sizeof(DacrtPush) == 48 && offsetof(DacrtPush, loopProbe) == 32);
 static_assert(offsetof(DacrtPush, rayTmin) == 36 && offsetof(DacrtPush, order) == 40);
+static_assert(offsetof(DacrtPush, stackSlots) == 44);
 static_assert(sizeof(ShadowLight) == 48 && offsetof(ShadowLight, type) == 12);
 static_assert(offsetof(ShadowLight, direction) == 16 && offsetof(ShadowLight, range) == 28);
 static_assert(offsetof(ShadowLight, cosOuterSquared) == 32);
@@ -261,8 +264,8 @@ static_assert(offsetof(SecondaryPush, firstInvocation) == 88);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
-static_assert(sizeof(GpuCounters) == 52 && offsetof(GpuCounters, raysRetired) == 20);
-static_assert(offsetof(GpuCounters, terminatedStep1) == 48);
+static_assert(sizeof(GpuCounters) == 56 && offsetof(GpuCounters, raysRetired) == 20);
+static_assert(offsetof(GpuCounters, terminatedStep1) == 48 && offsetof(GpuCounters, stackSlotsTaken) == 52);
 static_assert(offsetof(GpuCounters, itemsFinished) == 32 && offsetof(GpuCounters, tooLarge) == 44);
 static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, loopLimitHits) == 28);
 static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);

@@ -107,6 +107,7 @@ Tracer openTracer(const BenchCommand& cmd, const std::vector<Backend>& backends)
     o.trace.backend = *vulkan;
     o.device = cmd.device;
     o.validate = cmd.validate;
+    if (o.trace.backend == Backend::Gpu) o.gpu.profile = cmd.gpuProfile;  // gpuDefaults: the sweep's, under it
     return Tracer(o);
 }
 
@@ -133,6 +134,8 @@ std::vector<BenchConfig> chooseConfigs(const BenchCommand& cmd, const std::vecto
                                               : table51Configs(b, hardwareThreads);
         configs.insert(configs.end(), more.begin(), more.end());
     }
+    for (BenchConfig& c : configs)
+        if (c.backend() == Backend::Gpu) c.options.gpu.profile = cmd.gpuProfile;
     return configs;
 }
 

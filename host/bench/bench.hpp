@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include <dacrt/backend_tuning.hpp>
 #include <dacrt/options.hpp>
 
 #include "core/camera.hpp"
@@ -53,6 +54,7 @@ struct BenchCommand {
     bool useCache = true;
     std::string device;        // gpu, rayquery: --device (index or part of the name; empty: the best)
     bool validate = false;     // gpu, rayquery: --validate
+    GpuProfile gpuProfile = GpuProfile::Auto;  // gpu: --gpu-profile, every configuration's
     // --suite passes: the lights (render's --light) and the occlusion rays per hit (--ao).
     PassOptions passes{.lights = {}, .occlusionSamples = 4, .occlusionDistance = 0.0};
     // --suite animation: frames first..last (--frames, render's syntax), frame n at n / fps

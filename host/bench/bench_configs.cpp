@@ -31,6 +31,8 @@ std::string optionText(const BenchConfig& c) {
       << " threads=" << c.threads();
     if (c.backend() == Backend::Gpu)
         s << " ray_groups=" << (c.options.gpu.rayGroups ? std::to_string(c.options.gpu.rayGroups) : "auto");
+    if (c.backend() == Backend::Gpu && c.options.gpu.profile != GpuProfile::Auto)
+        s << " profile=" << toString(c.options.gpu.profile);
     const SkipSwitches& k = c.options.trace.skips;
     if (!(k == SkipSwitches{}))
         s << " no_skip=" << (k.backFaces ? "" : "backfaces,") << (k.frustum ? "" : "frustum,") << (k.uploads ? "" : "uploads,") << (k.subScenes ? "" : "subscenes,");

@@ -268,6 +268,7 @@ Subcommand addRenderCommand(CLI::App& app) {
     addDeviceOptions(cmd, render.tracer.device, render.tracer.validate);
     cmd->add_option("--workgroup-size", render.tracer.gpu.workgroupSize)->check(CLI::Range(1u, 1024u));
     cmd->add_option("--ray-groups", render.tracer.gpu.rayGroups)->check(CLI::Range(1u, 64u));
+    addEnumOption(cmd, "--gpu-profile", render.tracer.gpu.profile, "");
     addFrameOptions(cmd, *s);
     describeBackendOptions(cmd);
     return {cmd, [s, cmd] {
@@ -422,6 +423,9 @@ Subcommand addBenchCommand(CLI::App& app) {
     cmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
     cmd->add_flag("--no-cache", s->noCache, "always recompute the float64 reference");
     addDeviceOptions(cmd, bench.device, bench.validate);
+    addEnumOption(cmd, "--gpu-profile", bench.gpuProfile,
+                  "whose defaults the gpu rows take: auto (the device's kind), cpu (a CPU device's) or discrete "
+                  "(a discrete GPU's, on any device; docs/gpu.md)");
     return {cmd, [s, cmd, light, ao, aoDistance, frames, fps, animation] {
                 if (s->bench.suite != BenchSuite::Passes && (light->count() || ao->count() || aoDistance->count()))
                     throw InputError("--light, --ao and --ao-distance light the frames of --suite passes; the other "

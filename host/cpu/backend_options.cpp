@@ -19,8 +19,8 @@ constexpr bool kAdvanced = true;
 constexpr bool kDacrtOption = true;
 
 // The order is the help's, and the order in which a refusal names the options.
-constexpr std::array<BackendOption, 16> kBackendOptions{{
-    {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 16 on a GPU",
+constexpr std::array<BackendOption, 17> kBackendOptions{{
+    {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.axis != DivisionAxis::Best; }},
@@ -47,8 +47,12 @@ constexpr std::array<BackendOption, 16> kBackendOptions{{
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,
      [](const RequestedOptions& r) { return r.workgroupSize != 0; }},
     {"--ray-groups", kGpu, "work items per region, each a band of its rays with its own copy of the region's triangle ids",
-     "default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; 64 / regions on a GPU",
+     "default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; 2048 / regions on a GPU",
      kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.rayGroups != 0; }},
+    {"--gpu-profile", kGpu,
+     "whose defaults the regions, ray groups and workgroup size take where not given: auto (the device's kind), cpu "
+     "(a CPU device's, as lavapipe's) or discrete (a discrete GPU's, at least 2048 work items in Step 1, on any device)",
+     "default: auto", kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.gpuProfile != GpuProfile::Auto; }},
     {"--no-skip", {Backend::Brute, Backend::CpuSeq, Backend::Cpu, Backend::Gpu},
      "skips to turn off (each changes speed only): backfaces (single-sided triangles facing away from the camera), "
      "frustum (triangles outside the view), uploads (gpu: triangle buffers kept across frames), subscenes (cpu: small "

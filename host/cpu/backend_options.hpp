@@ -37,6 +37,7 @@ struct RequestedOptions {
     std::uint32_t rayGroups = 0;
     bool embreeRobust = true;
     bool embreePackets = true;
+    GpuProfile gpuProfile = GpuProfile::Auto;
 };
 
 // One backend-specific option of `dacrt render`.

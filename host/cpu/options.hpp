@@ -70,6 +70,11 @@ struct EnumNames<EmbreeBuild> {
         {{EmbreeBuild::Dynamic, "dynamic"}, {EmbreeBuild::Refit, "refit"}, {EmbreeBuild::Static, "static"}}};
 };
 template <>
+struct EnumNames<GpuProfile> {
+    static constexpr std::array<std::pair<GpuProfile, std::string_view>, 3> table{
+        {{GpuProfile::Auto, "auto"}, {GpuProfile::Cpu, "cpu"}, {GpuProfile::Discrete, "discrete"}}};
+};
+template <>
 struct EnumNames<RayQueryBuild> {
     static constexpr std::array<std::pair<RayQueryBuild, std::string_view>, 3> table{
         {{RayQueryBuild::Dynamic, "dynamic"}, {RayQueryBuild::Refit, "refit"}, {RayQueryBuild::Static, "static"}}};

@@ -7,6 +7,17 @@
 
 namespace dacrt::gpu {
 
+namespace {
+
+std::uint64_t stackBytes(std::uint32_t maxDepth) { return (2 * std::uint64_t(maxDepth) + 1) * sizeof(StackEntry); }
+
+}  // namespace
+
+std::uint64_t stackSlotsFor(std::uint64_t workItems, std::uint32_t maxDepth, const DeviceInfo& device, bool slices) {
+    if (!slices) return 1;
+    return std::max<std::uint64_t>(1, std::min(workItems, device.maxStorageBufferRange / stackBytes(maxDepth)));
+}
+
 DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& c) {
     DacrtBufferPlan p{};
     p[DACRT_BINDING_RAYS] = {"rays", c.rays * sizeof(Ray)};
@@ -19,7 +30,7 @@ DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& c) {
     p[DACRT_BINDING_WORK_ITEMS] = {"work items", c.workItems * sizeof(WorkItem)};
     p[DACRT_BINDING_COUNTERS] = {"counters", sizeof(GpuCounters)};
     p[DACRT_BINDING_STATES] = {"traversal states", c.workItems * sizeof(TraversalState)};
-    p[DACRT_BINDING_STACKS] = {"traversal stacks", c.workItems * (2 * std::uint64_t(c.maxDepth) + 1) * sizeof(StackEntry)};
+    p[DACRT_BINDING_STACKS] = {"traversal stacks", (c.stackSlots ? c.stackSlots : c.workItems) * stackBytes(c.maxDepth)};
     p[DACRT_BINDING_SOURCE_RAYS] = {"primary rays (secondary passes)", std::max<std::uint64_t>(c.sourceRays, 1) * sizeof(Ray)};
     p[DACRT_BINDING_SOURCE_HITS] = {"primary hits (secondary passes)", std::max<std::uint64_t>(c.sourceRays, 1) * sizeof(Hit)};
     return p;

@@ -22,8 +22,15 @@ struct DacrtBufferCounts {
     std::uint64_t regions = 0;       // region slots
     std::uint64_t workItems = 0;
     std::uint32_t maxDepth = 0;      // traversal stack depth per work item
+    // Traversal stacks kept between slices, taken in turn by the work items that save one
+    // (stackSlotsFor); 0: one per work item.
+    std::uint64_t stackSlots = 0;
     std::uint64_t sourceRays = 0;    // secondary passes: the primary rays they start from (0: a primary pass)
 };
+
+// The traversal stacks a frame keeps: none is saved without a loop budget (one slot, bound and
+// never used); with one, a stack per work item as far as the device's largest buffer holds them.
+std::uint64_t stackSlotsFor(std::uint64_t workItems, std::uint32_t maxDepth, const DeviceInfo& device, bool slices);
 
 struct PlannedBuffer {
     const char* name;    // for the memory plan and error messages

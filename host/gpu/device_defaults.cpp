@@ -17,16 +17,20 @@ std::uint32_t loopBudgetOf(const DeviceInfo& device) {
     return major >= 25 ? 0u : 40000u;
 }
 
+bool takesCpuDefaults(const DeviceInfo& device, GpuProfile profile) {
+    return profile == GpuProfile::Auto ? device.isCpu() : profile == GpuProfile::Cpu;
+}
+
 std::uint32_t widestWorkgroup(const DeviceInfo& device) {
     const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
     return std::min({device.maxComputeWorkGroupInvocations, device.maxComputeWorkGroupSizeX, subgroup * subgroup});
 }
 
-std::uint32_t defaultWorkgroupSize(const DeviceInfo& device, std::uint32_t largestRegionRays,
+std::uint32_t defaultWorkgroupSize(const DeviceInfo& device, GpuProfile profile, std::uint32_t largestRegionRays,
                                    std::uint32_t largestRegionTriangles) {
     const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
     const std::uint32_t widest = widestWorkgroup(device);
-    std::uint32_t size = device.isCpu() ? subgroup : std::max(64u, subgroup);
+    std::uint32_t size = takesCpuDefaults(device, profile) ? subgroup : std::max(64u, subgroup);
     if (const std::uint32_t budget = loopBudgetOf(device)) {
         // The largest single step (a split of the biggest region, then its final partition)
         // must fit one slice: about (2 (rays + triangles) + 2 rays) / (4 size) iterations, a
@@ -37,22 +41,24 @@ std::uint32_t defaultWorkgroupSize(const DeviceInfo& device, std::uint32_t large
     return std::min(size, widest);
 }
 
-std::uint32_t defaultRayGroups(const DeviceInfo& device, unsigned regions) {
+std::uint32_t defaultRayGroups(const DeviceInfo& device, GpuProfile profile, unsigned regions) {
     // A CPU device under the loop limiter: two per region, because a dispatch of slices lasts
     // as long as its longest slice and more work items even them out (docs/gpu.md). Without
     // the limiter each work item runs to its end in one dispatch, and a second group only
     // filters the region's triangles twice near the root (Mesa 25.0.7: one group 5.5% faster
-    // on the Dragon, 1.7% on the Bunny, docs/benchmarks.md). A GPU: at least 64 work items in
-    // Step 1 (unmeasured).
-    if (device.isCpu()) return loopBudgetOf(device) ? 2u : 1u;
-    return std::max(1u, (64u + regions - 1u) / regions);
+    // on the Dragon, 1.7% on the Bunny, docs/benchmarks.md). A GPU: enough groups for
+    // kDiscreteStep1WorkItems in Step 1, each a copy of its region's triangle ids (docs/gpu.md,
+    // "The gpu profiles": the Dragon at 1920x1080, counted by the kernel's cost model).
+    if (takesCpuDefaults(device, profile)) return loopBudgetOf(device) ? 2u : 1u;
+    return std::clamp((kDiscreteStep1WorkItems + regions - 1u) / regions, 1u, kMostDefaultRayGroups);
 }
 
-unsigned defaultGpuRegions(const DeviceInfo& device) {
+unsigned defaultGpuRegions(const DeviceInfo& device, GpuProfile profile) {
     // A CPU device runs one workgroup per thread: one region per core, as for the cpu backend,
     // measured best on lavapipe (docs/benchmarks.md: 2 regions beat 16 by 35% on the Bunny
-    // and 17% on the Dragon). A GPU wants many work items; 16 is unmeasured there.
-    return device.isCpu() ? std::max(1u, std::thread::hardware_concurrency()) : 16u;
+    // and 17% on the Dragon). A GPU wants thousands of work items: 64 regions halved the
+    // longest chain of dependent work items of 16 (docs/gpu.md, "The gpu profiles").
+    return takesCpuDefaults(device, profile) ? std::max(1u, std::thread::hardware_concurrency()) : kDiscreteRegions;
 }
 
 }  // namespace dacrt::gpu

@@ -3,9 +3,21 @@
 // (docs/gpu.md), and the limits that bound those choices.
 #include <cstdint>
 
+#include <dacrt/backend_tuning.hpp>
+
 #include "gpu/context.hpp"
 
 namespace dacrt::gpu {
+
+// The discrete profile's shape (docs/gpu.md, "The gpu profiles"): Step 1 gets at
+// least kDiscreteStep1WorkItems work items, kDiscreteRegions regions times their ray groups
+// (at most kMostDefaultRayGroups, the triangle ids being copied once per group).
+inline constexpr unsigned kDiscreteRegions = 64;
+inline constexpr std::uint32_t kDiscreteStep1WorkItems = 2048;
+inline constexpr std::uint32_t kMostDefaultRayGroups = 64;
+
+// Whether the profile gives this device a CPU device's defaults (GpuProfile::Auto: if it is one).
+bool takesCpuDefaults(const DeviceInfo& device, GpuProfile profile);
 
 // Loop iterations one slice of a work item may spend: llvmpipe's loop limiter, 0 elsewhere.
 std::uint32_t loopBudgetOf(const DeviceInfo& device);
@@ -17,13 +29,13 @@ std::uint32_t widestWorkgroup(const DeviceInfo& device);
 // A CPU device such as lavapipe runs a workgroup on one thread, SIMD across invocations, so
 // one subgroup per workgroup (no shared-memory barrier at all), widened only as far as the
 // loop budget needs for the largest region; a GPU wants wider workgroups.
-std::uint32_t defaultWorkgroupSize(const DeviceInfo& device, std::uint32_t largestRegionRays,
+std::uint32_t defaultWorkgroupSize(const DeviceInfo& device, GpuProfile profile, std::uint32_t largestRegionRays,
                                    std::uint32_t largestRegionTriangles);
 
 // Ray groups per region (see groupRegions in gpu/work_plan.hpp).
-std::uint32_t defaultRayGroups(const DeviceInfo& device, unsigned regions);
+std::uint32_t defaultRayGroups(const DeviceInfo& device, GpuProfile profile, unsigned regions);
 
 // Regions (sub-scenes).
-unsigned defaultGpuRegions(const DeviceInfo& device);
+unsigned defaultGpuRegions(const DeviceInfo& device, GpuProfile profile);
 
 }  // namespace dacrt::gpu

@@ -13,6 +13,7 @@
 #include "gpu/device_defaults.hpp"
 #include "gpu/dispatch_recorder.hpp"
 #include "gpu/work_plan.hpp"
+#include "gpu/work_spread.hpp"
 
 namespace dacrt {
 
@@ -45,6 +46,7 @@ struct GpuTracer::Frame {
     std::uint32_t workgroupSize = 0;
     std::uint64_t triIdCount = 0;           // triangle ids over every ray group
     gpu::DacrtBufferPlan buffers{};
+    std::uint64_t stackSlots = 0;           // traversal stacks kept between slices (stackSlotsFor)
     gpu::ResidentBuffers kept{};            // bound from elsewhere: resident triangles, the primary pass's
     bool trianglesOnDevice = false;         // resident_ holds this frame's already (uploads skip)
     bool keepsTriangles = false;            // the uploads skip applies: triangles kept on the device
@@ -67,7 +69,7 @@ std::uint32_t chooseWorkgroupSize(const gpu::WorkPlan& work, const GpuTuning& tu
                                   TraceResult& result) {
     const std::uint32_t size = tuning.workgroupSize
                                    ? tuning.workgroupSize
-                                   : gpu::defaultWorkgroupSize(device, work.largestSlotRays, work.largestSlotTriangles);
+                                   : gpu::defaultWorkgroupSize(device, tuning.profile, work.largestSlotRays, work.largestSlotTriangles);
     const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
     const std::uint32_t widest = gpu::widestWorkgroup(device);
     if (size % subgroup != 0 || size > widest)
@@ -86,6 +88,15 @@ void checkLoopLimit(const GpuCounters& counters, std::size_t items, const gpu::D
                             " work item slices were cut short by the driver's loop limit (" + device.driver +
                             " ends every shader invocation after 65535 loop iterations in all); the kernel's cost " +
                             "estimates undercount this scene: please report it (docs/gpu.md)");
+}
+
+// A work item that saved its stack past the buffer's last slot cannot resume: checked after
+// every submission, as the loop limit.
+void checkStackSlots(const GpuCounters& counters, std::uint32_t slots) {
+    if (counters.stackSlotsTaken > slots)
+        throw InputError(std::to_string(counters.stackSlotsTaken) + " work items ran out of the loop budget and saved " +
+                         "their traversal stacks, more than the " + std::to_string(slots) + " the device's largest " +
+                         "buffer holds; use fewer regions or ray groups (docs/gpu.md)");
 }
 
 // Records `count` work items from `first` as dispatches of at most maxComputeWorkGroupCountX.
@@ -140,6 +151,7 @@ void dispatchContinuations(const gpu::WorkPlan& work, gpu::Context& context, gpu
     const std::uint32_t perDispatch = device.maxComputeWorkGroupCountX;
     while (counters.itemsFinished < items) {
         checkLoopLimit(counters, items, device);
+        checkStackSlots(counters, push.stackSlots);
         if (counters.tooLarge > 0)
             throw InputError(std::to_string(counters.tooLarge) + " work items have a single step larger than the loop " +
                              "budget of " + std::to_string(gpu::loopBudgetOf(device)) + " iterations (" + device.driver +
@@ -153,6 +165,7 @@ void dispatchContinuations(const gpu::WorkPlan& work, gpu::Context& context, gpu
             throw InternalError("gpu work items stopped making progress (" + std::to_string(counters.itemsFinished) +
                                 " of " + std::to_string(items) + " finished): please report it");
     }
+    checkStackSlots(counters, push.stackSlots);
 }
 
 // Secondary rays start on the surfaces, at most kOffsetSteps float32 steps of the triangles'
@@ -265,12 +278,12 @@ TraceResult GpuTracer::trace(const FrameGeometry& geometry, const PlanHook& onPl
 void GpuTracer::divide(Frame& frame) {
     const auto start = Clock::now();
     const gpu::DeviceInfo& device = context_.info();
-    const unsigned regions = options_.regions ? options_.regions : gpu::defaultGpuRegions(device);
+    const unsigned regions = options_.regions ? options_.regions : gpu::defaultGpuRegions(device, tuning_.profile);
     const int axis = options_.axis == DivisionAxis::Best ? chooseDivisionAxis(frame.geometry, regions)
                                                          : int(options_.axis) - 1;
     frame.division = divideScene(frame.geometry, regions, axis, pool_, frame.hostPlan);
     const std::vector<TransferRound> schedule = transferSchedule(frame.division);
-    const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, regions);
+    const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, tuning_.profile, regions);
     frame.ownWork = gpu::planWorkItems(frame.division, schedule, groups);
     frame.triIdCount = std::uint64_t(frame.division.triIds.size()) * frame.work->groups;
     frame.result.regions = regions;
@@ -292,13 +305,14 @@ void GpuTracer::planMemory(Frame& frame) const {
         .regions = work.slots.size(),
         .workItems = work.items.size(),
         .maxDepth = options_.dacrt.maxDepth,
+        .stackSlots = frame.stackSlots = stackSlots(work.items.size()),
     });
     MemoryPlan& plan = frame.result.memory;
     for (const auto& [name, bytes] : frame.hostPlan.buffers) plan.add("host: " + name, bytes);
     plan.add("host: triangle ids per ray group", frame.triIdCount * 4);
     gpu::addToMemoryPlan(frame.buffers, context_.info(), plan);
     plan.work.insert(plan.work.end(), frame.hostPlan.work.begin(), frame.hostPlan.work.end());
-    plan.addWork("gpu work items", work.items.size(), "Step 1 and transfer pairs, per ray group");
+    gpu::addWorkItemLines(work, plan);
     const std::uint64_t triangleBytes = std::uint64_t(g.triangles->size()) * (sizeof(Triangle) + sizeof(Bounds));
     const std::uint64_t uploaded = std::uint64_t(g.rays->size()) * (sizeof(Ray) + sizeof(Hit)) +
                                    (frame.trianglesOnDevice ? 0 : triangleBytes) +
@@ -309,8 +323,8 @@ void GpuTracer::planMemory(Frame& frame) const {
     plan.addWork("skipped: triangle and bounds upload (bytes)", frame.trianglesOnDevice ? triangleBytes : 0,
                  frame.keepsTriangles ? (frame.trianglesOnDevice ? "on the device since an earlier frame" : "uploaded, kept for the next frame")
                                       : g.trianglesVersion ? "skip off (--no-skip uploads)" : "the triangles' version is unknown");
-    plan.addWork("bytes read back", std::uint64_t(g.rays->size()) * sizeof(Hit) + work.slots.size() * sizeof(Region),
-                 "hits and regions");
+    plan.addWork("bytes read back", std::uint64_t(g.rays->size()) * sizeof(Hit) + work.slots.size() * sizeof(Region) +
+                 work.items.size() * sizeof(TraversalState), "hits, regions and work item states (their costs)");
 }
 
 // Creates the frame's buffers and fills them.
@@ -347,6 +361,10 @@ void GpuTracer::upload(Frame& frame) const {
     frame.result.phases.upload = msSince(start);
 }
 
+std::uint64_t GpuTracer::stackSlots(std::uint64_t workItems) const {
+    return gpu::stackSlotsFor(workItems, options_.dacrt.maxDepth, context_.info(), gpu::loopBudgetOf(context_.info()) != 0);
+}
+
 void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const {
     const auto start = Clock::now();
     const DacrtOptions leafLimits = options_.dacrt.resolvedFor(Backend::Gpu);
@@ -379,6 +397,7 @@ void GpuTracer::dispatch(Frame& frame) const {
     push.loopProbe = 2;
     push.rayTmin = frame.geometry.rays->front().tmin;
     push.order = frame.geometry.order == ChildOrder::PerRay ? shared::kOrderPerRay : shared::kOrderNearSide;
+    push.stackSlots = std::uint32_t(frame.stackSlots);
     frame.counters = dispatchSchedule(*frame.work, context_, *frame.kernel, *frame.set, push, *frame.result.gpu);
     dispatchContinuations(*frame.work, context_, *frame.kernel, *frame.set, push, frame.counters, *frame.result.gpu);
     frame.result.phases.dispatch = msSince(start);
@@ -393,6 +412,8 @@ void GpuTracer::readBack(Frame& frame) const {
     set[DACRT_BINDING_HITS].download(result.hits.data(), result.hits.size() * sizeof(Hit));
     std::vector<Region> after(work.slots.size());
     set[DACRT_BINDING_REGIONS].download(after.data(), after.size() * sizeof(Region));
+    std::vector<TraversalState> states(work.items.size());
+    set[DACRT_BINDING_STATES].download(states.data(), states.size() * sizeof(TraversalState));
     result.phases.readback = msSince(start);
 
     const GpuCounters& counters = frame.counters;
@@ -411,6 +432,10 @@ void GpuTracer::readBack(Frame& frame) const {
     report.workItemsRun = counters.workItemsRun;
     report.workItemsEmpty = counters.workItemsEmpty;
     report.validationErrors = context_.validationErrors();
+    std::vector<std::uint32_t> costs;
+    costs.reserve(states.size());
+    for (const TraversalState& state : states) costs.push_back(state.cost);
+    gpu::reportWorkSpread(work, costs, report);
 }
 
 TraceResult GpuTracer::traceSecondary(GpuPassSource& source, const FrameGeometry& geometry, const SecondaryPass& pass,
@@ -449,7 +474,7 @@ TraceResult GpuTracer::traceSecondary(GpuPassSource& source, const FrameGeometry
 void GpuTracer::divideForSecondaryRays(GpuPassSource& source, const FrameGeometry& frame, TraceResult& result) const {
     const auto start = Clock::now();
     const gpu::DeviceInfo& device = context_.info();
-    const unsigned regions = options_.regions ? options_.regions : gpu::defaultGpuRegions(device);
+    const unsigned regions = options_.regions ? options_.regions : gpu::defaultGpuRegions(device, tuning_.profile);
     const glm::vec3 extent = frame.sceneBox.extent();
     const int longest = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
     const int axis = options_.axis == DivisionAxis::Best ? longest : int(options_.axis) - 1;
@@ -462,7 +487,7 @@ void GpuTracer::divideForSecondaryRays(GpuPassSource& source, const FrameGeometr
     triangles.margin = source.margin;
     MemoryPlan unused;
     source.division = divideScene(triangles, regions, axis, pool_, unused);
-    const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, regions);
+    const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, tuning_.profile, regions);
     source.work = gpu::planWorkItems(source.division, transferSchedule(source.division, false), groups);
     const std::vector<std::uint32_t> ids = gpu::groupTriangleIds(source.division, groups);
     const std::uint64_t idBytes = std::max<std::uint64_t>(ids.size(), 1) * 8;
@@ -488,6 +513,7 @@ void GpuTracer::planPass(Frame& frame, const GpuPassSource& source, const Second
         .regions = source.work.slots.size(),
         .workItems = source.work.items.size(),
         .maxDepth = options_.dacrt.maxDepth,
+        .stackSlots = frame.stackSlots = stackSlots(source.work.items.size()),
         .sourceRays = source.primaryRays,
     });
     gpu::DacrtBindingSet& primary = *source.primary;
@@ -503,7 +529,7 @@ void GpuTracer::planPass(Frame& frame, const GpuPassSource& source, const Second
     plan.add("device: kept from the primary pass (its rays, hits, triangles and work buffers)", kept);
     plan.addWork("rays made on the device", frame.rays,
                  std::to_string(pass.raysPerHit) + " per primary hit, where the surface can send one");
-    plan.addWork("gpu work items", source.work.items.size(), "Step 1 and every pair of regions, per ray group");
+    gpu::addWorkItemLines(source.work, plan);
 }
 
 void GpuTracer::uploadPass(Frame& frame, const GpuPassSource& source) const {
@@ -530,6 +556,7 @@ void GpuTracer::dispatchPass(Frame& frame, const GpuPassSource& source, const Se
     push.triScratchHalf = std::uint32_t(frame.triIdCount);
     push.loopProbe = 2;
     push.order = shared::kOrderPerRay;  // any hit: every ray visits the low child, then the high
+    push.stackSlots = std::uint32_t(frame.stackSlots);
     const Prelude prelude = makeRaysOnDevice(*frame.rayMaker, secondaryPush(source, pass), frame.rays,
                                              context_.info().maxComputeWorkGroupCountX);
     frame.counters = dispatchSchedule(source.work, context_, *frame.kernel, *frame.set, push, *frame.result.gpu, prelude);

@@ -72,6 +72,7 @@ private:
     void dispatchPass(Frame& frame, const GpuPassSource& source, const SecondaryPass& pass) const;
     // Shared by both.
     TraceResult startResult() const;
+    std::uint64_t stackSlots(std::uint64_t workItems) const;
     void compileKernel(Frame& frame, bool sharedStart, bool anyHit) const;
 
     gpu::Context& context_;

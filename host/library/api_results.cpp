@@ -62,11 +62,14 @@ std::vector<RayHit> hitsOf(const std::vector<Hit>& hits, const std::vector<std::
 DeviceReport deviceReportOf(const GpuReport& g) {
     std::vector<DeviceReport::Dispatch> dispatchTimes;
     for (const auto& [name, ms] : g.dispatchMs) dispatchTimes.push_back({name, ms});
+    std::vector<DeviceReport::WorkPass> workPasses;
+    for (const GpuWorkPass& p : g.workPasses) workPasses.push_back({p.name, p.items, p.maxCost, p.meanCost});
     return DeviceReport{.device = g.device, .driver = g.driver, .workgroupSize = g.workgroupSize,
                         .subgroupSize = g.subgroupSize, .rayGroups = g.rayGroups,
                         .dispatchTimes = std::move(dispatchTimes), .dispatches = g.dispatches,
                         .workItemsRun = g.workItemsRun, .workItemsEmpty = g.workItemsEmpty, .workItemSlices = g.slices,
-                        .raysFinished = g.raysFinished, .validationErrors = g.validationErrors};
+                        .raysFinished = g.raysFinished, .validationErrors = g.validationErrors,
+                        .workPasses = std::move(workPasses), .workCost = g.workCost, .longestChainCost = g.longestChainCost};
 }
 
 }  // namespace

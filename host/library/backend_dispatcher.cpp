@@ -22,7 +22,8 @@ bool usesVulkan(const std::vector<Backend>& backends) {
 }  // namespace
 
 void checkBackendRequest(const BackendRequest& r) {
-    checkRequestedOptions({r.trace, r.gpuTuning.workgroupSize, r.gpuTuning.rayGroups, r.embree.robust, r.embree.packets});
+    checkRequestedOptions({r.trace, r.gpuTuning.workgroupSize, r.gpuTuning.rayGroups, r.embree.robust, r.embree.packets,
+                           r.gpuTuning.profile});
 }
 
 void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends) {

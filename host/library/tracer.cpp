@@ -184,8 +184,9 @@ std::optional<VulkanDeviceProperties> Tracer::deviceProperties() const {
 std::optional<Tracer::GpuDefaults> Tracer::gpuDefaults() const {
     const gpu::Context* gpu = impl_->dispatcher.gpuContext();
     if (!gpu) return std::nullopt;
-    const unsigned regions = gpu::defaultGpuRegions(gpu->info());
-    return GpuDefaults{regions, gpu::defaultRayGroups(gpu->info(), regions)};
+    const GpuProfile profile = impl_->options.gpu.profile;
+    const unsigned regions = gpu::defaultGpuRegions(gpu->info(), profile);
+    return GpuDefaults{regions, gpu::defaultRayGroups(gpu->info(), profile, regions)};
 }
 
 std::uint32_t Tracer::validationErrors() const { return impl_->dispatcher.validationErrors(); }

@@ -41,10 +41,20 @@ nlohmann::ordered_json phasesJson(const TraceTimings& timings) {
     return phases;
 }
 
+// The work items of each dispatch and their costs' spread (docs/gpu.md, "Work items and parallelism").
+nlohmann::ordered_json workItemsJson(const DeviceReport& g) {
+    nlohmann::ordered_json passes = nlohmann::ordered_json::array();
+    for (const DeviceReport::WorkPass& p : g.workPasses)
+        passes.push_back({{"name", p.name}, {"work_items", p.workItems}, {"cost_max", p.costMax},
+                          {"cost_mean", p.costMean}, {"max_over_mean", p.costMean > 0.0 ? double(p.costMax) / p.costMean : 0.0}});
+    return {{"passes", passes}, {"cost_total", g.workCost}, {"longest_chain_cost", g.longestChainCost},
+            {"parallelism", g.parallelism()}};
+}
+
 nlohmann::ordered_json gpuJson(const DeviceReport& g) {
     nlohmann::ordered_json dispatches = nlohmann::ordered_json::array();
     for (const DeviceReport::Dispatch& d : g.dispatchTimes) dispatches.push_back({{"name", d.name}, {"gpu_ms", d.gpuMs}});
-    return {{"device", g.device},
+    nlohmann::ordered_json j = {{"device", g.device},
             {"driver", g.driver},
             {"workgroup_size", g.workgroupSize},
             {"subgroup_size", g.subgroupSize},
@@ -56,6 +66,8 @@ nlohmann::ordered_json gpuJson(const DeviceReport& g) {
             {"work_item_slices", g.workItemSlices},
             {"rays_finished", g.raysFinished},
             {"validation_errors", g.validationErrors}};
+    if (!g.workPasses.empty()) j["work_items"] = workItemsJson(g);  // gpu (rayquery has no work items)
+    return j;
 }
 
 double perSecond(std::uint64_t rays, double ms) { return ms > 0.0 ? double(rays) / (ms * 1e-3) : 0.0; }

@@ -6,9 +6,17 @@
 
 namespace dacrt {
 
+// Whose defaults the gpu backend takes where GpuTuning and TraceOptions leave the dispatch's
+// shape open (docs/gpu.md). Auto: the device's own kind. Cpu: a CPU device's (lavapipe): one
+// region per core, a few work items, one subgroup per workgroup. Discrete: a discrete GPU's,
+// thousands of work items in Step 1, on any device: lavapipe then runs the shape a GPU would
+// run, with the same hits. The driver's loop limit (llvmpipe) applies under every profile.
+enum class GpuProfile { Auto, Cpu, Discrete };
+
 struct GpuTuning {
-    std::uint32_t workgroupSize = 0;  // 0: the device's default (gpu::defaultWorkgroupSize)
-    std::uint32_t rayGroups = 0;      // 0: the device's default (gpu::defaultRayGroups)
+    std::uint32_t workgroupSize = 0;  // 0: the profile's default (gpu::defaultWorkgroupSize)
+    std::uint32_t rayGroups = 0;      // 0: the profile's default (gpu::defaultRayGroups)
+    GpuProfile profile = GpuProfile::Auto;
 };
 
 // How the BVH follows the frames, as Embree's users configure each case.

@@ -23,6 +23,21 @@ struct DeviceReport {
     std::uint32_t workItemSlices = 0;  // more than work items: continuations
     std::uint64_t raysFinished = 0;    // with a hit or without, over all steps
     std::uint32_t validationErrors = 0;
+
+    // The schedule's dispatches (Step 1, then each transfer round), each with its work items
+    // and their costs: the loop iterations of the kernel's cost model that a work item spent
+    // (docs/gpu.md, "Work items and parallelism"), deterministic for a frame and options.
+    struct WorkPass {
+        std::string name;
+        std::uint32_t workItems = 0;
+        std::uint64_t costMax = 0;  // the costliest work item's
+        double costMean = 0.0;      // over the dispatch's work items, empty ones (cost 0) included
+    };
+    std::vector<WorkPass> workPasses;
+    std::uint64_t workCost = 0;          // every work item's, summed
+    std::uint64_t longestChainCost = 0;  // the costliest chain of work items that wait for each other
+    // The parallelism the schedule offers: the work over its longest chain.
+    double parallelism() const { return longestChainCost ? double(workCost) / double(longestChainCost) : 0.0; }
 };
 
 }  // namespace dacrt

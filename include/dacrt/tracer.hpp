@@ -87,7 +87,7 @@ public:
     // Its properties and limits (as listDevices() gives them); none where no device is open.
     std::optional<VulkanDeviceProperties> deviceProperties() const;
     // What the gpu backend chooses on that device where GpuTuning and TraceOptions leave it
-    // open (docs/gpu.md); none where no device is open.
+    // open, under these options' GpuTuning::profile (docs/gpu.md); none where no device is open.
     struct GpuDefaults {
         unsigned regions = 0;           // sub-scenes (TraceOptions::regions 0)
         std::uint32_t rayGroups = 0;    // work items per sub-scene and round, with that many sub-scenes

@@ -149,6 +149,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCommand{"ZeroRayGroups", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend gpu --ray-groups 0", "--ray-groups"},
         BadCommand{"RayGroupsOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu --ray-groups 2",
                    "--ray-groups is not an option of --backend cpu"},
+        BadCommand{"GpuProfileOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu --gpu-profile discrete",
+                   "--gpu-profile is not an option of --backend cpu"},
+        BadCommand{"UnknownGpuProfile", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend gpu --gpu-profile huge",
+                   "--gpu-profile"},
         BadCommand{"UnknownSkip", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --no-skip everything", "--no-skip"},
         BadCommand{"UnknownCull", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --cull sideways", "--cull"},
         BadCommand{"NoSkipOnAPeer", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend embree --no-skip frustum",
@@ -286,6 +290,23 @@ TEST(Cli, GpuRenderUnderValidationMatchesCpuSeq) {
     for (const char* key : {"device", "driver", "dispatches", "dispatch_times", "work_items_run", "work_items_empty"})
         EXPECT_TRUE(j["gpu"].contains(key)) << key;
     EXPECT_EQ(j["gpu"]["validation_errors"], 0);
+    // The work item report: Step 1 first, 2 regions times the ray groups, its spread measured.
+    const nlohmann::json& work = j["gpu"]["work_items"];
+    ASSERT_FALSE(work["passes"].empty());
+    EXPECT_EQ(work["passes"][0]["name"], "step1");
+    EXPECT_EQ(work["passes"][0]["work_items"], 2 * j["gpu"]["ray_groups"].get<int>());
+    EXPECT_GE(work["passes"][0]["cost_max"].get<double>(), work["passes"][0]["cost_mean"].get<double>());
+    EXPECT_GE(work["parallelism"].get<double>(), 1.0);
+}
+
+TEST(Cli, DiscreteGpuProfilePlansItsWorkItemsOnAnyDevice) {
+    if (run("devices").code != 0) GTEST_SKIP() << "no Vulkan device";
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") +
+                                " --size 24x16 --backend gpu --gpu-profile discrete --plan");
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("gpu work items: step1"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("2048"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("gpu longest chain of work items"), std::string::npos) << r.output;
 }
 
 // The rayquery backend from the command line: on a device with ray query, cpu-seq's primitives

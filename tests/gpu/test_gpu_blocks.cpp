@@ -17,6 +17,7 @@
 #include "gpu/dispatch_recorder.hpp"
 #include "gpu/embedded_shaders.hpp"
 #include "gpu/work_plan.hpp"
+#include "gpu/work_spread.hpp"
 
 
 using namespace dacrt;
@@ -282,3 +283,33 @@ INSTANTIATE_TEST_SUITE_P(WorkgroupSizes, GpuBlocks, ::testing::Values(1u, 4u, 8u
                          [](const ::testing::TestParamInfo<std::uint32_t>& info) {
                              return "subgroups" + std::to_string(info.param);
                          });
+
+TEST(GpuBlocks, TheLongestChainFollowsTheWorkItemsThatWaitForEachOther) {
+    // Three slots; Step 1, then round a (0 -> 1, 1 -> 2), then round b (0 -> 2). An item waits
+    // for the latest earlier items on its ray slot and on its triangle slot.
+    gpu::WorkPlan work;
+    work.slots.resize(3);
+    for (const auto& [rays, tris] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}})
+        work.items.push_back(WorkItem{rays, tris, 0, 0, 0, 0, 0, 0});
+    work.passes = {{"step1", 3}, {"a", 2}, {"b", 1}};
+    const std::vector<std::uint32_t> costs{5, 3, 4, 2, 1, 7};
+    // 0 -> 1 starts after item 0 (5), ends at 7; 1 -> 2 after item 2 (4), ends at 5; 0 -> 2 after 7.
+    EXPECT_EQ(gpu::longestChainCost(work, costs), 14u);
+    EXPECT_EQ(gpu::longestChainCost(work, std::vector<std::uint32_t>(6, 1)), 3u);
+    GpuReport report;
+    gpu::reportWorkSpread(work, costs, report);
+    ASSERT_EQ(report.workPasses.size(), 3u);
+    EXPECT_EQ(report.workPasses[0].items, 3u);
+    EXPECT_EQ(report.workPasses[0].maxCost, 5u);
+    EXPECT_DOUBLE_EQ(report.workPasses[0].meanCost, 4.0);
+    EXPECT_EQ(report.workPasses[1].maxCost, 2u);
+    EXPECT_DOUBLE_EQ(report.workPasses[1].meanCost, 1.5);
+    EXPECT_EQ(report.workPasses[2].name, "b");
+    EXPECT_EQ(report.workCost, 22u);
+    EXPECT_EQ(report.longestChainCost, 14u);
+    MemoryPlan plan;
+    gpu::addWorkItemLines(work, plan);
+    ASSERT_EQ(plan.work.size(), 5u);
+    EXPECT_EQ(plan.work[1].name, "gpu work items: step1");
+    EXPECT_EQ(plan.work[4].count, 3u);
+}

@@ -20,11 +20,33 @@ Scene shapes() {
                            "shapes");
 }
 
-// gpu == cpu-seq, bit for bit, for every region count (work items too large for llvmpipe's
-// loop limiter run in several slices; none may be cut short). Returns the transfer work
-// items of all the frames traced.
+// The work item report against the counters: every work item in one of the dispatches, each
+// dispatch's mean within its largest cost, the longest chain within the whole work and at least
+// Step 1's costliest item.
+void expectConsistentWorkReport(const TraceResult& r) {
+    const GpuReport& g = *r.gpu;
+    ASSERT_FALSE(g.workPasses.empty());
+    EXPECT_EQ(g.workPasses.front().name, "step1");
+    EXPECT_EQ(g.workPasses.front().items, r.regions * g.rayGroups);
+    std::uint64_t items = 0;
+    double cost = 0.0;
+    for (const GpuWorkPass& p : g.workPasses) {
+        items += p.items;
+        cost += p.meanCost * p.items;
+        EXPECT_LE(p.meanCost, double(p.maxCost)) << p.name;
+    }
+    EXPECT_EQ(items, std::uint64_t(g.workItemsRun) + g.workItemsEmpty);
+    EXPECT_NEAR(cost, double(g.workCost), 1e-6 * double(g.workCost));
+    EXPECT_GT(g.workCost, 0u);
+    EXPECT_GE(g.longestChainCost, g.workPasses.front().maxCost);
+    EXPECT_LE(g.longestChainCost, g.workCost);
+}
+
+// gpu == cpu-seq, bit for bit, for every region count (0: the tuning's profile's default; work
+// items too large for llvmpipe's loop limiter run in several slices; none may be cut short).
+// Returns the transfer work items of all the frames traced.
 std::uint64_t expectGpuMatchesCpu(gpu::Context& context, const Frame& frame, std::initializer_list<unsigned> regionCounts,
-                        std::uint32_t workgroupSize = 0, std::uint32_t rayGroups = 0) {
+                                  const GpuTuning& tuning = {}) {
     const TraceResult reference = frame.trace(Backend::CpuSeq);
     std::uint64_t transferWorkItems = 0;
     for (unsigned regions : regionCounts) {
@@ -32,19 +54,22 @@ std::uint64_t expectGpuMatchesCpu(gpu::Context& context, const Frame& frame, std
         o.backend = Backend::Gpu;
         o.regions = regions;
         ThreadPool pool(2);
-        const TraceResult r = GpuTracer(context, pool, o, GpuTuning{workgroupSize, rayGroups}).trace(frame.geometry);
-        EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << regions << " regions, " << r.gpu->rayGroups << " ray groups";
+        const TraceResult r = GpuTracer(context, pool, o, tuning).trace(frame.geometry);
+        EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << r.regions << " regions, " << r.gpu->rayGroups << " ray groups";
         EXPECT_EQ(r.gpu->dispatches, r.gpu->dispatchMs.size());
-        if (rayGroups) {
-            EXPECT_EQ(r.gpu->rayGroups, rayGroups);
+        if (tuning.rayGroups) {
+            EXPECT_EQ(r.gpu->rayGroups, tuning.rayGroups);
         }
-        EXPECT_EQ(r.gpu->workItemsRun + r.gpu->workItemsEmpty, (regions + r.counters.transferWorkItems) * r.gpu->rayGroups);
+        EXPECT_EQ(r.gpu->workItemsRun + r.gpu->workItemsEmpty, (r.regions + r.counters.transferWorkItems) * r.gpu->rayGroups);
         EXPECT_GE(r.gpu->slices, r.gpu->workItemsRun);
+        expectConsistentWorkReport(r);
         transferWorkItems += r.counters.transferWorkItems;
     }
     EXPECT_TRUE(noValidationErrors(context));
     return transferWorkItems;
 }
+
+constexpr GpuTuning kDiscreteProfile{.profile = GpuProfile::Discrete};
 
 TraceOptions gpuOptions(unsigned regions) {
     TraceOptions o;
@@ -70,7 +95,7 @@ TEST(GpuImages, ProceduralShapes) {
     const Scene s = shapes();
     const Frame frame(shapes(), defaultCamera(s, 96, 72), 96, 72);
     expectGpuMatchesCpu(*context, frame, {1, 2, 3, 4, 8, 16});
-    expectGpuMatchesCpu(*context, frame, {1, 4}, 32);
+    expectGpuMatchesCpu(*context, frame, {1, 4}, GpuTuning{.workgroupSize = 32});
 }
 
 TEST(GpuImages, RaysFromSurfacesInEveryDirection) {
@@ -143,10 +168,10 @@ TEST(GpuImages, RayGroupsGiveTheSameHits) {
     DACRT_REQUIRE_GPU(context);
     const Scene s = shapes();
     const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
-    for (std::uint32_t groups : {1u, 3u, 5u}) expectGpuMatchesCpu(*context, frame, {1, 2, 4}, 0, groups);
+    for (std::uint32_t groups : {1u, 3u, 5u}) expectGpuMatchesCpu(*context, frame, {1, 2, 4}, GpuTuning{.rayGroups = groups});
     const Frame inside = insideView({box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)},
                                     {0.1, 0.0, 0.2}, {0.3, 0.0, -1.0}, 40, 30);
-    EXPECT_GT(expectGpuMatchesCpu(*context, inside, {4}, 0, 64), 0u) << "expected transfer rounds";
+    EXPECT_GT(expectGpuMatchesCpu(*context, inside, {4}, GpuTuning{.rayGroups = 64}), 0u) << "expected transfer rounds";
 }
 
 TEST(GpuImages, CameraInsideTheSceneAndOnSplitPlanes) {
@@ -176,6 +201,49 @@ TEST(GpuImages, StanfordBunny) {
     const Camera cam = defaultCamera(s, 160, 120);
     const Frame frame(std::move(s), cam, 160, 120);
     expectGpuMatchesCpu(*context, frame, {1, 2, 4, 8, 16, 64});
+}
+
+TEST(GpuImages, DiscreteProfileGivesCpuSeqHitsOnTheTestScenes) {
+    // A discrete GPU's defaults forced on any device (lavapipe here): kDiscreteRegions regions
+    // with their ray groups, at least kDiscreteStep1WorkItems work items in Step 1 (most of them
+    // empty on frames this small), wide workgroups; the same hits bit for bit.
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 96, 72), 96, 72);
+    EXPECT_GT(expectGpuMatchesCpu(*context, frame, {0}, kDiscreteProfile), 0u);
+    const Frame inside = insideView({box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2),
+                                     torus({-1.0f, -0.5f, 1.5f}, 0.6f, 0.2f, 24, 12)},
+                                    {0.0, 0.0, 0.2}, {0.3, 0.0, -1.0}, 64, 48);
+    EXPECT_GT(expectGpuMatchesCpu(*context, inside, {0}, kDiscreteProfile), 0u);
+    if (const std::string bunny = sharedScene("bunny.glb"); !bunny.empty()) {
+        Scene loaded = loadGltf(bunny);
+        const Camera cam = defaultCamera(loaded, 160, 120);
+        EXPECT_GT(expectGpuMatchesCpu(*context, Frame(std::move(loaded), cam, 160, 120), {0}, kDiscreteProfile), 0u);
+    }
+    ThreadPool pool(2);
+    const TraceResult r = GpuTracer(*context, pool, gpuOptions(0), kDiscreteProfile).trace(frame.geometry);
+    EXPECT_EQ(r.regions, gpu::kDiscreteRegions);
+    EXPECT_GE(r.gpu->workPasses.front().items, gpu::kDiscreteStep1WorkItems);
+    EXPECT_EQ(r.gpu->workgroupSize, std::max(64u, context->info().subgroupSize));
+}
+
+TEST(GpuImages, WorkItemCostsAreTheSameInEveryRun) {
+    // The report's costs come from the kernel's cost model, not from timings: a frame traced
+    // again gives the same spread; the profiles shape the work items differently.
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 96, 72), 96, 72);
+    ThreadPool pool(2);
+    auto spread = [&](const GpuTuning& tuning) {
+        const TraceResult r = GpuTracer(*context, pool, gpuOptions(0), tuning).trace(frame.geometry);
+        std::vector<std::uint64_t> costs{r.gpu->workCost, r.gpu->longestChainCost};
+        for (const GpuWorkPass& p : r.gpu->workPasses) costs.insert(costs.end(), {p.items, p.maxCost});
+        return costs;
+    };
+    const GpuTuning cpuProfile{.profile = GpuProfile::Cpu};
+    EXPECT_EQ(spread(cpuProfile), spread(cpuProfile));
+    EXPECT_EQ(spread(kDiscreteProfile), spread(kDiscreteProfile));
+    EXPECT_NE(spread(cpuProfile), spread(kDiscreteProfile));
 }
 
 TEST(GpuImages, SlicedWorkItemsMatchTheUnslicedOnes) {

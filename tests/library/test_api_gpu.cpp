@@ -74,6 +74,24 @@ TEST(ApiGpu, ReportsItsDeviceAndTheGpuDefaultsThere) {
     EXPECT_EQ(out.counters.regions, defaults->regions);
     ASSERT_TRUE(out.gpu);
     EXPECT_EQ(out.gpu->rayGroups, defaults->rayGroups);
+    // The discrete profile on any device: its shape, in gpuDefaults and in the trace, whose
+    // report gives Step 1's work items and their spread.
+    TracerOptions discrete = gpu->options();
+    discrete.gpu.profile = GpuProfile::Discrete;
+    gpu->setOptions(discrete);
+    const std::optional<Tracer::GpuDefaults> shaped = gpu->gpuDefaults();
+    ASSERT_TRUE(shaped);
+    EXPECT_GE(shaped->regions * shaped->rayGroups, 2048u);
+    const TraceOutput wide = gpu->trace(scene, RayBatch::fromCamera(scene, {}, 64, 48));
+    EXPECT_EQ(wide.counters.regions, shaped->regions);
+    ASSERT_TRUE(wide.gpu);
+    ASSERT_FALSE(wide.gpu->workPasses.empty());
+    EXPECT_EQ(wide.gpu->workPasses.front().workItems, shaped->regions * shaped->rayGroups);
+    EXPECT_GE(wide.gpu->parallelism(), 1.0);
+    for (std::size_t i = 0; i < out.hits.size(); ++i) {
+        EXPECT_EQ(wide.hits[i].primitive, out.hits[i].primitive) << "ray " << i;
+        EXPECT_EQ(wide.hits[i].t, out.hits[i].t) << "ray " << i;
+    }
 }
 
 TEST(ApiGpu, MovedVerticesAreUploadedAgain) {
