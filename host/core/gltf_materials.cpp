@@ -7,11 +7,9 @@
 #include <map>
 #include <string_view>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include "core/data_uri.hpp"
 #include "core/errors.hpp"
+#include "core/image_codecs.hpp"
 #include "core/input_file.hpp"
 
 namespace dacrt::gltf {
@@ -82,22 +80,16 @@ std::string percentDecoded(const std::string& uri) {
 Texture decodeWith(const ImageFormat& format, std::span<const unsigned char> bytes, const AccessorReader& budget,
                    std::string& why) {
     Texture t;
-    OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
-    // glTF colours are not premultiplied by alpha; OpenImageIO's PNG reader would otherwise
-    // associate them.
-    OIIO::ImageSpec config;
-    config.attribute("oiio:UnassociatedAlpha", 1);
-    OIIO::Filesystem::IOProxy* proxy = &memory;  // with a config, the reader takes its proxy from it
-    config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-    auto in = OIIO::ImageInput::create(format.reader, false, &config, &memory);
-    OIIO::ImageSpec opened;
-    if (!in || !in->open(std::string("image.") + format.reader, opened, config)) {
-        why = "it does not decode (" + (in ? in->geterror() : OIIO::geterror()) + ")";
+    std::string openError;
+    const std::unique_ptr<ImageReader> in = imageCodecs().openMemory(format.reader, bytes, openError);
+    if (!in) {
+        why = "it does not decode (" + openError + ")";
         return t;
     }
-    const OIIO::ImageSpec& spec = in->spec();
+    const ImageHeader& spec = in->header();
+    const int channels = int(spec.channelNames.size());
     const std::uint64_t texels = std::uint64_t(std::max(spec.width, 0)) * std::uint64_t(std::max(spec.height, 0));
-    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || texels * 4 > kMaxTextureBytes) {
+    if (spec.width <= 0 || spec.height <= 0 || channels <= 0 || texels * 4 > kMaxTextureBytes) {
         why = "its size " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " is empty or over the " +
               std::to_string(kMaxTextureBytes >> 20) + " MiB texture limit";
         return t;
@@ -107,10 +99,9 @@ Texture decodeWith(const ImageFormat& format, std::span<const unsigned char> byt
               std::to_string(budget.byteLimit()) + "-byte memory limit";
         return t;
     }
-    const int channels = spec.nchannels;
     std::vector<std::uint8_t> raw(std::size_t(texels) * std::size_t(channels));
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, raw.data())) {
-        why = "its pixels do not decode (" + in->geterror() + ")";
+    if (!in->readChannels(0, channels, SampleType::UInt8, raw.data())) {
+        why = "its pixels do not decode (" + in->error() + ")";
         return t;
     }
     t.width = spec.width;
@@ -137,6 +128,7 @@ Texture decodeImage(std::span<const unsigned char> bytes, const std::string& mim
         why = unsupportedFormat(format, mimeType);
         return {};
     }
+    imageCodecs();  // a missing module is the installation's fault: an error, not the image's warning
     try {
         return decodeWith(*format, bytes, budget, why);
     } catch (const std::exception& e) {  // a reader's own failure (an allocation, a bad length)

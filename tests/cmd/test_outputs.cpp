@@ -131,3 +131,23 @@ TEST(CliOutputs, InputsThatAreNotRegularFilesAreRefusedWithoutWaiting) {
     EXPECT_EQ(device.code, 2) << device.output;
     EXPECT_NE(device.output.find("is a character device"), std::string::npos) << device.output;
 }
+
+// OpenImageIO lives in a module loaded on the first image (core/image_codecs.hpp): a run that
+// writes no image never needs it, and one that does, without it, fails before tracing, naming
+// where it looked and leaving nothing behind.
+TEST(CliOutputs, TheImageCodecsModuleIsLoadedOnlyForImagesAndItsAbsenceIsNamed) {
+    const fs::path d = freshFolder("codecs");
+    const std::string missing = "DACRT_CODECS_MODULE=" + (d / "no_such_module.so").string();
+    const CommandResult statsOnly =
+        dacrt::test::runDacrt("render " + kScene + " --size 8x6 --stats " + (d / "s.json").string(), missing);
+    EXPECT_EQ(statsOnly.code, 0) << statsOnly.output;
+    EXPECT_TRUE(fs::exists(d / "s.json"));
+    const CommandResult image =
+        dacrt::test::runDacrt("render " + kScene + " --size 8x6 -o " + (d / "a.png").string() + " --stats " +
+                                  (d / "t.json").string(), missing);
+    EXPECT_NE(image.code, 0) << image.output;
+    EXPECT_NE(image.output.find((d / "no_such_module.so").string() + ": "), std::string::npos) << image.output;
+    EXPECT_NE(image.output.find("DACRT_CODECS_MODULE"), std::string::npos) << image.output;
+    EXPECT_EQ(image.output.find(" rays"), std::string::npos) << "traced before finding it cannot write: " << image.output;
+    EXPECT_EQ(namesIn(d), (std::set<std::string>{"s.json"}));
+}
