@@ -27,7 +27,11 @@ std::string encodePixels(const std::string& path, const ImageToEncode& image) {
 std::string imageWriterProblem(const std::string& path) { return imageCodecs().writerProblem(path); }
 
 std::string encodeRgb8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb) {
-    ImageToEncode image{width, height, {"R", "G", "B"}, std::vector<SampleType>(3, SampleType::UInt8)};
+    ImageToEncode image;
+    image.width = width;
+    image.height = height;
+    image.channelNames = {"R", "G", "B"};
+    image.channelTypes.assign(3, SampleType::UInt8);
     image.pixels = rgb.data();
     return encodePixels(path, image);
 }
@@ -59,8 +63,10 @@ std::string encodeAov(const std::string& path, const Scene& scene, const HitImag
         for (std::size_t c = 0; c < extra.size(); ++c)
             std::memcpy(&packed[i * stride + sizeof(Pixel) + c * sizeof(float)], &extra[c].values.at(i), sizeof(float));
     }
-    ImageToEncode aov{image.width, image.height,
-                      {"Z", "N.X", "N.Y", "N.Z", "primId", "hit", "u", "v", "albedo.R", "albedo.G", "albedo.B"}};
+    ImageToEncode aov;
+    aov.width = image.width;
+    aov.height = image.height;
+    aov.channelNames = {"Z", "N.X", "N.Y", "N.Z", "primId", "hit", "u", "v", "albedo.R", "albedo.G", "albedo.B"};
     for (const AovChannel& c : extra) aov.channelNames.push_back(c.name);
     aov.channelTypes.assign(aov.channelNames.size(), SampleType::Float);
     aov.channelTypes[4] = SampleType::UInt32;

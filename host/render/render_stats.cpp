@@ -1,6 +1,7 @@
 #include "render/render_stats.hpp"
 
 #include "app/json_keys.hpp"
+#include "core/process_memory.hpp"
 
 namespace dacrt {
 namespace {
@@ -165,6 +166,10 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     if (!r.timings.step1RegionMs.empty()) t["step1_region"] = r.timings.step1RegionMs;
     j["timings_ms"] = t;
     j["memory_plan_bytes"] = memoryJson(r.plan);
+    // What the plan is measured against: the whole process, so its peak holds the parsed file,
+    // the scene and every earlier frame and pass as well as this frame's buffers.
+    if (const std::optional<ResidentMemory> m = residentMemory())
+        j["memory_measured_bytes"] = {{"resident", m->current}, {"peak_resident", m->peak}};
     nlohmann::ordered_json dropped = nlohmann::ordered_json::array();
     dropped.push_back({{"name", "degenerate triangles dropped at load"},
                        {"count", frame.scene.degenerateTrianglesDropped},

@@ -32,6 +32,23 @@ std::string temp(const std::string& name) { return ::testing::TempDir() + "/cli_
 
 }  // namespace
 
+// The measured memory is the process's own: its peak holds at least the rays the plan counts,
+// which the frame fills (a figure that is not read from the system would not).
+TEST(Cli, StatsMeasureTheResidentMemoryThePlanIsHeldTo) {
+    const std::string stats = temp("memory.json");
+    const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 1024x768 --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::ifstream f(stats);
+    const nlohmann::json j = nlohmann::json::parse(f);
+    ASSERT_TRUE(j.contains("memory_measured_bytes")) << j.dump(1);
+    const auto peak = j["memory_measured_bytes"]["peak_resident"].get<std::uint64_t>();
+    const auto resident = j["memory_measured_bytes"]["resident"].get<std::uint64_t>();
+    EXPECT_GT(resident, 0u);
+    EXPECT_GE(peak, resident);
+    EXPECT_GT(j["memory_plan_bytes"]["rays"].get<std::uint64_t>(), 30u << 20);
+    EXPECT_GE(peak, j["memory_plan_bytes"]["rays"].get<std::uint64_t>());
+}
+
 TEST(Cli, RenderWritesImageAovAndStats) {
     const std::string png = temp("quad.png"), exr = temp("quad.exr"), stats = temp("quad.json");
     const CommandResult r = run("render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --size 32x24 --backend cpu --regions 3 -o " +
