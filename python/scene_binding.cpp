@@ -51,6 +51,14 @@ std::unique_ptr<SceneHandle> sceneFromGltf(const std::string& path, double time,
     return std::make_unique<SceneHandle>(TraceScene::load(path, options));
 }
 
+void setPositions(SceneHandle& s, const py::handle& vertices) {
+    const Contiguous<float> v = rowsOf<float>(vertices, "vertices", 3);
+    if (v.ndim() != 2) throw InputError("vertices: expected an array of shape (N, 3)");
+    py::gil_scoped_release release;
+    std::scoped_lock lock(s.mutex);
+    s.scene.setPositions(spanOf(v));
+}
+
 py::array_t<float> cameraRays(SceneHandle& s, int width, int height, const Point& eye, const Point& target,
                               const Point& up, std::optional<double> fov) {
     const RayBatch rays = cameraBatch(s, cameraOf(eye, target, up, fov), width, height);
@@ -89,6 +97,13 @@ animations (`animation`: an index or name; empty: all), `scene` and `camera` an 
 name (empty: the default scene, the first placed camera), `cull` the face rule: material
 (glTF's doubleSided, the default), none or backfaces. Primitive ids follow the file's
 order of nodes, meshes and primitives.)")
+        .def("set_positions", &setPositions, py::arg("vertices"),
+             R"(Moves the vertices of a scene made from arrays, for the next frame of an animation:
+vertices (N, 3) float32, as many as the scene was made with; the triangles, their ids and
+face rules stay. The next trace follows them (the gpu uploads them again; embree and
+rayquery rebuild or refit). Raises dacrt.InputError, changing nothing, on another vertex
+count, a coordinate that is not finite or beyond +-1e9, a triangle dropped for having no area
+that has area now, and for a scene loaded from a file (load it again at the new time).)")
         .def_property_readonly("triangle_count", [](SceneHandle& s) { return s.scene.triangleCount(); },
                                "triangles traced (those with area)")
         .def_property_readonly("triangles_dropped", [](SceneHandle& s) { return s.scene.trianglesDropped(); },

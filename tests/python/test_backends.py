@@ -129,3 +129,36 @@ def test_stanford_scenes_on_every_dacrt_backend(name, rays, tracer):
             continue
     camera = scene.camera_rays(48, 36)
     assert_same_hits(tracer("cpu").render(scene, 48, 36), tracer("cpu-seq").cast_rays(scene, camera), name)
+
+
+@pytest.mark.parametrize("backend", DACRT_BACKENDS + PEERS)
+def test_moved_vertices_are_traced_where_they_are_now(backend, tracer):
+    """set_positions moves a scene's vertices between frames: every backend (the same tracer,
+    whose peers keep a structure per scene) then hits the triangles where they are now, as a
+    scene made from the moved vertices does."""
+    vertices, indices, double_sided = random_scene(6, 1500)
+    rays, tmax = random_rays(106, 6000)
+    scene = dacrt.Scene(vertices, indices, double_sided=double_sided)
+    before = tracer(backend).cast_rays(scene, rays, tmax=tmax)
+    moved = (vertices * np.float32(0.9) + np.float32(0.05)).astype(np.float32)
+    scene.set_positions(moved)
+    expected = tracer("brute").cast_rays(dacrt.Scene(moved, indices, double_sided=double_sided), rays, tmax=tmax)
+    got = tracer(backend).cast_rays(scene, rays, tmax=tmax)
+    assert np.count_nonzero(got["primitive_ids"] != before["primitive_ids"]) > rays.shape[0] // 20
+    if backend in DACRT_BACKENDS:
+        assert_same_hits(got, expected, f"{backend} after set_positions")
+    else:
+        assert np.count_nonzero(got["primitive_ids"] != expected["primitive_ids"]) <= rays.shape[0] // 1000
+
+
+def test_set_positions_refuses_another_vertex_count_and_a_file_scene():
+    vertices, indices, _ = random_scene(7, 100)
+    scene = dacrt.Scene(vertices, indices)
+    with pytest.raises(dacrt.InputError, match="vert"):
+        scene.set_positions(vertices[:-3])
+    with pytest.raises(dacrt.InputError, match="finite"):
+        bad = vertices.copy()
+        bad[0, 0] = np.nan
+        scene.set_positions(bad)
+    with pytest.raises(dacrt.InputError):
+        dacrt.Scene.from_gltf(str(ROOM)).set_positions(vertices)
