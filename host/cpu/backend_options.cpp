@@ -56,7 +56,7 @@ constexpr std::array<BackendOption, 17> kBackendOptions{{
     {"--no-skip", {Backend::Brute, Backend::CpuSeq, Backend::Cpu, Backend::Gpu},
      "skips to turn off (each changes speed only): backfaces (single-sided triangles facing away from the camera), "
      "frustum (triangles outside the view), uploads (gpu: triangle buffers kept across frames), subscenes (cpu: small "
-     "frames traced as one sequential DACRT)",
+     "frames traced as one sequential DACRT), passrays (secondary passes: triangles no ray of the pass comes near)",
      "", !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return !(r.trace.skips == SkipSwitches{}); }},
     {"--embree-fast", kEmbree, "without RTC_SCENE_FLAG_ROBUST: faster, leaks through edges", "", !kAdvanced,
      !kDacrtOption, [](const RequestedOptions& r) { return !r.embreeRobust; }},
