@@ -14,7 +14,15 @@ constexpr int kMostRowsLooked = 64;
 // Pieces of segment the grid marks per triangle of the scene, at most: the grid's resolution
 // is chosen so that marking costs a fraction of the pass over the triangles (measured:
 // docs/benchmarks.md, "Secondary passes").
-constexpr double kPiecesPerTriangle = 1.0 / 8.0;
+constexpr double kPiecesPerTriangle = 0.5;
+
+// The grid is marked for passes of fewer rays than this many triangles each: the Dragon's
+// occlusion pass (192,048 rays, 4.5 triangles each) lost more to marking than the 12% of
+// triangles it dropped saved; its shadow pass (42,331 rays, 21 each) gained.
+constexpr std::size_t kTrianglesPerRayForTheGrid = 8;
+
+// Rays whose segments' lengths the grid's resolution is chosen from.
+constexpr std::size_t kSurveySamples = 4096;
 
 // The parameters [t0, t1] of the ray's segment inside [lo, hi], in float64 (empty: t0 > t1).
 struct Interval {
@@ -48,21 +56,39 @@ float floatAbove(double x) {
 
 // What the cull learns from one pass over the rays.
 struct RaySurvey {
-    double cellSpans = 0.0;       // the clipped segments' lengths, in the box's longest side
+    double cellSpans = 0.0;       // the clipped segments' lengths, in the box's longest side (estimated)
     glm::dvec3 originLo{kNoHitT}, originHi{-kNoHitT};
     bool directionShared = true;
 };
 
-RaySurvey surveyRays(const FrameGeometry& g, const glm::dvec3& clipLo, const glm::dvec3& clipHi) {
-    RaySurvey s;
+// The origins' box and whether the directions agree, over every ray (the back-face test's
+// exactness rests on both), in parallel; the segments' lengths from a sample of the rays.
+RaySurvey surveyRays(const FrameGeometry& g, const glm::dvec3& clipLo, const glm::dvec3& clipHi, ThreadPool& pool) {
     const std::vector<Ray>& rays = *g.rays;
+    const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(64, rays.size() / 4096 + 1));
+    std::vector<RaySurvey> parts(chunks);
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        RaySurvey s;
+        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks; i < end; ++i) {
+            s.originLo = glm::min(s.originLo, glm::dvec3(rays[i].origin));
+            s.originHi = glm::max(s.originHi, glm::dvec3(rays[i].origin));
+            s.directionShared = s.directionShared && std::memcmp(&rays[i].dir, &rays.front().dir, sizeof(Ray::dir)) == 0;
+        }
+        parts[c] = s;
+    });
+    RaySurvey s;
+    for (const RaySurvey& p : parts) {
+        s.originLo = glm::min(s.originLo, p.originLo);
+        s.originHi = glm::max(s.originHi, p.originHi);
+        s.directionShared = s.directionShared && p.directionShared;
+    }
     const double longest = std::max({clipHi.x - clipLo.x, clipHi.y - clipLo.y, clipHi.z - clipLo.z});
-    for (const Ray& r : rays) {
-        s.originLo = glm::min(s.originLo, glm::dvec3(r.origin));
-        s.originHi = glm::max(s.originHi, glm::dvec3(r.origin));
-        s.directionShared = s.directionShared && std::memcmp(&r.dir, &rays.front().dir, sizeof(r.dir)) == 0;
-        const Interval iv = clipped(r, clipLo, clipHi);
-        if (iv.t0 <= iv.t1) s.cellSpans += (iv.t1 - iv.t0) * glm::length(glm::dvec3(r.dir)) / longest + 1.0 / RayGrid::kMaxCells;
+    const std::size_t stride = std::max<std::size_t>(1, rays.size() / kSurveySamples);
+    for (std::size_t i = 0; i < rays.size(); i += stride) {
+        const Interval iv = clipped(rays[i], clipLo, clipHi);
+        if (iv.t0 <= iv.t1)
+            s.cellSpans += double(stride) * ((iv.t1 - iv.t0) * glm::length(glm::dvec3(rays[i].dir)) / longest +
+                                             1.0 / RayGrid::kMaxCells);
     }
     return s;
 }
@@ -203,9 +229,11 @@ void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPoo
     if ((!switches.passRays && !switches.backFaces) || rays.empty() || g.triangles->empty()) return;
 
     const double grow = 2.0 * double(g.margin);
-    const RaySurvey survey = surveyRays(g, glm::dvec3(g.sceneBox.lo) - grow, glm::dvec3(g.sceneBox.hi) + grow);
+    const RaySurvey survey = surveyRays(g, glm::dvec3(g.sceneBox.lo) - grow, glm::dvec3(g.sceneBox.hi) + grow, pool);
     RayGrid grid;
-    if (switches.passRays) {
+    // A pass of many rays for its triangles spends its time on the rays: the grid would cost
+    // more than it saves (measured: docs/benchmarks.md, "Secondary passes").
+    if (switches.passRays && (cellsAlongLongest || rays.size() * kTrianglesPerRayForTheGrid < g.triangles->size())) {
         // Cells along the longest side: as many as the marking budget allows, up to kMaxCells.
         const double budget = kPiecesPerTriangle * double(g.triangles->size());
         const double cells = std::clamp(budget / std::max(survey.cellSpans, 1e-30), 1.0, double(RayGrid::kMaxCells));
@@ -223,7 +251,8 @@ void planPassCull(const FrameGeometry& g, const SkipSwitches& switches, const Pa
     plan.addWork("skipped: outside the pass's rays' bounds", cull.outsideRays,
                  cull.raysTested ? "no segment of the pass's rays passes their cells (" +
                                        std::to_string(cull.cellsAlongLongest) + " cells along the scene's longest side)"
-                                 : std::string(switches.passRays ? "" : "skip off (--no-skip)"));
+                 : switches.passRays ? "none tested: too many rays for the triangles to pay for the grid"
+                                     : "skip off (--no-skip)");
     plan.addWork("skipped: back-facing", cull.skips.backFacing,
                  cull.directionShared ? "single-sided, facing away from the rays' shared direction"
                  : !switches.backFaces ? "skip off (--no-skip)"
