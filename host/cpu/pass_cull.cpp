@@ -105,8 +105,9 @@ enum Verdict : std::uint8_t { kTraced = kTracedVerdict, kOutsideRays, kBackFacin
 
 int RayGrid::cellOf(float x, int a) const {
     // Monotone in x (each rounding and the clamp are), so boxes that overlap get cell ranges
-    // that overlap. Branch-free: the triangles' pass calls it six times a triangle.
-    return int(std::clamp((x - lo_[a]) * scale_[a], 0.0f, float(n_[a] - 1)));
+    // that overlap. Branch-free: the triangles' pass calls it six times a triangle. std::max
+    // with 0 first: an infinite x on a flat axis (scale 0) gives NaN, which it turns into 0.
+    return int(std::min(std::max(0.0f, (x - lo_[a]) * scale_[a]), float(n_[a] - 1)));
 }
 
 // Cells from..to of a row, as bits.
