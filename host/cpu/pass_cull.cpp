@@ -103,11 +103,11 @@ enum Verdict : std::uint8_t { kTraced = kTracedVerdict, kOutsideRays, kBackFacin
 
 }  // namespace
 
-int RayGrid::cellOf(float x, int a) const {
+int RayGrid::cellOf(float x, int k) const {
     // Monotone in x (each rounding and the clamp are), so boxes that overlap get cell ranges
     // that overlap. Branch-free: the triangles' pass calls it six times a triangle. std::max
     // with 0 first: an infinite x on a flat axis (scale 0) gives NaN, which it turns into 0.
-    return int(std::min(std::max(0.0f, (x - lo_[a]) * scale_[a]), float(n_[a] - 1)));
+    return int(std::min(std::max(0.0f, (x - lo_[k]) * scale_[k]), float(n_[k] - 1)));
 }
 
 // Cells from..to of a row, as bits.
@@ -115,9 +115,9 @@ std::uint64_t rowBits(int from, int to) { return (~0ull >> (63 - to)) & (~0ull <
 
 void RayGrid::markBox(const glm::dvec3& lo, const glm::dvec3& hi) {
     int from[3], to[3];
-    for (int a = 0; a < 3; ++a) {
-        from[a] = cellOf(floatBelow(lo[a] - grow_), a);
-        to[a] = cellOf(floatAbove(hi[a] + grow_), a);
+    for (int k = 0; k < 3; ++k) {
+        from[k] = cellOf(floatBelow(lo[axis_[k]] - grow_), k);
+        to[k] = cellOf(floatAbove(hi[axis_[k]] + grow_), k);
     }
     const std::uint64_t bits = rowBits(from[0], to[0]);
     for (int z = from[2]; z <= to[2]; ++z)
@@ -133,7 +133,7 @@ void RayGrid::markRay(const Ray& ray) {
     const glm::dvec3 o(ray.origin), d(ray.dir);
     // Pieces of at most one cell along every axis, each marked with its box.
     double span = 0.0;
-    for (int a = 0; a < 3; ++a) span = std::max(span, std::abs(d[a]) * (iv.t1 - iv.t0) * double(scale_[a]));
+    for (int k = 0; k < 3; ++k) span = std::max(span, std::abs(d[axis_[k]]) * (iv.t1 - iv.t0) * double(scale_[k]));
     const int pieces = int(std::clamp(std::ceil(span), 1.0, double(4 * kMaxCells)));
     glm::dvec3 from = o + iv.t0 * d;
     for (int k = 1; k <= pieces; ++k) {
@@ -147,12 +147,19 @@ void RayGrid::markRay(const Ray& ray) {
 void RayGrid::mark(const FrameGeometry& g, unsigned cellsAlongLongest, std::vector<std::uint64_t>& rows, ThreadPool& pool) {
     const Box& box = g.sceneBox;
     const glm::vec3 extent = box.extent();
-    const float longest = std::max({extent.x, extent.y, extent.z});
-    longest_ = std::clamp(cellsAlongLongest, 1u, kMaxCells);
-    lo_ = box.lo;
-    for (int a = 0; a < 3; ++a) {
-        n_[a] = longest > 0.0f ? std::clamp(int(std::ceil(double(extent[a]) / longest * longest_)), 1, int(longest_)) : 1;
-        scale_[a] = extent[a] > 0.0f ? float(n_[a]) / extent[a] : 0.0f;
+    const int shortest = int(std::min_element(&extent[0], &extent[0] + 3) - &extent[0]);
+    axis_[0] = shortest, axis_[1] = (shortest + 1) % 3, axis_[2] = (shortest + 2) % 3;
+    const double longest = std::max({extent.x, extent.y, extent.z});
+    // Cubic cells, cellsAlongLongest along the longest side, no more than kWordCells along the
+    // shortest (larger cells where it would take more).
+    const double cell = std::max(longest / std::clamp(cellsAlongLongest, 1u, kMaxCells), double(extent[shortest]) / kWordCells);
+    longest_ = 1;
+    for (int k = 0; k < 3; ++k) {
+        const int a = axis_[k];
+        n_[k] = cell > 0.0 ? std::clamp(int(std::ceil(double(extent[a]) / cell)), 1, int(k == 0 ? kWordCells : kMaxCells)) : 1;
+        lo_[k] = box.lo[a];
+        scale_[k] = extent[a] > 0.0f ? float(n_[k]) / extent[a] : 0.0f;
+        longest_ = std::max(longest_, unsigned(n_[k]));
     }
     grow_ = 2.0 * double(g.margin);
     clipLo_ = glm::dvec3(box.lo) - grow_;
@@ -167,8 +174,8 @@ void RayGrid::mark(const FrameGeometry& g, unsigned cellsAlongLongest, std::vect
 }
 
 bool RayGrid::mayMeet(const glm::vec3& lo, const glm::vec3& hi) const {
-    const int x0 = cellOf(lo.x, 0), x1 = cellOf(hi.x, 0), y0 = cellOf(lo.y, 1), y1 = cellOf(hi.y, 1);
-    const int z0 = cellOf(lo.z, 2), z1 = cellOf(hi.z, 2);
+    const int x0 = cellOf(lo[axis_[0]], 0), x1 = cellOf(hi[axis_[0]], 0), y0 = cellOf(lo[axis_[1]], 1),
+              y1 = cellOf(hi[axis_[1]], 1), z0 = cellOf(lo[axis_[2]], 2), z1 = cellOf(hi[axis_[2]], 2);
     const std::uint64_t bits = rowBits(x0, x1);
     auto row = [&](int y, int z) { return rows_[std::size_t(z) * n_[1] + y]; };
     // Most triangles span at most two cells along y and z: their four rows, without a loop.

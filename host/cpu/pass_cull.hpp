@@ -21,8 +21,10 @@ namespace dacrt {
 // The cells the rays' segments pass through, over the scene box.
 class RayGrid {
 public:
-    // At most this many cells along the box's longest side (a row along x is one word of bits).
-    static constexpr unsigned kMaxCells = 64;
+    // At most this many cells along the box's longest side, and kWordCells along its
+    // shortest, whose rows of cells are one word of bits each.
+    static constexpr unsigned kMaxCells = 128;
+    static constexpr unsigned kWordCells = 64;
 
     // Marks every cell within twice g.margin of a ray's segment [tmin, tmax] clipped to the
     // scene box, cellsAlongLongest cells along its longest side (1 to kMaxCells). rows is the
@@ -33,11 +35,14 @@ public:
     unsigned cellsAlongLongest() const { return longest_; }
 
 private:
-    int cellOf(float x, int axis) const;
+    int cellOf(float x, int k) const;  // along the grid's axis k
     void markRay(const Ray& ray);
     void markBox(const glm::dvec3& lo, const glm::dvec3& hi);
 
     unsigned longest_ = 1;
+    // The grid's axes: axis_[0] the shortest side's (along a word), then the other two; n_,
+    // lo_ and scale_ are in that order.
+    int axis_[3] = {0, 1, 2};
     int n_[3] = {1, 1, 1};
     glm::vec3 lo_{};      // the grid's corner: the scene box's
     glm::vec3 scale_{};   // cells per unit along each axis (0 on a flat axis)
