@@ -35,7 +35,7 @@ std::string optionText(const BenchConfig& c) {
         s << " profile=" << toString(c.options.gpu.profile);
     const SkipSwitches& k = c.options.trace.skips;
     if (!(k == SkipSwitches{}))
-        s << " no_skip=" << (k.backFaces ? "" : "backfaces,") << (k.frustum ? "" : "frustum,") << (k.uploads ? "" : "uploads,") << (k.subScenes ? "" : "subscenes,");
+        s << " no_skip=" << (k.backFaces ? "" : "backfaces,") << (k.frustum ? "" : "frustum,") << (k.uploads ? "" : "uploads,") << (k.subScenes ? "" : "subscenes,") << (k.passRays ? "" : "passrays,");
     return s.str();
 }
 
@@ -157,7 +157,7 @@ std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads) {
     off("frustum", [](SkipSwitches& s) { s.frustum = false; });
     if (b == Backend::Gpu) off("uploads", [](SkipSwitches& s) { s.uploads = false; });
     if (b == Backend::Cpu) off("subscenes", [](SkipSwitches& s) { s.subScenes = false; });
-    off("all", [](SkipSwitches& s) { s = SkipSwitches{false, false, false, false}; });
+    off("all", [](SkipSwitches& s) { s = SkipSwitches{false, false, false, false, false}; });
     return out;
 }
 

@@ -157,6 +157,7 @@ void addSkipListOption(CLI::App* cmd, SkipSwitches& skips) {
                    if (skip == Skip::Frustum) skips.frustum = false;
                    if (skip == Skip::Uploads) skips.uploads = false;
                    if (skip == Skip::SubScenes) skips.subScenes = false;
+                   if (skip == Skip::PassRays) skips.passRays = false;
                }
            },
            "")

@@ -56,10 +56,11 @@ constexpr std::uint64_t kSequentialBelowPairs = std::uint64_t(1) << 28;
 // The skips as --no-skip names them.
 template <>
 struct EnumNames<Skip> {
-    static constexpr std::array<std::pair<Skip, std::string_view>, 4> table{{{Skip::BackFaces, "backfaces"},
+    static constexpr std::array<std::pair<Skip, std::string_view>, 5> table{{{Skip::BackFaces, "backfaces"},
                                                                              {Skip::Frustum, "frustum"},
                                                                              {Skip::Uploads, "uploads"},
-                                                                             {Skip::SubScenes, "subscenes"}}};
+                                                                             {Skip::SubScenes, "subscenes"},
+                                                                             {Skip::PassRays, "passrays"}}};
 };
 
 // The peers' builds (public <dacrt/backend_tuning.hpp>), named as the command line and the

@@ -17,7 +17,7 @@ constexpr double kFrustumSlack = 0x1p-12;
 // facesAwayFrom's bound: side / R^2 > kFacingL L + kFacingR R.
 constexpr double kFacingL = 480.0 * kFloatUnit, kFacingR = 200.0 * kFloatUnit * kFloatUnit;
 
-enum class Verdict : std::uint8_t { Traced, BackFacing, OutsideFrustum };
+enum class Verdict : std::uint8_t { Traced = kTracedVerdict, BackFacing, OutsideFrustum };
 
 }  // namespace
 
@@ -35,6 +35,17 @@ bool facesAwayFrom(const Triangle& t, const glm::dvec3& origin) {
     const double r2 = std::max({glm::dot(a, a), glm::dot(b, b), glm::dot(c, c)});
     const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
     return side / r2 > kFacingL * std::sqrt(l2) + kFacingR * std::sqrt(r2);
+}
+
+bool facesAwayAlong(const Triangle& t, const glm::dvec3& direction, double reach) {
+    const glm::dvec3 p0(t.v0), p1(t.v1), p2(t.v2);
+    const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0, e3 = p2 - p1;
+    // The exact determinant of a ray along `direction` is at least n . d / |d| in magnitude,
+    // whatever its origin; its rounding error is facesAwayFrom's, with R = reach.
+    const double along = glm::dot(glm::cross(e1, e2), direction) / glm::length(direction);
+    if (!(along > 0.0)) return false;
+    const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
+    return along / reach > kFacingL * std::sqrt(l2) + kFacingR * reach;
 }
 
 bool outsideFrustum(const Triangle& t, const ViewFrustum& f) {
@@ -76,18 +87,13 @@ TriangleSkips skipTriangles(const FrameGeometry& g, const SkipSwitches& switches
     if (!backFaces && !frustum) return s;  // not even counted: a frame with the skips off pays nothing
 
     const glm::dvec3 origin(g.rayOrigin);
-    const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(64, tris.size() / 4096 + 1));
-    std::vector<Verdict> verdict(tris.size());
-    std::vector<std::uint64_t> kept(chunks, 0), away(chunks, 0), outside(chunks, 0), single(chunks, 0);
-    std::vector<Box> boxes(chunks);
-    auto range = [&](std::size_t c) {
-        return std::pair<std::size_t, std::size_t>(tris.size() * c / chunks, tris.size() * (c + 1) / chunks);
-    };
+    const std::size_t chunks = skipChunks(tris.size());
+    std::vector<std::uint8_t> verdict(tris.size());
+    std::vector<SkipTally> tallies(chunks);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        const auto [begin, end] = range(c);
+        const auto [begin, end] = skipChunkRange(c, chunks, tris.size());
         // Counted locally: neighbouring chunks' counters share cache lines.
-        std::uint64_t keptHere = 0, awayHere = 0, outsideHere = 0, singleHere = 0;
-        Box box;
+        SkipTally tally;
         // The facing of the chunk's triangles in SIMD lanes first; facesAwayFrom where they
         // cannot tell.
         std::vector<std::uint8_t> facing(end - begin, backFaces ? simd::kUndecided : simd::kKeep);
@@ -96,42 +102,58 @@ TriangleSkips skipTriangles(const FrameGeometry& g, const SkipSwitches& switches
         for (std::size_t i = begin; i < end; ++i) {
             const Triangle& t = tris[i];
             Verdict v = Verdict::Traced;
-            singleHere += t.cullBackFace != 0u;
+            tally.singleSided += t.cullBackFace != 0u;
             const std::uint8_t f = facing[i - begin];
             if (f == simd::kDrop || (f == simd::kUndecided && t.cullBackFace && facesAwayFrom(t, origin)))
-                v = Verdict::BackFacing, ++awayHere;
+                v = Verdict::BackFacing, ++tally.backFacing;
             else if (frustum && outsideFrustum(t, *g.frustum))
-                v = Verdict::OutsideFrustum, ++outsideHere;
+                v = Verdict::OutsideFrustum, ++tally.outside;
             else {
-                ++keptHere;
-                box.extend(t.v0);  // the triangle's bounds, without reading them
-                box.extend(t.v1);
-                box.extend(t.v2);
+                ++tally.kept;
+                tally.box.extend(t.v0);  // the triangle's bounds, without reading them
+                tally.box.extend(t.v1);
+                tally.box.extend(t.v2);
             }
-            verdict[i] = v;
+            verdict[i] = std::uint8_t(v);
         }
-        kept[c] = keptHere, away[c] = awayHere, outside[c] = outsideHere, single[c] = singleHere;
-        boxes[c] = box;
+        tallies[c] = tally;
     });
+    s.outsideFrustum = listTraced(tallies, verdict.data(), tris.size(), true, pool, s);
+    return s;
+}
+
+std::size_t skipChunks(std::size_t triangles) {
+    return std::max<std::size_t>(1, std::min<std::size_t>(64, triangles / 4096 + 1));
+}
+
+std::pair<std::size_t, std::size_t> skipChunkRange(std::size_t c, std::size_t chunks, std::size_t triangles) {
+    return {triangles * c / chunks, triangles * (c + 1) / chunks};
+}
+
+std::uint64_t listTraced(const std::vector<SkipTally>& tallies, const std::uint8_t* verdict, std::size_t triangles,
+                         bool evenIfAllKept, ThreadPool& pool, TriangleSkips& s) {
+    const std::size_t chunks = tallies.size();
     std::vector<std::uint64_t> offset(chunks, 0);
-    std::uint64_t total = 0;
+    std::uint64_t total = 0, outside = 0;
     for (std::size_t c = 0; c < chunks; ++c) {
+        const SkipTally& t = tallies[c];
         offset[c] = total;
-        total += kept[c];
-        s.backFacing += away[c];
-        s.outsideFrustum += outside[c];
-        s.singleSided += single[c];
-        if (!boxes[c].empty()) s.tracedBox.extend(boxes[c].lo), s.tracedBox.extend(boxes[c].hi);
+        total += t.kept;
+        s.backFacing += t.backFacing;
+        outside += t.outside;
+        s.singleSided += t.singleSided;
+        if (!t.box.empty()) s.tracedBox.extend(t.box.lo), s.tracedBox.extend(t.box.hi);
     }
-    s.applied = true;
+    s.applied = evenIfAllKept || total < triangles;
+    if (!s.applied) return outside;
     s.traced.resize(total);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        const auto [begin, end] = range(c);
+        const auto [begin, end] = skipChunkRange(c, chunks, triangles);
         std::uint64_t k = offset[c];
         for (std::size_t i = begin; i < end; ++i)
-            if (verdict[i] == Verdict::Traced) s.traced[k++] = std::uint32_t(i);
+            if (verdict[i] == kTracedVerdict) s.traced[k++] = std::uint32_t(i);
     });
-    return s;
+    return outside;
 }
 
 FrameGeometry withSkips(const FrameGeometry& g, const TriangleSkips& skips) {

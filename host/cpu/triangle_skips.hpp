@@ -4,6 +4,7 @@
 // by construction (docs/correctness.md, "Skips"): a triangle is dropped only where the
 // intersection test provably never reports it for these rays.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/thread_pool.hpp"
@@ -27,6 +28,10 @@ struct TriangleSkips {
 // watertight test (or Moller-Trumbore's, or float64's) can overcome: every ray from origin
 // then meets its back, and the face rule rejects it.
 bool facesAwayFrom(const Triangle& triangle, const glm::dvec3& origin);
+// Whether a single-sided triangle faces away from `direction` by the same margin, for rays of
+// that direction (bit for bit) whose origins lie within `reach` of every vertex: each of them
+// meets its back.
+bool facesAwayAlong(const Triangle& triangle, const glm::dvec3& direction, double reach);
 // Whether the triangle lies outside one side plane of the frustum by more than the test's
 // rounding can bridge: no ray inside the frustum can hit it.
 bool outsideFrustum(const Triangle& triangle, const ViewFrustum& frustum);
@@ -38,6 +43,22 @@ TriangleSkips skipTriangles(const FrameGeometry& g, const SkipSwitches& switches
 // g restricted to the kept triangles: tracedTriangles, the kept triangles' box and its margin.
 // skips must outlive the result.
 FrameGeometry withSkips(const FrameGeometry& g, const TriangleSkips& skips);
+
+// What a skip's first pass over a chunk of triangles counted (pass_cull.cpp's too).
+struct SkipTally {
+    std::uint64_t kept = 0, backFacing = 0, outside = 0, singleSided = 0;
+    Box box;  // the kept triangles' bounds
+};
+// The chunks of a skip's passes over `triangles`: up to 64, of at least 4096, and chunk c's range.
+std::size_t skipChunks(std::size_t triangles);
+std::pair<std::size_t, std::size_t> skipChunkRange(std::size_t c, std::size_t chunks, std::size_t triangles);
+// A verdict byte of kTracedVerdict keeps the triangle.
+constexpr std::uint8_t kTracedVerdict = 0;
+// The chunks' tallies added into skips, and skips.traced filled with the kept ids, ascending,
+// chunk by chunk in parallel (not where every triangle was kept, unless evenIfAllKept:
+// skips.applied says which). Returns the tallies' `outside` total.
+std::uint64_t listTraced(const std::vector<SkipTally>& tallies, const std::uint8_t* verdict, std::size_t triangles,
+                         bool evenIfAllKept, ThreadPool& pool, TriangleSkips& skips);
 
 // The skips' lines of the work plan.
 void planSkips(const FrameGeometry& g, const SkipSwitches& switches, const TriangleSkips& skips, MemoryPlan& plan);

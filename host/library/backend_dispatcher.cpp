@@ -8,6 +8,7 @@
 #include "core/timing.hpp"
 #include "cpu/backend_options.hpp"
 #include "cpu/cpu_tracers.hpp"
+#include "cpu/pass_cull.hpp"
 #include "cpu/triangle_skips.hpp"
 
 namespace dacrt {
@@ -66,7 +67,12 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
     const TriangleSkips skips = skipTriangles(geometry, request.trace.skips, threadPool);
     MemoryPlan skipPlan;
     planSkips(geometry, request.trace.skips, skips, skipPlan);
-    const double skipMs = msSince(start);
+    return traceAfterSkips(geometry, skips, skipPlan, msSince(start), request, onPlan, onProgress);
+}
+
+TraceResult BackendDispatcher::traceAfterSkips(const FrameGeometry& geometry, const TriangleSkips& skips,
+                                               const MemoryPlan& skipPlan, double skipMs, const BackendRequest& request,
+                                               const PlanHook& onPlan, const ProgressHook& onProgress) {
     auto withSkipLines = [&](TraceResult r) {
         r.memory.work.insert(r.memory.work.begin(), skipPlan.work.begin(), skipPlan.work.end());
         r.phases.skips = skipMs;
@@ -76,7 +82,7 @@ TraceResult BackendDispatcher::trace(const FrameGeometry& geometry, const Backen
     if (skips.applied && skips.traced.empty()) {
         // No triangle can be hit: every ray misses, with nothing to divide or upload.
         TraceResult r;
-        r.threads = threadPool.size();
+        r.threads = pool(threadsOf(request.trace)).size();
         r.memory.add("hits", std::uint64_t(geometry.rays->size()) * sizeof(Hit));
         if (!planWithSkips || planWithSkips(r.memory)) {
             r.hits.reserve(geometry.rays->size());
@@ -147,12 +153,22 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
         FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays.rays, primary.sceneBox);
         g.trianglesVersion = primary.trianglesVersion;
         g.sceneId = primary.sceneId;
-        out.result = traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass);
+        out.result = isPeer(request.trace.backend) ? traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass)
+                                                   : traceCulled(g, request, onPlan);
         if (out.result.hits.empty()) return out;  // stopped at the plan
         out.result.hits = hitsPerSlot(rays, out.result.hits);
     }
     out.result.phases.makeRays = makeMs;
     return out;
+}
+
+TraceResult BackendDispatcher::traceCulled(const FrameGeometry& g, const BackendRequest& request,
+                                           const PlanHook& onPlan) {
+    const auto start = Clock::now();
+    cullForPass(g, request.trace.skips, pool(threadsOf(request.trace)), passCull_);
+    MemoryPlan cullPlan;
+    planPassCull(g, request.trace.skips, passCull_, cullPlan);
+    return traceAfterSkips(g, passCull_.skips, cullPlan, msSince(start), request, onPlan, {});
 }
 
 std::uint32_t BackendDispatcher::validationErrors() const { return gpu_ ? gpu_->validationErrors() : 0; }

@@ -15,6 +15,7 @@
 #include "cpu/frame_geometry.hpp"
 #include "cpu/memory_plan.hpp"
 #include "cpu/options.hpp"
+#include "cpu/pass_cull.hpp"
 #include "cpu/secondary_rays.hpp"
 #include "cpu/trace_result.hpp"
 #include "gpu/context.hpp"
@@ -70,8 +71,8 @@ public:
     // A secondary pass of the frame the last trace() traced (with request.keepForPasses on
     // gpu): its rays made from the primary hits (on the device for gpu, where the primary pass
     // left them; on the host for the others, and for gpu where it kept nothing) and traced for
-    // any hit by the same backend, over
-    // every triangle (no skips: a shadow may fall from anywhere). `primary` is the frame as
+    // any hit by the same backend, over the triangles the pass cull keeps (pass_cull.hpp:
+    // those the pass's rays can reach; the peers trace every one). `primary` is the frame as
     // given to trace(); the peers trace the structure it left. Returns one hit per slot
     // (hitsPerSlot) and the rays made.
     struct PassTrace {
@@ -90,6 +91,12 @@ private:
     // The trace itself, on the triangles the skips left (dacrt's backends) or on every one.
     TraceResult traceOnBackend(const FrameGeometry& geometry, const BackendRequest& request, const PlanHook& onPlan,
                                const ProgressHook& onProgress, PeerFrame frame);
+    // The trace of the triangles `skips` kept, its plan and result opened by skipPlan's lines.
+    TraceResult traceAfterSkips(const FrameGeometry& geometry, const TriangleSkips& skips, const MemoryPlan& skipPlan,
+                                double skipMs, const BackendRequest& request, const PlanHook& onPlan,
+                                const ProgressHook& onProgress);
+    // A secondary pass's rays on dacrt's backends, over the triangles the pass cull keeps.
+    TraceResult traceCulled(const FrameGeometry& pass, const BackendRequest& request, const PlanHook& onPlan);
 
     DeviceChoice devices_;
     std::map<unsigned, std::unique_ptr<ThreadPool>> pools_;
@@ -98,6 +105,7 @@ private:
     std::unique_ptr<gpu::ResidentTriangles> resident_;  // gpu: the triangles kept on the device
     GpuPassSourcePtr passSource_;                       // gpu: the last frame kept for its secondary passes
     PeerScenes peers_;                                  // embree, rayquery: their structures
+    PassCull passCull_;                                 // the last pass's cull, its buffers reused
 };
 
 }  // namespace dacrt

@@ -155,7 +155,8 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
                     {"skip_backfaces", trace.skips.backFaces},
                     {"skip_frustum", trace.skips.frustum},
                     {"skip_uploads", trace.skips.uploads},
-                    {"skip_subscenes", trace.skips.subScenes}};
+                    {"skip_subscenes", trace.skips.subScenes},
+                    {"skip_passrays", trace.skips.passRays}};
     if (trace.backend == Backend::Embree)
         j["options"] = {{"robust", o.tracer.embree.robust}, {"build", toString(o.tracer.embree.build)},
                         {"packets", o.tracer.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};

@@ -67,13 +67,15 @@ struct DacrtOptions {
 
 // The frame's skips (docs/skips.md), each exact by construction, each on unless turned off
 // (--no-skip): they change speed only.
-enum class Skip { BackFaces, Frustum, Uploads, SubScenes };
+enum class Skip { BackFaces, Frustum, Uploads, SubScenes, PassRays };
 struct SkipSwitches {
-    bool backFaces = true;  // single-sided triangles facing away from the rays' shared origin
+    bool backFaces = true;  // single-sided triangles facing away from the rays' shared origin (or
+                            // a secondary pass's shared direction)
     bool frustum = true;    // triangles outside the camera's view frustum
     bool uploads = true;    // gpu: triangle buffers kept on the device while the triangles do not change
     bool subScenes = true;  // cpu: one sequential DACRT instead of sub-scenes for frames too small to pay
                             // for a division (kSequentialBelowRays), unless --regions is given
+    bool passRays = true;   // secondary passes: triangles that no segment of the pass's rays comes near
     bool operator==(const SkipSwitches&) const = default;
 };
 

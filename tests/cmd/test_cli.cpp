@@ -519,17 +519,19 @@ static std::string insideOutScene() {
 // Every backend culls the same back faces (glTF's rule), with the skips on, as brute force
 // does with them off: cpu-seq, cpu and gpu bit for bit, the peers within their own rounding.
 TEST(Cli, EveryBackendCullsTheSameBackFacesAndTheSkipsChangeNoPixel) {
+    // With the key light's shadow pass and an occlusion pass, whose triangles the pass cull
+    // drops (passrays, and back faces along the light's direction) unless turned off.
     const std::string scene = insideOutScene(), ref = temp("cull_ref.exr");
-    ASSERT_EQ(run("render " + scene + " --size 48x32 --backend brute --no-skip backfaces,frustum --aov " + ref).code, 0);
+    ASSERT_EQ(run("render " + scene + " --size 48x32 --ao 2 --backend brute --no-skip backfaces,frustum,passrays --aov " + ref).code, 0);
     const std::string none = temp("cull_none.exr");
-    ASSERT_EQ(run("render " + scene + " --size 48x32 --backend cpu --cull none --aov " + none).code, 0);
+    ASSERT_EQ(run("render " + scene + " --size 48x32 --ao 2 --backend cpu --cull none --aov " + none).code, 0);
     EXPECT_EQ(run("compare " + ref + " " + none + " --fail-on any").code, 1) << "the walls' backs show without the rule";
     const bool vulkan = run("devices").code == 0;
     for (const std::string backend : {"brute", "cpu-seq", "cpu", "gpu", "embree", "rayquery"}) {
         if (!vulkan && (backend == "gpu" || backend == "rayquery")) continue;
         const std::string out = temp("cull_" + backend + ".exr");
         std::filesystem::remove(out);
-        const CommandResult r = run("render " + scene + " --size 48x32 --backend " + backend +
+        const CommandResult r = run("render " + scene + " --size 48x32 --ao 2 --backend " + backend +
                                     (backend == "gpu" || backend == "rayquery" ? " --validate" : "") +
                                     (backend == "cpu" ? " --regions 2" : "") + " --aov " + out);
         if (backend == "rayquery" && r.code == 2 && r.output.find("VK_KHR_ray_query") != std::string::npos) continue;
@@ -636,6 +638,18 @@ TEST(Cli, PlanAndStatsListEverySkipWithItsCounts) {
               counts["triangles"]);
     const CommandResult off = run("render " + scene + " --size 48x32 --plan --no-skip backfaces,frustum");
     EXPECT_NE(off.output.find("skip off (--no-skip)"), std::string::npos) << off.output;
+    // Each secondary pass's own cull: the key light's shadow pass and the occlusion pass.
+    ASSERT_EQ(run("render " + scene + " --size 48x32 --ao 2 --stats " + stats).code, 0);
+    std::ifstream passStats(stats);
+    const nlohmann::json p = nlohmann::json::parse(passStats);
+    ASSERT_EQ(p["passes"].size(), 3u);
+    for (std::size_t i = 1; i < 3; ++i) {
+        std::map<std::string, std::uint64_t> pass;
+        for (const auto& line : p["passes"][i]["work_plan"]) pass[line["name"]] = line["count"];
+        ASSERT_TRUE(pass.count("skipped: outside the pass's rays' bounds")) << p["passes"][i].dump();
+        EXPECT_EQ(pass["triangles traced"] + pass["skipped: back-facing"] + pass["skipped: outside the pass's rays' bounds"],
+                  counts["triangles"]) << p["passes"][i]["name"];
+    }
     // Without --regions a frame this small is one sequential DACRT, and the plan says so.
     const CommandResult small = run("render " + scene + " --size 48x32 --plan");
     EXPECT_NE(small.output.find("sub-scenes"), std::string::npos) << small.output;
