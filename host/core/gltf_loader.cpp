@@ -28,6 +28,7 @@
 #include "core/gltf_materials.hpp"
 #include "core/input_file.hpp"
 #include "core/json_nesting.hpp"
+#include "core/mapped_memory.hpp"
 #include "core/system_memory.hpp"
 #include "core/triangle_rules.hpp"
 
@@ -392,7 +393,11 @@ public:
         const int animation = gltf::chooseAnimation(document_.animations, selection_.animation, reader_);
         pose_ = gltf::poseAt(document_.animations, animation, selection_.time, model_.nodes.size());
         const std::vector<NodeInstance> instances = walkHierarchy(check_.sceneRoots(document_.parent, sceneIndex));
-        planTriangles(instances);
+        plannedTriangles_ = planTriangles(instances);
+        // Filled to at most the planned count (less the degenerate triangles): never regrown.
+        reserveMapped(scene_.triangles, plannedTriangles_);
+        reserveMapped(scene_.sources, plannedTriangles_);
+        reserveMapped(scene_.materialOfTriangle, plannedTriangles_);
         scene_.materials = document_.shared.materials;
         scene_.textures = document_.shared.textures;
         scene_.warnings = document_.shared.warnings;
@@ -452,8 +457,8 @@ private:
     }
 
     // The triangle total over every instance, checked against the 32-bit primitive ids and this
-    // machine's memory before anything is flattened.
-    void planTriangles(const std::vector<NodeInstance>& instances) const {
+    // machine's memory before anything is flattened. Returns it.
+    std::uint64_t planTriangles(const std::vector<NodeInstance>& instances) const {
         std::vector<std::int64_t> meshTriangles(model_.meshes.size(), -1);
         std::uint64_t total = 0, meshInstances = 0;
         for (const NodeInstance& i : instances) {
@@ -473,6 +478,7 @@ private:
             check_.fail("the scene has " + counted + ", which need " + str(bytes) + " bytes, more than the " + str(limit) +
                         " bytes of " + (limits_.maxBytes ? "the limit" : "this machine's memory") + " (over by " +
                         str(bytes - limit) + ")");
+        return total;
     }
 
     std::uint64_t meshTriangleCount(std::size_t m) const {
@@ -602,9 +608,11 @@ private:
             check_.fail(where + ": POSITION is quantized (integer components), which needs the extension KHR_mesh_quantization the file does not declare");
     }
 
-    // Grows an attribute array to one entry per triangle so far, with its default.
+    // Grows an attribute array to one entry per triangle so far, with its default (room for
+    // the planned triangles made once).
     template <typename T>
-    static void fillTo(std::vector<std::array<T, 3>>& v, std::size_t n, const T& value) {
+    void fillTo(std::vector<std::array<T, 3>>& v, std::size_t n, const T& value) const {
+        if (v.empty()) reserveMapped(v, plannedTriangles_);
         if (v.size() < n) v.resize(n, {value, value, value});
     }
 
@@ -1008,6 +1016,7 @@ private:
     GltfChecker check_;
     Scene scene_;
     std::uint32_t defaultMaterial_ = 0;
+    std::uint64_t plannedTriangles_ = 0;                // before the degenerate ones are dropped
     std::vector<gltf::NodePose> pose_;                  // every node's animated properties at this instant
     std::vector<std::optional<glm::dmat4>> worlds_;     // nodeWorld's, computed on demand
     std::uint64_t unweightedVertices_ = 0;              // skinned vertices without a weight

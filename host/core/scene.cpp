@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/mapped_memory.hpp"
 
 namespace dacrt {
 
@@ -63,6 +64,7 @@ std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles) {
 void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool& pool, std::vector<Bounds>& bounds,
                               Box& box) {
     constexpr std::size_t kChunk = 16384;
+    reserveMapped(bounds, triangles.size());
     bounds.resize(triangles.size());
     const std::size_t chunks = (triangles.size() + kChunk - 1) / kChunk;
     std::vector<Box> chunkBox(chunks);
