@@ -49,6 +49,10 @@ public:
     // for a scene or animation that does not exist, or an animation that cannot be sampled.
     Scene scene(const GltfSelection& selection = {}) const;
 
+    // The threads that place the vertices and assemble the triangles (0: every core, the
+    // default). The scene is the same for any number, bit for bit.
+    void setThreads(unsigned threads);
+
     const std::vector<GltfAnimationInfo>& animations() const;
 
     // Throws InputError listing the animations when `choice` (an index or a name) names none;

@@ -204,6 +204,7 @@ LoadedDocument loadDocument(const RenderOptions& o) {
     const auto start = Clock::now();
     LoadedDocument d{GltfDocument::open(o.scenePath), 0.0};
     d.document.checkAnimationChoice(o.animationChoice);
+    d.document.setThreads(o.tracer.trace.threads);  // --threads: the flattening's too
     d.loadMs = msSince(start);
     if (o.frames && d.document.animations().empty())
         std::cerr << "dacrt: warning: " << o.scenePath << " has no animations: every frame of the range is the same\n";
@@ -234,7 +235,9 @@ Scene evaluateAnimation(const RenderOptions& o, const GltfDocument& document, co
     selectCamera(scene, o.cameraChoice);
     if (firstFrame)  // every instant has the file's warnings: printed once
         for (const std::string& w : scene.warnings) std::cerr << "dacrt: warning: " << w << "\n";
+    const auto cullStart = Clock::now();
     applyCullMode(scene, o.cull);
+    scene.setupPhasesMs.emplace_back("cull", msSince(cullStart));
     return scene;
 }
 
