@@ -391,9 +391,9 @@ namespace {
 
 class GltfFlattener {
 public:
-    GltfFlattener(GltfDocument::Impl& document, const GltfSelection& selection)
+    GltfFlattener(GltfDocument::Impl& document, const GltfSelection& selection, const std::function<void(double)>& onProgress)
         : document_(document), reader_(*document.reader), model_(document.model), limits_(document.limits),
-          selection_(selection), check_(*document.reader) {
+          selection_(selection), onProgress_(onProgress), check_(*document.reader) {
         scene_.name = document.name;
     }
 
@@ -809,6 +809,8 @@ private:
         addTriangles(TriangleSource{node, meshIndex, primIndex, 0}, material, corners, placed, shading, where);
         touchTriangles(scene_);
         phases_.triangles += lap(since);
+        assembledTriangles_ += corners.size() / 3;
+        if (onProgress_ && plannedTriangles_) onProgress_(double(assembledTriangles_) / double(plannedTriangles_));
     }
 
     // The primitive's material, the default one when it names none.
@@ -1108,10 +1110,12 @@ private:
     const tinygltf::Model& model_;
     GltfLimits limits_;
     GltfSelection selection_;
+    const std::function<void(double)>& onProgress_;
     GltfChecker check_;
     Scene scene_;
     std::uint32_t defaultMaterial_ = 0;
     std::uint64_t plannedTriangles_ = 0;                // before the degenerate ones are dropped
+    std::uint64_t assembledTriangles_ = 0;              // of the planned, so far
     // The flattening's phases (ms; the primitives' summed), for Scene::setupPhasesMs: the pose and
     // the plan; the arrays' pages mapped; the primitives' data and corners (read on first use);
     // their vertices placed; their triangles assembled (degenerate ones dropped).
@@ -1176,9 +1180,9 @@ GltfDocument GltfDocument::fromMemory(std::span<const unsigned char> bytes, cons
     return GltfDocument(openDocument(bytes, name, "", false, limits));
 }
 
-Scene GltfDocument::scene(const GltfSelection& selection) const {
+Scene GltfDocument::scene(const GltfSelection& selection, const std::function<void(double)>& onProgress) const {
     if (!std::isfinite(selection.time)) throw InputError(impl_->name + ": the time " + std::to_string(selection.time) + " is not finite");
-    Scene scene = GltfFlattener(*impl_, selection).run();
+    Scene scene = GltfFlattener(*impl_, selection, onProgress).run();
     const auto start = Clock::now();
     validateScene(scene);
     scene.setupPhasesMs.emplace_back("validate", msSince(start));

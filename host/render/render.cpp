@@ -230,8 +230,9 @@ struct PreparedScene {
 // The scene's camera and lights are those of that instant, so an animated camera node moves.
 Scene evaluateAnimation(const RenderOptions& o, const GltfDocument& document, const FrameInstant& instant,
                         bool firstFrame) {
-    Scene scene =
-        document.scene(GltfSelection{.scene = o.sceneChoice, .animation = o.animationChoice, .time = instant.time});
+    Progress progress("dacrt render", 1);  // on a terminal, a bar while a large scene is flattened
+    Scene scene = document.scene(GltfSelection{.scene = o.sceneChoice, .animation = o.animationChoice, .time = instant.time},
+                                 [&progress](double done) { progress.fraction(done, "flattening the scene"); });
     selectCamera(scene, o.cameraChoice);
     if (firstFrame)  // every instant has the file's warnings: printed once
         for (const std::string& w : scene.warnings) std::cerr << "dacrt: warning: " << w << "\n";
