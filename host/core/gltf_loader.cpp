@@ -824,9 +824,13 @@ private:
         return material;
     }
 
-    // The primitive's triangleCorners, made once per document.
+    // The primitive's triangleCorners, made once per document (an indexed list's are its indices).
     const std::vector<std::uint32_t>& primitiveCorners(std::uint32_t meshIndex, std::uint32_t primIndex, int mode,
                                                        const gltf::PrimitiveData& data, const std::string& where) {
+        if (mode == TINYGLTF_MODE_TRIANGLES && data.indexed) {  // the indices themselves
+            if (data.indices.size() % 3 != 0) check_.fail(where + ": " + str(data.indices.size()) + " indices is not a multiple of 3");
+            return data.indices;
+        }
         const auto key = std::make_pair(meshIndex, primIndex);
         if (auto cached = document_.corners.find(key); cached != document_.corners.end()) return cached->second;
         return document_.corners.emplace(key, triangleCorners(mode, data, where)).first->second;
@@ -883,7 +887,7 @@ private:
                                     const gltf::PrimitiveData& data, const std::vector<glm::dvec4>* normals,
                                     const std::string& where) const {
         const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
-        MorphedVertices morphed{std::vector<glm::dvec3>(positions.size()), std::vector<glm::dvec3>(normals ? positions.size() : 0)};
+        MorphedVertices morphed{mappedArray<glm::dvec3>(positions.size()), mappedArray<glm::dvec3>(normals ? positions.size() : 0)};
         std::vector<glm::dvec3>& local = morphed.positions;
         std::vector<glm::dvec3>& localNormals = morphed.normals;
         for (std::size_t i = 0; i < positions.size(); ++i) local[i] = glm::dvec3(positions[i]);
@@ -914,7 +918,7 @@ private:
         if (skin >= 0) placed.skinning = vertexSkinning(data, jointMatrices(skin, where), local.size(), where);
         auto transformOf = [&](std::uint32_t vertex) -> const glm::dmat4& { return skin >= 0 ? placed.skinning[vertex] : world; };
 
-        placed.worldPositions.resize(local.size());
+        placed.worldPositions = mappedArray<glm::vec3>(local.size());
         // On the document's threads, each chunk up to its first non-finite vertex; the first of all is reported.
         std::vector<std::size_t> nonFinite((local.size() + kChunk - 1) / kChunk, kNone);
         document_.threadPool().parallelFor(nonFinite.size(), [&](std::size_t c, unsigned) {

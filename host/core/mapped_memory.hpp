@@ -22,4 +22,13 @@ void reserveMapped(std::vector<T>& v, std::size_t n) {
     mapForWriting(v.data(), n * sizeof(T));
 }
 
+// A new array of `n` copies of `value`, its pages mapped at once (reserveMapped).
+template <typename T>
+std::vector<T> mappedArray(std::size_t n, const T& value = T()) {
+    std::vector<T> v;
+    reserveMapped(v, n);
+    v.resize(n, value);
+    return v;
+}
+
 }  // namespace dacrt
