@@ -772,7 +772,8 @@ private:
         bool colorHasAlpha = false;
     };
 
-    // A primitive's vertices and normals in the mesh's space, morph targets' offsets weighted in.
+    // A primitive's vertices and normals in the mesh's space, morph targets' offsets weighted in
+    // (positions: empty where no offset moves them, the primitive's own then read in place).
     struct MorphedVertices {
         std::vector<glm::dvec3> positions;
         std::vector<glm::dvec3> normals;
@@ -887,18 +888,22 @@ private:
                                     const gltf::PrimitiveData& data, const std::vector<glm::dvec4>* normals,
                                     const std::string& where) const {
         const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
-        MorphedVertices morphed{mappedArray<glm::dvec3>(positions.size()), mappedArray<glm::dvec3>(normals ? positions.size() : 0)};
-        std::vector<glm::dvec3>& local = morphed.positions;
+        MorphedVertices morphed{{}, mappedArray<glm::dvec3>(normals ? positions.size() : 0)};
+        std::vector<glm::dvec3>& local = morphed.positions;  // made by the first position offset
         std::vector<glm::dvec3>& localNormals = morphed.normals;
-        for (std::size_t i = 0; i < positions.size(); ++i) local[i] = glm::dvec3(positions[i]);
         for (std::size_t i = 0; i < localNormals.size(); ++i) localNormals[i] = glm::dvec3((*normals)[i]);
         if (!prim.targets.empty()) {
             const std::vector<double> weights =
                 morphWeights(node, model_.meshes[meshIndex], prim.targets.size(), "node " + std::to_string(node) + " " + where);
             for (std::size_t t = 0; t < weights.size(); ++t) {
                 if (weights[t] == 0.0) continue;
-                if (const auto* d = vertexAttribute(data, "TARGET" + std::to_string(t) + ":" + kPosition, where))
+                if (const auto* d = vertexAttribute(data, "TARGET" + std::to_string(t) + ":" + kPosition, where)) {
+                    if (local.empty()) {
+                        local = mappedArray<glm::dvec3>(positions.size());
+                        for (std::size_t i = 0; i < positions.size(); ++i) local[i] = glm::dvec3(positions[i]);
+                    }
                     for (std::size_t i = 0; i < local.size(); ++i) local[i] += weights[t] * glm::dvec3((*d)[i]);
+                }
                 if (const auto* d = vertexAttribute(data, "TARGET" + std::to_string(t) + ":" + kNormal, where); d && normals)
                     for (std::size_t i = 0; i < localNormals.size(); ++i) localNormals[i] += weights[t] * glm::dvec3((*d)[i]);
             }
@@ -911,28 +916,31 @@ private:
                                  const gltf::PrimitiveData& data, const std::vector<glm::dvec4>* normals, const glm::dmat4& world,
                                  const std::string& where) {
         MorphedVertices morphed = morphedVertices(node, meshIndex, prim, data, normals, where);
-        const std::vector<glm::dvec3>& local = morphed.positions;
+        const std::vector<glm::dvec4>& own = data.attributes.at(kPosition);
+        const std::size_t vertices = own.size();
+        auto localAt = [&](std::size_t i) { return morphed.positions.empty() ? glm::dvec3(own[i]) : morphed.positions[i]; };
         PlacedVertices placed;
         const int skin = model_.nodes[node].skin;
         placed.skinned = skin >= 0;
-        if (skin >= 0) placed.skinning = vertexSkinning(data, jointMatrices(skin, where), local.size(), where);
+        if (skin >= 0) placed.skinning = vertexSkinning(data, jointMatrices(skin, where), vertices, where);
         auto transformOf = [&](std::uint32_t vertex) -> const glm::dmat4& { return skin >= 0 ? placed.skinning[vertex] : world; };
 
-        placed.worldPositions = mappedArray<glm::vec3>(local.size());
+        placed.worldPositions = mappedArray<glm::vec3>(vertices);
         // On the document's threads, each chunk up to its first non-finite vertex; the first of all is reported.
-        std::vector<std::size_t> nonFinite((local.size() + kChunk - 1) / kChunk, kNone);
+        std::vector<std::size_t> nonFinite((vertices + kChunk - 1) / kChunk, kNone);
         document_.threadPool().parallelFor(nonFinite.size(), [&](std::size_t c, unsigned) {
-            for (std::size_t i = c * kChunk; i < std::min(local.size(), (c + 1) * kChunk); ++i) {
-                if (!finite3(local[i])) {
+            for (std::size_t i = c * kChunk; i < std::min(vertices, (c + 1) * kChunk); ++i) {
+                const glm::dvec3 local = localAt(i);
+                if (!finite3(local)) {
                     nonFinite[c] = i;
                     return;
                 }
-                placed.worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(local[i], 1.0));
+                placed.worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(local, 1.0));
             }
         });
         for (const std::size_t i : nonFinite)
             if (i != kNone) {
-                const glm::dvec3& p = local[i];
+                const glm::dvec3 p = localAt(i);
                 check_.fail(where + ": vertex " + std::to_string(i) + " has a non-finite position (" + std::to_string(p.x) +
                             ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
             }
@@ -1188,7 +1196,7 @@ Scene GltfDocument::scene(const GltfSelection& selection, const std::function<vo
     if (!std::isfinite(selection.time)) throw InputError(impl_->name + ": the time " + std::to_string(selection.time) + " is not finite");
     Scene scene = GltfFlattener(*impl_, selection, onProgress).run();
     const auto start = Clock::now();
-    validateScene(scene);
+    validateScene(scene, &impl_->threadPool());
     scene.setupPhasesMs.emplace_back("validate", msSince(start));
     return scene;
 }

@@ -184,7 +184,8 @@ void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool
                               Box& box);
 
 // Checks that the scene can be traced: triangles exist and every coordinate is finite.
-// Throws InputError naming the first offending triangle and its provenance.
-void validateScene(const Scene& scene);
+// Throws InputError naming the first offending triangle and its provenance. On pool's threads
+// where given (the same triangle is named).
+void validateScene(const Scene& scene, ThreadPool* pool = nullptr);
 
 }  // namespace dacrt

@@ -98,7 +98,9 @@ TEST(ParallelFlattening, ABigPrimitiveIsTheSameOnOneThreadAndTwo) {
     for (std::size_t i = 1; i < a.sources.size(); ++i) {
         const TriangleSource &p = a.sources[i - 1], &s = a.sources[i];
         EXPECT_NE(s.triangle % kDegenerateEvery, 0u) << i;
-        if (s.node == p.node && s.primitive == p.primitive) ASSERT_LT(p.triangle, s.triangle) << i;
+        if (s.node == p.node && s.primitive == p.primitive) {
+            ASSERT_LT(p.triangle, s.triangle) << i;
+        }
     }
     const std::size_t plainAt = perPrimitive - degenerate;  // node 0's second primitive's first triangle
     EXPECT_EQ(a.sources[plainAt].primitive, 1u);
