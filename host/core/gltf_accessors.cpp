@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "core/errors.hpp"
+#include "core/mapped_memory.hpp"
 
 namespace dacrt::gltf {
 
@@ -195,7 +196,7 @@ bool AccessorReader::tryReserve(std::uint64_t bytes) const {
 std::vector<glm::dvec4> AccessorReader::readVectors(int index, std::initializer_list<int> types, const std::string& where) const {
     const Elements e = elements(index, types, where);
     reserveDecoded(e.count, sizeof(glm::dvec4), where + ": accessor " + std::to_string(index));
-    std::vector<glm::dvec4> out(e.count, glm::dvec4(0.0));
+    std::vector<glm::dvec4> out = mappedArray(std::size_t(e.count), glm::dvec4(0.0));
     if (e.data) {
         const std::uint64_t componentSize = std::uint64_t(tinygltf::GetComponentSizeInBytes(std::uint32_t(e.componentType)));
         for (std::uint64_t i = 0; i < e.count; ++i) {
@@ -236,7 +237,7 @@ std::vector<std::uint32_t> AccessorReader::readIndices(int index, const std::str
     }
     const Elements e = elements(index, {TINYGLTF_TYPE_SCALAR}, where);
     reserveDecoded(e.count, sizeof(std::uint32_t), where + ": accessor " + std::to_string(index));
-    std::vector<std::uint32_t> out(e.count);
+    std::vector<std::uint32_t> out = mappedArray<std::uint32_t>(std::size_t(e.count));
     for (std::uint64_t i = 0; i < e.count; ++i)
         out[i] = std::uint32_t(readComponent(e.data + i * e.stride, e.componentType, false));
     return out;

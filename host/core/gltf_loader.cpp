@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 #include <string_view>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
@@ -28,7 +29,9 @@
 #include "core/gltf_materials.hpp"
 #include "core/input_file.hpp"
 #include "core/json_nesting.hpp"
+#include "core/mapped_memory.hpp"
 #include "core/system_memory.hpp"
+#include "core/timing.hpp"
 #include "core/triangle_rules.hpp"
 
 namespace dacrt {
@@ -373,31 +376,47 @@ struct GltfDocument::Impl {
     std::vector<gltf::Animation> animations;
     std::vector<GltfAnimationInfo> animationInfo;
     std::map<std::pair<std::uint32_t, std::uint32_t>, gltf::PrimitiveData> primitives;  // by (mesh, primitive)
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> corners;  // their triangleCorners
+    unsigned threads = 0;               // that flatten the triangles; 0: every core
+    std::unique_ptr<ThreadPool> pool;   // made on first use, kept from frame to frame
 
     std::uint64_t memoryLimit() const { return limits.maxBytes ? limits.maxBytes : physicalMemoryBytes(); }
+    ThreadPool& threadPool() {
+        if (!pool) pool = std::make_unique<ThreadPool>(threads ? threads : std::max(1u, std::thread::hardware_concurrency()));
+        return *pool;
+    }
 };
 
 namespace {
 
 class GltfFlattener {
 public:
-    GltfFlattener(GltfDocument::Impl& document, const GltfSelection& selection)
+    GltfFlattener(GltfDocument::Impl& document, const GltfSelection& selection, const std::function<void(double)>& onProgress)
         : document_(document), reader_(*document.reader), model_(document.model), limits_(document.limits),
-          selection_(selection), check_(*document.reader) {
+          selection_(selection), onProgress_(onProgress), check_(*document.reader) {
         scene_.name = document.name;
     }
 
     Scene run() {
+        auto since = Clock::now();
         const int sceneIndex = check_.chooseScene(selection_.scene);
         const int animation = gltf::chooseAnimation(document_.animations, selection_.animation, reader_);
         pose_ = gltf::poseAt(document_.animations, animation, selection_.time, model_.nodes.size());
         const std::vector<NodeInstance> instances = walkHierarchy(check_.sceneRoots(document_.parent, sceneIndex));
-        planTriangles(instances);
+        plannedTriangles_ = planTriangles(instances);
+        phases_.pose = lap(since);
+        // Filled to at most the planned count (less the degenerate triangles): never regrown.
+        reserveMapped(scene_.triangles, plannedTriangles_);
+        reserveMapped(scene_.sources, plannedTriangles_);
+        reserveMapped(scene_.materialOfTriangle, plannedTriangles_);
+        phases_.mapMemory = lap(since);
         scene_.materials = document_.shared.materials;
         scene_.textures = document_.shared.textures;
         scene_.warnings = document_.shared.warnings;
         defaultMaterial_ = std::uint32_t(scene_.materials.size() - 1);
         for (const NodeInstance& i : instances) flattenNode(i);
+        scene_.setupPhasesMs = {{"pose", phases_.pose}, {"map_memory", phases_.mapMemory}, {"primitives", phases_.primitives},
+                                {"vertices", phases_.vertices}, {"triangles", phases_.triangles}};
         takeInventory(sceneIndex);
         if (unweightedVertices_)
             scene_.warnings.push_back(reader_.name() + ": " + str(unweightedVertices_) +
@@ -407,6 +426,13 @@ public:
 
 private:
     std::uint64_t memoryLimit() const { return document_.memoryLimit(); }
+
+    // The milliseconds since `since`, which moves to now.
+    static double lap(Clock::time_point& since) {
+        const double ms = msSince(since);
+        since = Clock::now();
+        return ms;
+    }
 
     // Every node of the scene with its world transform, depth first without recursion.
     std::vector<NodeInstance> walkHierarchy(const std::vector<int>& roots) const {
@@ -452,8 +478,8 @@ private:
     }
 
     // The triangle total over every instance, checked against the 32-bit primitive ids and this
-    // machine's memory before anything is flattened.
-    void planTriangles(const std::vector<NodeInstance>& instances) const {
+    // machine's memory before anything is flattened. Returns it.
+    std::uint64_t planTriangles(const std::vector<NodeInstance>& instances) const {
         std::vector<std::int64_t> meshTriangles(model_.meshes.size(), -1);
         std::uint64_t total = 0, meshInstances = 0;
         for (const NodeInstance& i : instances) {
@@ -473,6 +499,7 @@ private:
             check_.fail("the scene has " + counted + ", which need " + str(bytes) + " bytes, more than the " + str(limit) +
                         " bytes of " + (limits_.maxBytes ? "the limit" : "this machine's memory") + " (over by " +
                         str(bytes - limit) + ")");
+        return total;
     }
 
     std::uint64_t meshTriangleCount(std::size_t m) const {
@@ -602,9 +629,11 @@ private:
             check_.fail(where + ": POSITION is quantized (integer components), which needs the extension KHR_mesh_quantization the file does not declare");
     }
 
-    // Grows an attribute array to one entry per triangle so far, with its default.
+    // Grows an attribute array to one entry per triangle so far, with its default (room for
+    // the planned triangles made once).
     template <typename T>
-    static void fillTo(std::vector<std::array<T, 3>>& v, std::size_t n, const T& value) {
+    void fillTo(std::vector<std::array<T, 3>>& v, std::size_t n, const T& value) const {
+        if (v.empty()) reserveMapped(v, plannedTriangles_);
         if (v.size() < n) v.resize(n, {value, value, value});
     }
 
@@ -743,7 +772,8 @@ private:
         bool colorHasAlpha = false;
     };
 
-    // A primitive's vertices and normals in the mesh's space, morph targets' offsets weighted in.
+    // A primitive's vertices and normals in the mesh's space, morph targets' offsets weighted in
+    // (positions: empty where no offset moves them, the primitive's own then read in place).
     struct MorphedVertices {
         std::vector<glm::dvec3> positions;
         std::vector<glm::dvec3> normals;
@@ -766,16 +796,22 @@ private:
                       const tinygltf::Primitive& prim, const glm::dmat4& world) {
         const std::string where = "mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(primIndex);
         int mode = modeOf(prim);
+        auto since = Clock::now();
         const std::uint32_t material = primitiveMaterial(prim, where);
         checkPositionType(prim, where);
         const gltf::PrimitiveData& data = primitiveData(meshIndex, primIndex, prim, material, where);
         if (data.trianglesListed) mode = TINYGLTF_MODE_TRIANGLES;
         if (!data.attributes.count(kPosition)) check_.fail(where + ": no POSITION data");
-        const std::vector<std::uint32_t> corners = triangleCorners(mode, data, where);
+        const std::vector<std::uint32_t>& corners = primitiveCorners(meshIndex, primIndex, mode, data, where);
         const VertexShading shading = vertexShading(prim, data, material, where);
+        phases_.primitives += lap(since);
         const PlacedVertices placed = placeVertices(node, meshIndex, prim, data, shading.normals, world, where);
+        phases_.vertices += lap(since);
         addTriangles(TriangleSource{node, meshIndex, primIndex, 0}, material, corners, placed, shading, where);
         touchTriangles(scene_);
+        phases_.triangles += lap(since);
+        assembledTriangles_ += corners.size() / 3;
+        if (onProgress_ && plannedTriangles_) onProgress_(double(assembledTriangles_) / double(plannedTriangles_));
     }
 
     // The primitive's material, the default one when it names none.
@@ -787,6 +823,18 @@ private:
             material = std::uint32_t(prim.material);
         }
         return material;
+    }
+
+    // The primitive's triangleCorners, made once per document (an indexed list's are its indices).
+    const std::vector<std::uint32_t>& primitiveCorners(std::uint32_t meshIndex, std::uint32_t primIndex, int mode,
+                                                       const gltf::PrimitiveData& data, const std::string& where) {
+        if (mode == TINYGLTF_MODE_TRIANGLES && data.indexed) {  // the indices themselves
+            if (data.indices.size() % 3 != 0) check_.fail(where + ": " + str(data.indices.size()) + " indices is not a multiple of 3");
+            return data.indices;
+        }
+        const auto key = std::make_pair(meshIndex, primIndex);
+        if (auto cached = document_.corners.find(key); cached != document_.corners.end()) return cached->second;
+        return document_.corners.emplace(key, triangleCorners(mode, data, where)).first->second;
     }
 
     // Three vertex indices per triangle, as TRIANGLES: an unindexed primitive's vertices in
@@ -840,18 +888,22 @@ private:
                                     const gltf::PrimitiveData& data, const std::vector<glm::dvec4>* normals,
                                     const std::string& where) const {
         const std::vector<glm::dvec4>& positions = data.attributes.at(kPosition);
-        MorphedVertices morphed{std::vector<glm::dvec3>(positions.size()), std::vector<glm::dvec3>(normals ? positions.size() : 0)};
-        std::vector<glm::dvec3>& local = morphed.positions;
+        MorphedVertices morphed{{}, mappedArray<glm::dvec3>(normals ? positions.size() : 0)};
+        std::vector<glm::dvec3>& local = morphed.positions;  // made by the first position offset
         std::vector<glm::dvec3>& localNormals = morphed.normals;
-        for (std::size_t i = 0; i < positions.size(); ++i) local[i] = glm::dvec3(positions[i]);
         for (std::size_t i = 0; i < localNormals.size(); ++i) localNormals[i] = glm::dvec3((*normals)[i]);
         if (!prim.targets.empty()) {
             const std::vector<double> weights =
                 morphWeights(node, model_.meshes[meshIndex], prim.targets.size(), "node " + std::to_string(node) + " " + where);
             for (std::size_t t = 0; t < weights.size(); ++t) {
                 if (weights[t] == 0.0) continue;
-                if (const auto* d = vertexAttribute(data, "TARGET" + std::to_string(t) + ":" + kPosition, where))
+                if (const auto* d = vertexAttribute(data, "TARGET" + std::to_string(t) + ":" + kPosition, where)) {
+                    if (local.empty()) {
+                        local = mappedArray<glm::dvec3>(positions.size());
+                        for (std::size_t i = 0; i < positions.size(); ++i) local[i] = glm::dvec3(positions[i]);
+                    }
                     for (std::size_t i = 0; i < local.size(); ++i) local[i] += weights[t] * glm::dvec3((*d)[i]);
+                }
                 if (const auto* d = vertexAttribute(data, "TARGET" + std::to_string(t) + ":" + kNormal, where); d && normals)
                     for (std::size_t i = 0; i < localNormals.size(); ++i) localNormals[i] += weights[t] * glm::dvec3((*d)[i]);
             }
@@ -864,95 +916,160 @@ private:
                                  const gltf::PrimitiveData& data, const std::vector<glm::dvec4>* normals, const glm::dmat4& world,
                                  const std::string& where) {
         MorphedVertices morphed = morphedVertices(node, meshIndex, prim, data, normals, where);
-        const std::vector<glm::dvec3>& local = morphed.positions;
+        const std::vector<glm::dvec4>& own = data.attributes.at(kPosition);
+        const std::size_t vertices = own.size();
+        auto localAt = [&](std::size_t i) { return morphed.positions.empty() ? glm::dvec3(own[i]) : morphed.positions[i]; };
         PlacedVertices placed;
         const int skin = model_.nodes[node].skin;
         placed.skinned = skin >= 0;
-        if (skin >= 0) placed.skinning = vertexSkinning(data, jointMatrices(skin, where), local.size(), where);
+        if (skin >= 0) placed.skinning = vertexSkinning(data, jointMatrices(skin, where), vertices, where);
         auto transformOf = [&](std::uint32_t vertex) -> const glm::dmat4& { return skin >= 0 ? placed.skinning[vertex] : world; };
 
-        placed.worldPositions.resize(local.size());
-        for (std::size_t i = 0; i < local.size(); ++i) {
-            const glm::dvec3& p = local[i];
-            if (!finite3(p))
+        placed.worldPositions = mappedArray<glm::vec3>(vertices);
+        // On the document's threads, each chunk up to its first non-finite vertex; the first of all is reported.
+        std::vector<std::size_t> nonFinite((vertices + kChunk - 1) / kChunk, kNone);
+        document_.threadPool().parallelFor(nonFinite.size(), [&](std::size_t c, unsigned) {
+            for (std::size_t i = c * kChunk; i < std::min(vertices, (c + 1) * kChunk); ++i) {
+                const glm::dvec3 local = localAt(i);
+                if (!finite3(local)) {
+                    nonFinite[c] = i;
+                    return;
+                }
+                placed.worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(local, 1.0));
+            }
+        });
+        for (const std::size_t i : nonFinite)
+            if (i != kNone) {
+                const glm::dvec3 p = localAt(i);
                 check_.fail(where + ": vertex " + std::to_string(i) + " has a non-finite position (" + std::to_string(p.x) +
                             ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
-            placed.worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(p, 1.0));
-        }
+            }
         placed.localNormals = std::move(morphed.normals);
         placed.nodeNormalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
         placed.nodeMirrored = glm::determinant(glm::dmat3(world)) < 0.0;
         return placed;
     }
 
-    // The primitive's triangles into the scene, front faces counter-clockwise, each with its
-    // provenance (`primitive`, numbered within it), material and corners' attributes.
-    void addTriangles(const TriangleSource& primitive, std::uint32_t material, const std::vector<std::uint32_t>& corners,
-                      const PlacedVertices& placed, const VertexShading& shading, const std::string& where) {
-        const std::size_t vertices = placed.worldPositions.size();
-        const std::uint32_t cullBackFace = scene_.materials[material].doubleSided ? 0u : 1u;
-        for (std::size_t t = 0; t * 3 < corners.size(); ++t) {
-            for (int k = 0; k < 3; ++k)
-                if (corners[t * 3 + std::size_t(k)] >= vertices)
-                    check_.fail(where + ": index " + std::to_string(corners[t * 3 + std::size_t(k)]) + " (triangle " +
-                                std::to_string(t) + ") is out of range for " + str(vertices) + " vertices");
-            // glTF: a transform that mirrors (negative determinant) turns the triangles' winding
-            // clockwise; swapping two corners keeps counter-clockwise the front. A skinned
-            // triangle mirrors with its first corner's skinning.
-            const bool mirrored =
-                placed.skinned ? glm::determinant(glm::dmat3(placed.skinning[corners[t * 3]])) < 0.0 : placed.nodeMirrored;
-            const int order[3] = {0, mirrored ? 2 : 1, mirrored ? 1 : 2};
-            Triangle tri{};
-            tri.cullBackFace = cullBackFace;
-            glm::vec3* v[3] = {&tri.v0, &tri.v1, &tri.v2};
-            std::uint32_t index[3];
-            for (int k = 0; k < 3; ++k) {
-                index[k] = corners[t * 3 + std::size_t(order[k])];
-                *v[k] = placed.worldPositions[index[k]];
-            }
-            // Never hit, so never traced. (A non-finite vertex gives a non-zero cross product:
-            // such a triangle stays, for validateScene to refuse.)
-            if (shared::triangleHasNoArea(tri.v0, tri.v1, tri.v2)) {
-                ++scene_.degenerateTrianglesDropped;
-                continue;
-            }
-            const std::size_t at = scene_.triangles.size();
-            scene_.triangles.push_back(tri);
-            scene_.sources.push_back(TriangleSource{primitive.node, primitive.mesh, primitive.primitive, std::uint32_t(t)});
-            scene_.materialOfTriangle.push_back(material);
-            addCornerAttributes(at, index, placed, shading);
+    // A triangle of the primitive as placed, front face counter-clockwise: glTF's mirroring
+    // transform (negative determinant) turns the winding clockwise, and swapping two corners
+    // keeps counter-clockwise the front. A skinned triangle mirrors with its first corner's
+    // skinning. `index`: the vertices of its corners, in its corner order.
+    static Triangle placedTriangle(std::size_t t, const std::vector<std::uint32_t>& corners, const PlacedVertices& placed,
+                                   std::uint32_t cullBackFace, std::uint32_t (&index)[3]) {
+        const bool mirrored =
+            placed.skinned ? glm::determinant(glm::dmat3(placed.skinning[corners[t * 3]])) < 0.0 : placed.nodeMirrored;
+        const int order[3] = {0, mirrored ? 2 : 1, mirrored ? 1 : 2};
+        Triangle tri{};
+        tri.cullBackFace = cullBackFace;
+        glm::vec3* v[3] = {&tri.v0, &tri.v1, &tri.v2};
+        for (int k = 0; k < 3; ++k) {
+            index[k] = corners[t * 3 + std::size_t(order[k])];
+            *v[k] = placed.worldPositions[index[k]];
         }
+        return tri;
     }
 
-    // Triangle `at`'s corners' normals, colours and texture coordinates (its vertices `index`);
-    // once any triangle has one of these, every triangle has it, with its default where absent.
-    void addCornerAttributes(std::size_t at, const std::uint32_t (&index)[3], const PlacedVertices& placed,
-                             const VertexShading& shading) {
+    // Never hit, so never traced. (A non-finite vertex gives a non-zero cross product: such a
+    // triangle stays, for validateScene to refuse.)
+    static bool dropped(const Triangle& tri) { return shared::triangleHasNoArea(tri.v0, tri.v1, tri.v2); }
+
+    // A primitive's vertices and triangles are placed on the document's threads in chunks of
+    // this many: each chunk's kept triangles land where the sequential order puts them.
+    static constexpr std::size_t kChunk = 16384;
+    static constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+
+    // A chunk's triangles kept (with area), or the first of its corners whose index is out of range.
+    struct ChunkCount {
+        std::size_t kept = 0;
+        std::size_t badCorner = kNone;
+    };
+
+    // The first pass over a primitive's triangles: each chunk's corners checked and its
+    // triangles with area counted.
+    std::vector<ChunkCount> countTriangles(const std::vector<std::uint32_t>& corners, const PlacedVertices& placed) {
+        const std::size_t triangles = corners.size() / 3, vertices = placed.worldPositions.size();
+        std::vector<ChunkCount> chunks((triangles + kChunk - 1) / kChunk);
+        document_.threadPool().parallelFor(chunks.size(), [&](std::size_t c, unsigned) {
+            std::uint32_t index[3];
+            for (std::size_t t = c * kChunk; t < std::min(triangles, (c + 1) * kChunk); ++t) {
+                for (std::size_t k = 0; k < 3; ++k)
+                    if (corners[t * 3 + k] >= vertices) {
+                        chunks[c].badCorner = t * 3 + k;
+                        return;
+                    }
+                if (!dropped(placedTriangle(t, corners, placed, 0, index))) ++chunks[c].kept;
+            }
+        });
+        return chunks;
+    }
+
+    // The primitive's triangles into the scene, front faces counter-clockwise, each with its
+    // provenance (`primitive`, numbered within it), material and corners' attributes: counted,
+    // then written in place, each chunk from its first kept triangle's place.
+    void addTriangles(const TriangleSource& primitive, std::uint32_t material, const std::vector<std::uint32_t>& corners,
+                      const PlacedVertices& placed, const VertexShading& shading, const std::string& where) {
+        const std::vector<ChunkCount> chunks = countTriangles(corners, placed);
+        std::vector<std::size_t> first(chunks.size());
+        std::size_t kept = 0;
+        for (std::size_t c = 0; c < chunks.size(); ++c) {
+            if (const std::size_t bad = chunks[c].badCorner; bad != kNone)
+                check_.fail(where + ": index " + std::to_string(corners[bad]) + " (triangle " + std::to_string(bad / 3) +
+                            ") is out of range for " + str(placed.worldPositions.size()) + " vertices");
+            first[c] = kept;
+            kept += chunks[c].kept;
+        }
+        scene_.degenerateTrianglesDropped += corners.size() / 3 - kept;
+        if (kept == 0) return;
+        const std::size_t base = scene_.triangles.size(), triangles = corners.size() / 3;
+        scene_.triangles.resize(base + kept);
+        scene_.sources.resize(base + kept);
+        scene_.materialOfTriangle.resize(base + kept);
+        growCornerAttributes(base + kept, shading);
+        const std::uint32_t cullBackFace = scene_.materials[material].doubleSided ? 0u : 1u;
+        document_.threadPool().parallelFor(chunks.size(), [&](std::size_t c, unsigned) {
+            std::uint32_t index[3];
+            std::size_t at = base + first[c];
+            for (std::size_t t = c * kChunk; t < std::min(triangles, (c + 1) * kChunk); ++t) {
+                const Triangle tri = placedTriangle(t, corners, placed, cullBackFace, index);
+                if (dropped(tri)) continue;
+                scene_.triangles[at] = tri;
+                scene_.sources[at] = TriangleSource{primitive.node, primitive.mesh, primitive.primitive, std::uint32_t(t)};
+                scene_.materialOfTriangle[at] = material;
+                writeCornerAttributes(at, index, placed, shading);
+                ++at;
+            }
+        });
+    }
+
+    // Once any triangle has normals, colours or texture coordinates, every triangle has them,
+    // with their defaults where its primitive lacks them: the arrays grown to `n` triangles.
+    void growCornerAttributes(std::size_t n, const VertexShading& shading) {
         CornerAttributes& out = scene_.corners;
-        if (shading.normals || !out.normals.empty()) {
-            fillTo(out.normals, at + 1, glm::vec3(0.0f));
-            for (int k = 0; shading.normals && k < 3; ++k) {
-                const glm::dmat3 normalMatrix =
-                    placed.skinned ? glm::transpose(glm::inverse(glm::dmat3(placed.skinning[index[k]]))) : placed.nodeNormalMatrix;
-                const glm::dvec3 n = normalMatrix * placed.localNormals[index[k]];
-                const double length = glm::length(n);
-                out.normals[at][std::size_t(k)] = length > 0.0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f);
-            }
+        if (shading.normals || !out.normals.empty()) fillTo(out.normals, n, glm::vec3(0.0f));
+        if (shading.colors || !out.colors.empty()) fillTo(out.colors, n, glm::vec4(1.0f));
+        if (shading.texCoords || !out.texCoords.empty()) fillTo(out.texCoords, n, glm::vec2(0.0f));
+    }
+
+    // Triangle `at`'s corners' normals, colours and texture coordinates (its vertices `index`),
+    // those its primitive has (growCornerAttributes made room, with the defaults).
+    void writeCornerAttributes(std::size_t at, const std::uint32_t (&index)[3], const PlacedVertices& placed,
+                               const VertexShading& shading) {
+        CornerAttributes& out = scene_.corners;
+        for (int k = 0; shading.normals && k < 3; ++k) {
+            const glm::dmat3 normalMatrix =
+                placed.skinned ? glm::transpose(glm::inverse(glm::dmat3(placed.skinning[index[k]]))) : placed.nodeNormalMatrix;
+            const glm::dvec3 n = normalMatrix * placed.localNormals[index[k]];
+            const double length = glm::length(n);
+            out.normals[at][std::size_t(k)] = length > 0.0 && std::isfinite(length) ? glm::vec3(n / length) : glm::vec3(0.0f);
         }
-        if (shading.colors || !out.colors.empty()) {
-            fillTo(out.colors, at + 1, glm::vec4(1.0f));
-            for (int k = 0; shading.colors && k < 3; ++k) {
-                glm::vec4 c((*shading.colors)[index[k]]);
-                if (!shading.colorHasAlpha) c.a = 1.0f;
-                out.colors[at][std::size_t(k)] = glm::clamp(c, 0.0f, 1.0f);
-            }
+        for (int k = 0; shading.colors && k < 3; ++k) {
+            glm::vec4 c((*shading.colors)[index[k]]);
+            if (!shading.colorHasAlpha) c.a = 1.0f;
+            out.colors[at][std::size_t(k)] = glm::clamp(c, 0.0f, 1.0f);
         }
-        if (shading.texCoords || !out.texCoords.empty()) {
-            fillTo(out.texCoords, at + 1, glm::vec2(0.0f));
-            for (int k = 0; shading.texCoords && k < 3; ++k) {
-                const glm::vec2 uv((*shading.texCoords)[index[k]]);
-                out.texCoords[at][std::size_t(k)] = std::isfinite(uv.x) && std::isfinite(uv.y) ? uv : glm::vec2(0.0f);
-            }
+        for (int k = 0; shading.texCoords && k < 3; ++k) {
+            const glm::vec2 uv((*shading.texCoords)[index[k]]);
+            out.texCoords[at][std::size_t(k)] = std::isfinite(uv.x) && std::isfinite(uv.y) ? uv : glm::vec2(0.0f);
         }
     }
 
@@ -1005,9 +1122,18 @@ private:
     const tinygltf::Model& model_;
     GltfLimits limits_;
     GltfSelection selection_;
+    const std::function<void(double)>& onProgress_;
     GltfChecker check_;
     Scene scene_;
     std::uint32_t defaultMaterial_ = 0;
+    std::uint64_t plannedTriangles_ = 0;                // before the degenerate ones are dropped
+    std::uint64_t assembledTriangles_ = 0;              // of the planned, so far
+    // The flattening's phases (ms; the primitives' summed), for Scene::setupPhasesMs: the pose and
+    // the plan; the arrays' pages mapped; the primitives' data and corners (read on first use);
+    // their vertices placed; their triangles assembled (degenerate ones dropped).
+    struct PhaseTimes {
+        double pose = 0.0, mapMemory = 0.0, primitives = 0.0, vertices = 0.0, triangles = 0.0;
+    } phases_;
     std::vector<gltf::NodePose> pose_;                  // every node's animated properties at this instant
     std::vector<std::optional<glm::dmat4>> worlds_;     // nodeWorld's, computed on demand
     std::uint64_t unweightedVertices_ = 0;              // skinned vertices without a weight
@@ -1066,11 +1192,19 @@ GltfDocument GltfDocument::fromMemory(std::span<const unsigned char> bytes, cons
     return GltfDocument(openDocument(bytes, name, "", false, limits));
 }
 
-Scene GltfDocument::scene(const GltfSelection& selection) const {
+Scene GltfDocument::scene(const GltfSelection& selection, const std::function<void(double)>& onProgress) const {
     if (!std::isfinite(selection.time)) throw InputError(impl_->name + ": the time " + std::to_string(selection.time) + " is not finite");
-    Scene scene = GltfFlattener(*impl_, selection).run();
-    validateScene(scene);
+    Scene scene = GltfFlattener(*impl_, selection, onProgress).run();
+    const auto start = Clock::now();
+    validateScene(scene, &impl_->threadPool());
+    scene.setupPhasesMs.emplace_back("validate", msSince(start));
     return scene;
+}
+
+void GltfDocument::setThreads(unsigned threads) {
+    if (threads == impl_->threads) return;
+    impl_->threads = threads;
+    impl_->pool.reset();
 }
 
 const std::vector<GltfAnimationInfo>& GltfDocument::animations() const { return impl_->animationInfo; }

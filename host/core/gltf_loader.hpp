@@ -2,6 +2,7 @@
 // The load stage: a glTF 2.0 file's scene flattened into world-space triangles, at an instant of
 // its animations.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -47,7 +48,13 @@ public:
 
     // The flattened scene (as loadGltf describes) at the selection's instant. Throws InputError
     // for a scene or animation that does not exist, or an animation that cannot be sampled.
-    Scene scene(const GltfSelection& selection = {}) const;
+    // onProgress, when given, is called on the calling thread after each primitive instance
+    // with the fraction of the planned triangles assembled (a large scene takes seconds).
+    Scene scene(const GltfSelection& selection = {}, const std::function<void(double)>& onProgress = {}) const;
+
+    // The threads that place the vertices and assemble the triangles (0: every core, the
+    // default). The scene is the same for any number, bit for bit.
+    void setThreads(unsigned threads);
 
     const std::vector<GltfAnimationInfo>& animations() const;
 

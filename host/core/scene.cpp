@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/mapped_memory.hpp"
 
 namespace dacrt {
 
@@ -63,6 +64,7 @@ std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles) {
 void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool& pool, std::vector<Bounds>& bounds,
                               Box& box) {
     constexpr std::size_t kChunk = 16384;
+    reserveMapped(bounds, triangles.size());
     bounds.resize(triangles.size());
     const std::size_t chunks = (triangles.size() + kChunk - 1) / kChunk;
     std::vector<Box> chunkBox(chunks);
@@ -85,7 +87,32 @@ void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool
     }
 }
 
-void validateScene(const Scene& scene) {
+namespace {
+
+bool placeable(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) &&
+           glm::all(glm::lessThanEqual(glm::abs(v), glm::vec3(kMaxCoordinate)));
+}
+
+// Refuses triangle i, naming its first vertex that is not finite or out of range, and where it came from.
+[[noreturn]] void refuseTriangle(const Scene& scene, std::size_t i) {
+    const Triangle& t = scene.triangles[i];
+    const glm::vec3 v = !placeable(t.v0) ? t.v0 : !placeable(t.v1) ? t.v1 : t.v2;
+    const bool finite = std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+    std::ostringstream msg;
+    msg << scene.name << ": " << (finite ? "out-of-range" : "non-finite") << " vertex position (" << v.x << ", " << v.y
+        << ", " << v.z << ") in triangle " << i;
+    if (i < scene.sources.size()) {
+        const TriangleSource& s = scene.sources[i];
+        msg << " (node " << s.node << ", mesh " << s.mesh << ", primitive " << s.primitive << ", triangle " << s.triangle << ")";
+    }
+    if (finite) msg << "; coordinates must lie within +-" << kMaxCoordinate << " so that every intersection intermediate stays finite";
+    throw InputError(msg.str());
+}
+
+}  // namespace
+
+void validateScene(const Scene& scene, ThreadPool* pool) {
     if (scene.triangles.empty())
         throw InputError(scene.name + ": the scene has no triangles" +
                          (scene.degenerateTrianglesDropped
@@ -94,24 +121,24 @@ void validateScene(const Scene& scene) {
                               : std::string()));
     if (scene.triangles.size() >= kMissPrim)
         throw InputError(scene.name + ": too many triangles for 32-bit primitive ids");
-    for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
-        const Triangle& t = scene.triangles[i];
-        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) {
-            const bool finite = std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-            if (finite && glm::all(glm::lessThanEqual(glm::abs(v), glm::vec3(kMaxCoordinate)))) continue;
-            std::ostringstream msg;
-            msg << scene.name << ": " << (finite ? "out-of-range" : "non-finite") << " vertex position ("
-                << v.x << ", " << v.y << ", " << v.z << ") in triangle " << i;
-            if (i < scene.sources.size()) {
-                const TriangleSource& s = scene.sources[i];
-                msg << " (node " << s.node << ", mesh " << s.mesh << ", primitive " << s.primitive
-                    << ", triangle " << s.triangle << ")";
+    // In chunks, each up to its first offending triangle; the first of all is refused.
+    constexpr std::size_t kChunk = 65536;
+    const std::size_t n = scene.triangles.size();
+    std::vector<std::size_t> firstOffending((n + kChunk - 1) / kChunk, n);
+    const auto checkChunk = [&](std::size_t c, unsigned) {
+        for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
+            const Triangle& t = scene.triangles[i];
+            if (!placeable(t.v0) || !placeable(t.v1) || !placeable(t.v2)) {
+                firstOffending[c] = i;
+                return;
             }
-            if (finite) msg << "; coordinates must lie within +-" << kMaxCoordinate
-                            << " so that every intersection intermediate stays finite";
-            throw InputError(msg.str());
         }
-    }
+    };
+    if (pool) pool->parallelFor(firstOffending.size(), checkChunk);
+    else
+        for (std::size_t c = 0; c < firstOffending.size(); ++c) checkChunk(c, 0);
+    for (const std::size_t i : firstOffending)
+        if (i < n) refuseTriangle(scene, i);
 }
 
 }  // namespace dacrt

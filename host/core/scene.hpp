@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <dacrt/scene_options.hpp>
@@ -140,6 +141,9 @@ struct Scene {
     GltfInventory inventory;                        // what the file holds (dacrt info)
     std::uint64_t degenerateTrianglesDropped = 0;   // no area (triangleHasNoArea), dropped at load
     std::vector<std::string> warnings;              // what the loader ignored, one line each (render prints them)
+    // What each stage of its set-up took (ms), in order: the flattening's phases and the
+    // checks (GltfDocument::scene), then the caller's (dacrt render: the cull mode).
+    std::vector<std::pair<std::string, double>> setupPhasesMs;
     // Changes whenever `triangles` does (load, applyCullMode): a frame's FrameGeometry
     // trianglesVersion, unique in the process. Code that edits `triangles` itself calls
     // touchTriangles(*this).
@@ -180,7 +184,8 @@ void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool
                               Box& box);
 
 // Checks that the scene can be traced: triangles exist and every coordinate is finite.
-// Throws InputError naming the first offending triangle and its provenance.
-void validateScene(const Scene& scene);
+// Throws InputError naming the first offending triangle and its provenance. On pool's threads
+// where given (the same triangle is named).
+void validateScene(const Scene& scene, ThreadPool* pool = nullptr);
 
 }  // namespace dacrt

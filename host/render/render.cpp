@@ -204,6 +204,7 @@ LoadedDocument loadDocument(const RenderOptions& o) {
     const auto start = Clock::now();
     LoadedDocument d{GltfDocument::open(o.scenePath), 0.0};
     d.document.checkAnimationChoice(o.animationChoice);
+    d.document.setThreads(o.tracer.trace.threads);  // --threads: the flattening's too
     d.loadMs = msSince(start);
     if (o.frames && d.document.animations().empty())
         std::cerr << "dacrt: warning: " << o.scenePath << " has no animations: every frame of the range is the same\n";
@@ -229,12 +230,15 @@ struct PreparedScene {
 // The scene's camera and lights are those of that instant, so an animated camera node moves.
 Scene evaluateAnimation(const RenderOptions& o, const GltfDocument& document, const FrameInstant& instant,
                         bool firstFrame) {
-    Scene scene =
-        document.scene(GltfSelection{.scene = o.sceneChoice, .animation = o.animationChoice, .time = instant.time});
+    Progress progress("dacrt render", 1);  // on a terminal, a bar while a large scene is flattened
+    Scene scene = document.scene(GltfSelection{.scene = o.sceneChoice, .animation = o.animationChoice, .time = instant.time},
+                                 [&progress](double done) { progress.fraction(done, "flattening the scene"); });
     selectCamera(scene, o.cameraChoice);
     if (firstFrame)  // every instant has the file's warnings: printed once
         for (const std::string& w : scene.warnings) std::cerr << "dacrt: warning: " << w << "\n";
+    const auto cullStart = Clock::now();
     applyCullMode(scene, o.cull);
+    scene.setupPhasesMs.emplace_back("cull", msSince(cullStart));
     return scene;
 }
 

@@ -165,6 +165,9 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     const nlohmann::ordered_json phases = phasesJson(r.timings);
     if (!phases.empty()) t["trace_phases"] = phases;
     if (!r.timings.step1RegionMs.empty()) t["step1_region"] = r.timings.step1RegionMs;
+    nlohmann::ordered_json setup;  // evaluate_animation's phases
+    for (const auto& [name, ms] : frame.scene.setupPhasesMs) setup[name] = ms;
+    if (!setup.empty()) t["setup_phases"] = setup;
     j["timings_ms"] = t;
     j["memory_plan_bytes"] = memoryJson(r.plan);
     // What the plan is measured against: the whole process, so its peak holds the parsed file,

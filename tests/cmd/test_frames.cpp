@@ -267,6 +267,8 @@ TEST(Frames, ARangeWritesExactlyItsFramesFilesWithStagesInTheStats) {
         for (const char* stage :
              {"load", "evaluate_animation", "prepare", "trace", "secondary_passes", "write", "total"})
             EXPECT_TRUE(j["timings_ms"].contains(stage)) << name << " " << stage;
+        for (const char* phase : {"pose", "map_memory", "primitives", "vertices", "triangles", "validate", "cull"})
+            EXPECT_GE(j["timings_ms"]["setup_phases"].value(phase, -1.0), 0.0) << name << " " << phase;
         EXPECT_NE(r.output.find("frame " + std::to_string(frame) + " ("), std::string::npos) << r.output;
     }
     EXPECT_NE(r.output.find("frames: 3 rendered, 0 skipped"), std::string::npos) << r.output;

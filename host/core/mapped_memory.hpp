@@ -1,0 +1,34 @@
+#pragma once
+// Large arrays' pages mapped ahead of their first write. On the project's VM a fresh page
+// costs a fault taken through the hypervisor: 512 MiB written into fresh memory takes about
+// 1.5 s, the same mapped at once as huge pages about 45 ms (docs/benchmarks.md). A frame's
+// set-up writes hundreds of MiB (the flattened triangles, their provenance, their bounds).
+#include <cstddef>
+#include <vector>
+
+namespace dacrt {
+
+// Maps the pages of [data, data + bytes) for writing, as transparent huge pages where the
+// system allows (madvise MADV_HUGEPAGE, then MADV_POPULATE_WRITE). Leaves the memory's
+// contents as they are. Does nothing for ranges under a huge page, or where the system
+// refuses (the pages are then mapped by the first writes, as without it).
+void mapForWriting(void* data, std::size_t bytes);
+
+// Makes `v` hold room for `n` elements (its elements kept) with that room's pages mapped:
+// for an array about to be filled to `n`.
+template <typename T>
+void reserveMapped(std::vector<T>& v, std::size_t n) {
+    if (v.capacity() < n) v.reserve(n);
+    mapForWriting(v.data(), n * sizeof(T));
+}
+
+// A new array of `n` copies of `value`, its pages mapped at once (reserveMapped).
+template <typename T>
+std::vector<T> mappedArray(std::size_t n, const T& value = T()) {
+    std::vector<T> v;
+    reserveMapped(v, n);
+    v.resize(n, value);
+    return v;
+}
+
+}  // namespace dacrt
