@@ -78,6 +78,31 @@ std::vector<std::string> memoryHeaps(VkPhysicalDevice d) {
     return heaps;
 }
 
+// The largest device-local heap, else the largest heap: what the memory plan holds a frame to.
+std::uint64_t deviceLocalBytes(VkPhysicalDevice d) {
+    VkPhysicalDeviceMemoryProperties memory;
+    vkGetPhysicalDeviceMemoryProperties(d, &memory);
+    std::uint64_t local = 0, any = 0;
+    for (std::uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
+        any = std::max<std::uint64_t>(any, memory.memoryHeaps[h].size);
+        if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+            local = std::max<std::uint64_t>(local, memory.memoryHeaps[h].size);
+    }
+    return local ? local : any;
+}
+
+// Whether the device has the bufferDeviceAddress feature (core in Vulkan 1.2).
+bool hasBufferDeviceAddress(VkPhysicalDevice d, std::uint32_t apiVersion) {
+    if (apiVersion < VK_API_VERSION_1_2) return false;
+    VkPhysicalDeviceBufferDeviceAddressFeatures bda{};
+    bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    features.pNext = &bda;
+    vkGetPhysicalDeviceFeatures2(d, &features);
+    return bda.bufferDeviceAddress == VK_TRUE;
+}
+
 std::vector<VkExtensionProperties> deviceExtensions(VkPhysicalDevice d) {
     std::uint32_t extensionCount = 0;
     VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, nullptr));
@@ -158,6 +183,8 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     info.heaps = memoryHeaps(d);
     info.maxStorageBufferRange = l.maxStorageBufferRange;
     info.maxMemoryAllocationSize = maintenance3.maxMemoryAllocationSize;
+    info.deviceLocalBytes = deviceLocalBytes(d);
+    info.bufferDeviceAddress = hasBufferDeviceAddress(d, basic.apiVersion);
     info.maxComputeSharedMemorySize = l.maxComputeSharedMemorySize;
     info.maxComputeWorkGroupInvocations = l.maxComputeWorkGroupInvocations;
     info.maxComputeWorkGroupSizeX = l.maxComputeWorkGroupSize[0];
@@ -199,6 +226,7 @@ std::string DeviceInfo::describe() const {
     for (const std::string& h : heaps) s << " " << h << ";";
     s << "\n   max storage buffer range: " << maxStorageBufferRange << " bytes\n"
       << "   max allocation size: " << maxMemoryAllocationSize << " bytes\n"
+      << "   buffer device addresses: " << (bufferDeviceAddress ? "yes" : "no") << "\n"
       << "   compute shared memory: " << maxComputeSharedMemorySize << " bytes\n"
       << "   workgroup: " << maxComputeWorkGroupInvocations << " invocations, size x " << maxComputeWorkGroupSizeX
       << ", count x " << maxComputeWorkGroupCountX << "\n"
@@ -329,12 +357,17 @@ void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const De
     if (info.rayQuery) {
         rayQuery.rayQuery = VK_TRUE;
         accel.accelerationStructure = VK_TRUE;
-        addresses.bufferDeviceAddress = VK_TRUE;
         rayQuery.pNext = chain;
         accel.pNext = &rayQuery;
-        addresses.pNext = &accel;
-        chain = &addresses;
+        chain = &accel;
         for (const char* e : kRayQueryExtensions) enabled.push_back(e);
+    }
+    // Device addresses where the device has them: the acceleration structures' inputs, and the
+    // gpu kernels' arrays beyond maxStorageBufferRange.
+    if (info.bufferDeviceAddress || info.rayQuery) {
+        addresses.bufferDeviceAddress = VK_TRUE;
+        addresses.pNext = chain;
+        chain = &addresses;
     }
     deviceInfo.pNext = chain;
     deviceInfo.enabledExtensionCount = std::uint32_t(enabled.size());

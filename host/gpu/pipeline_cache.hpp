@@ -19,6 +19,9 @@ struct KernelSpecialization {
     std::uint32_t loopBudget = 0;
     bool sharedStart = false;
     bool anyHit = false;
+    // 0: the kernel that binds every array; else the addressed kernel (DACRT_ADDRESSED) with
+    // chunks of this many bytes.
+    std::uint32_t chunkBytes = 0;
     std::vector<std::uint32_t> values() const;  // in constant_id order
 };
 
@@ -29,8 +32,8 @@ public:
     explicit PipelineCache(Context& context) : context_(context) {}
     ComputePipeline& kernel(const KernelSpecialization& specialization);
     // shaders/secondary.comp: a secondary pass's rays made and binned on the device (the DACRT
-    // binding set; kSecondaryWorkgroup invocations a workgroup).
-    ComputePipeline& secondary();
+    // binding set; kSecondaryWorkgroup invocations a workgroup); addressed as the kernel is.
+    ComputePipeline& secondary(std::uint32_t chunkBytes = 0);
     // shaders/rayquery.comp: rays, hits, the top-level acceleration structure.
     ComputePipeline& rayQuery();
     // Whether the ray-query pipeline has run once (its caller primes it: the shader binds an
@@ -41,7 +44,7 @@ public:
 private:
     Context& context_;
     std::unique_ptr<ComputePipeline> rayQuery_;
-    std::unique_ptr<ComputePipeline> secondary_;
+    std::map<std::uint32_t, std::unique_ptr<ComputePipeline>> secondary_;  // by chunkBytes
     bool rayQueryPrimed_ = false;
     std::map<std::vector<std::uint32_t>, std::unique_ptr<ComputePipeline>> pipelines_;
 };
