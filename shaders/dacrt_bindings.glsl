@@ -19,9 +19,11 @@ layout(constant_id = DACRT_SPEC_ANY_HIT) const bool kAnyHit = false;
 // in chunks of kChunkBytes (the last one shorter), each its own allocation: an element's chunk
 // and place come from its index, with a division by a constant once specialized. The host
 // plans the chunks (host/gpu/binding_set.cpp) and writes their addresses to the chunk table.
+// kChunkBytes 0: every array is one chunk, whose address each invocation reads once.
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_buffer_reference_uvec2 : require
-layout(constant_id = DACRT_SPEC_CHUNK_BYTES) const uint kChunkBytes = DACRT_CHUNK_ALIGNMENT;
+layout(constant_id = DACRT_SPEC_CHUNK_BYTES) const uint kChunkBytes = 0;
+const uint kChunkDivisor = kChunkBytes == 0u ? DACRT_CHUNK_ALIGNMENT : kChunkBytes;
 layout(std430, binding = DACRT_BINDING_ADDRESSES) readonly buffer ChunkTable {
     uint firstChunk[DACRT_ADDRESSED_ARRAYS];
     uvec2 chunkAddresses[];
@@ -31,10 +33,17 @@ layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer Tr
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BoundsChunk { Bounds v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) coherent buffer HitChunk { Hit v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) coherent buffer IdChunk { uint v[]; };
-uvec2 chunkAddress(uint array, uint chunk) { return chunkAddresses[firstChunk[array] + chunk]; }
+uvec2 gArrayBase[DACRT_ADDRESSED_ARRAYS];  // each array's first chunk
+void loadArrayBases() {
+    for (uint a = 0u; a < DACRT_ADDRESSED_ARRAYS; ++a) gArrayBase[a] = chunkAddresses[firstChunk[a]];
+}
+uvec2 chunkAddress(uint array, uint chunk) {
+    return kChunkBytes == 0u ? gArrayBase[array] : chunkAddresses[firstChunk[array] + chunk];
+}
 // Element i of an addressed array (an lvalue); i is read twice, so it must have no side effects.
 #define DACRT_CHUNKED(Chunk, array, elementBytes, i) \
-    Chunk(chunkAddress(array, (i) / (kChunkBytes / elementBytes))).v[(i) % (kChunkBytes / elementBytes)]
+    Chunk(chunkAddress(array, (i) / (kChunkDivisor / elementBytes))) \
+        .v[kChunkBytes == 0u ? (i) : (i) % (kChunkDivisor / elementBytes)]
 #define RAYS(i) DACRT_CHUNKED(RayChunk, DACRT_ARRAY_RAYS, 64u, i)
 #define TRIANGLES(i) DACRT_CHUNKED(TriangleChunk, DACRT_ARRAY_TRIANGLES, 48u, i)
 #define TRIANGLE_BOUNDS(i) DACRT_CHUNKED(BoundsChunk, DACRT_ARRAY_TRIANGLE_BOUNDS, 32u, i)
@@ -69,6 +78,7 @@ layout(std430, binding = DACRT_BINDING_SOURCE_HITS) readonly buffer SourceHitBuf
 #define TRI_IDS(i) triIds[i]
 #define SOURCE_RAYS(i) sourceRays[i]
 #define SOURCE_HITS(i) sourceHits[i]
+void loadArrayBases() {}
 #endif
 layout(std430, binding = DACRT_BINDING_REGIONS) coherent buffer RegionBuffer { Region regions[]; };
 layout(std430, binding = DACRT_BINDING_WORK_ITEMS) readonly buffer WorkItemBuffer { WorkItem workItems[]; };

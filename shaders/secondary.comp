@@ -104,6 +104,7 @@ void writeRayId(uint slot) {
 
 void main() {
     gRayScratchHalf = push.sourceCount * push.raysPerHit;
+    loadArrayBases();
     uint i = push.firstInvocation + gl_GlobalInvocationID.x;
     if (push.step == 0u && i < gRayScratchHalf) makeRay(i);
     if (push.step == 1u && i == 0u) rangesFromCounts();

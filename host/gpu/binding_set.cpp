@@ -42,20 +42,20 @@ BufferLimits bufferLimits(const DeviceInfo& device, const GpuTuning& tuning) {
     const std::uint64_t allocation = std::min<std::uint64_t>(device.maxMemoryAllocationSize ? device.maxMemoryAllocationSize
                                                                                           : device.maxStorageBufferRange,
                                                              0xFFFFFFFFu);
-    limits.bindingBytes = device.maxStorageBufferRange;
+    limits.bindingBytes = limits.deviceBindingBytes = device.maxStorageBufferRange;
     limits.chunkBytes = allocation / DACRT_CHUNK_ALIGNMENT * DACRT_CHUNK_ALIGNMENT;
     limits.memoryBytes = device.deviceLocalBytes;
     limits.bindingLimit = "maxStorageBufferRange";
     limits.chunkLimit = "maxMemoryAllocationSize";
     limits.memoryLimit = "device-local memory";
-    const std::uint64_t cap = tuning.bufferBytes / DACRT_CHUNK_ALIGNMENT * DACRT_CHUNK_ALIGNMENT;
-    if (tuning.bufferBytes && cap < limits.bindingBytes) {
-        limits.bindingBytes = std::max<std::uint64_t>(cap, DACRT_CHUNK_ALIGNMENT);
+    if (tuning.bufferBytes && tuning.bufferBytes < limits.bindingBytes) {
+        limits.bindingBytes = tuning.bufferBytes;
         limits.bindingLimit = "buffer cap (GpuTuning::bufferBytes)";
     }
-    if (tuning.bufferBytes && cap < limits.chunkBytes) {
-        limits.chunkBytes = std::max<std::uint64_t>(cap, DACRT_CHUNK_ALIGNMENT);
-        limits.chunkLimit = "buffer cap (GpuTuning::bufferBytes)";
+    const std::uint64_t chunkCap = std::max<std::uint64_t>(tuning.chunkBytes / DACRT_CHUNK_ALIGNMENT, 1) * DACRT_CHUNK_ALIGNMENT;
+    if (tuning.chunkBytes && chunkCap < limits.chunkBytes) {
+        limits.chunkBytes = chunkCap;
+        limits.chunkLimit = "chunk cap (GpuTuning::chunkBytes)";
     }
     if (tuning.memoryBytes && (!limits.memoryBytes || tuning.memoryBytes < limits.memoryBytes)) {
         limits.memoryBytes = tuning.memoryBytes;
@@ -99,11 +99,11 @@ bool addressLargeArrays(DacrtBufferPlan& plan, const BufferLimits& limits) {
     bool beyondBinding = false;
     for (std::uint32_t k = 0; k < plan.size(); ++k) {
         const PlannedBuffer& b = plan[k];
-        if (b.bytes <= limits.bindingBytes) continue;
         const std::string what = std::string("the device buffer of ") + b.name;
-        if (!isAddressed(k))
-            throw InputError(overBy(what, b.bytes, limits.bindingLimit, limits.bindingBytes) +
+        if (!isAddressed(k) && b.bytes > limits.deviceBindingBytes)
+            throw InputError(overBy(what, b.bytes, "maxStorageBufferRange", limits.deviceBindingBytes) +
                              ", and the kernel reaches it through one binding; render fewer pixels or use fewer regions");
+        if (!isAddressed(k) || b.bytes <= limits.bindingBytes) continue;
         if (!limits.addresses)
             throw InputError(overBy(what, b.bytes, limits.bindingLimit, limits.bindingBytes) +
                              ", and the device lacks bufferDeviceAddress to reach it in chunks; render fewer pixels " +
@@ -160,6 +160,9 @@ DacrtBindingSet::DacrtBindingSet(const Context& context, const DacrtBufferPlan& 
 void DacrtBindingSet::writeChunkTable(std::uint64_t chunkBytes) {
     std::vector<std::uint32_t> first;
     std::vector<VkDeviceAddress> addresses;
+    addressed_ = true;
+    for (std::uint32_t binding : kAddressedBindings)
+        if (bound_[binding]->chunkCount() > 1) kernelChunkBytes_ = std::uint32_t(chunkBytes);
     for (std::uint32_t binding : kAddressedBindings) {
         const Buffer& b = *bound_[binding];
         if (b.chunkCount() > 1 ? b.chunkBytes() != chunkBytes : b.size() > chunkBytes)

@@ -55,6 +55,7 @@ constexpr std::array<std::uint32_t, DACRT_ADDRESSED_ARRAYS> kAddressedBindings =
 // (bufferBytes, memoryBytes: tests split small scenes with them). Each names its limit.
 struct BufferLimits {
     std::uint64_t bindingBytes = 0;  // one binding's reach: maxStorageBufferRange
+    std::uint64_t deviceBindingBytes = 0;  // the same, never capped: for the arrays always bound
     std::uint64_t chunkBytes = 0;    // one addressed chunk: maxMemoryAllocationSize, a multiple of DACRT_CHUNK_ALIGNMENT
     std::uint64_t memoryBytes = 0;   // every buffer of a frame together: the largest device-local heap
     bool addresses = false;          // the device has bufferDeviceAddress
@@ -96,12 +97,18 @@ public:
     const Buffer& operator[](std::uint32_t binding) const { return *bound_[binding]; }
     // Points every binding of the pipeline's set at its buffer.
     void bindTo(ComputePipeline& pipeline) const;
+    // Whether the addressed kernels run on it, and their chunk size (DACRT_SPEC_CHUNK_BYTES):
+    // 0 where every addressed array is one chunk.
+    bool addressed() const { return addressed_; }
+    std::uint32_t kernelChunkBytes() const { return kernelChunkBytes_; }
 
 private:
     void writeChunkTable(std::uint64_t chunkBytes);
 
     std::vector<Buffer> owned_;   // the bindings without a resident buffer
     ResidentBuffers bound_{};     // index = binding; into owned_ (its storage moves with it) or resident
+    bool addressed_ = false;
+    std::uint32_t kernelChunkBytes_ = 0;
 };
 
 }  // namespace dacrt::gpu

@@ -378,7 +378,8 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .loopBudget = gpu::loopBudgetOf(context_.info()),
         .sharedStart = sharedStart,
         .anyHit = anyHit,
-        .chunkBytes = std::uint32_t(gpu::chunkBytesOf(frame.buffers)),
+        .addressed = frame.set->addressed(),
+        .chunkBytes = frame.set->kernelChunkBytes(),
     });
     // Compilation only (a first use; later frames find the pipeline in the cache), so that
     // render and bench can take it out of the frame.
@@ -464,7 +465,7 @@ TraceResult GpuTracer::traceSecondary(GpuPassSource& source, const FrameGeometry
     uploadPass(frame, source);
     compileKernel(frame, false, true);
     const auto start = Clock::now();
-    frame.rayMaker = &pipelines_.secondary(std::uint32_t(gpu::chunkBytesOf(frame.buffers)));
+    frame.rayMaker = &pipelines_.secondary(frame.set->addressed(), frame.set->kernelChunkBytes());
     frame.set->bindTo(*frame.rayMaker);
     PhaseTimes::addTo(frame.result.phases.pipelineCompile, msSince(start));
     dispatchPass(frame, source, pass);

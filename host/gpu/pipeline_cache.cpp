@@ -23,10 +23,10 @@ std::vector<std::uint32_t> KernelSpecialization::values() const {
 namespace {
 
 // One of everything: the buffers a pipeline's first, empty dispatch binds.
-DacrtBufferPlan primingPlan(std::uint32_t chunkBytes) {
+DacrtBufferPlan primingPlan(bool addressed) {
     DacrtBufferPlan plan = planDacrtBuffers(DacrtBufferCounts{
         .rays = 1, .triangles = 1, .rayIds = 1, .triangleIds = 1, .regions = 1, .workItems = 1, .maxDepth = 0});
-    if (chunkBytes) chunkAddressedArrays(plan, chunkBytes);
+    if (addressed) chunkAddressedArrays(plan, DACRT_CHUNK_ALIGNMENT);
     return plan;
 }
 
@@ -34,8 +34,8 @@ DacrtBufferPlan primingPlan(std::uint32_t chunkBytes) {
 // compiles at the first dispatch (lavapipe does: about 10 s for this kernel on Mesa 25.0.7
 // without its shader cache) does so here, where the time is reported as the pipeline's, and
 // not inside a frame's dispatches.
-void prime(Context& context, ComputePipeline& pipeline, std::uint32_t chunkBytes) {
-    DacrtBindingSet set(context, primingPlan(chunkBytes));
+void prime(Context& context, ComputePipeline& pipeline, bool addressed) {
+    DacrtBindingSet set(context, primingPlan(addressed));
     TraversalState finished{};
     finished.phase = 2;  // kPhaseFinished in shaders/dacrt.comp
     set[DACRT_BINDING_STATES].upload(&finished, sizeof(finished));
@@ -52,28 +52,28 @@ void prime(Context& context, ComputePipeline& pipeline, std::uint32_t chunkBytes
 
 ComputePipeline& PipelineCache::kernel(const KernelSpecialization& specialization) {
     const std::vector<std::uint32_t> values = specialization.values();
-    std::unique_ptr<ComputePipeline>& slot = pipelines_[values];
+    const bool addressed = specialization.addressed;
+    std::unique_ptr<ComputePipeline>& slot = pipelines_[{addressed, values}];
     if (!slot) {
-        const bool addressed = specialization.chunkBytes != 0;
         slot = std::make_unique<ComputePipeline>(context_, addressed ? dacrtKernelAddressedSpirv() : dacrtKernelSpirv(),
                                                  DACRT_BINDING_COUNT, sizeof(DacrtPush), values,
                                                  addressed ? "dacrt (addressed)" : "dacrt");
-        prime(context_, *slot, specialization.chunkBytes);
+        prime(context_, *slot, addressed);
     }
     return *slot;
 }
 
-ComputePipeline& PipelineCache::secondary(std::uint32_t chunkBytes) {
-    std::unique_ptr<ComputePipeline>& slot = secondary_[chunkBytes];
+ComputePipeline& PipelineCache::secondary(bool addressed, std::uint32_t chunkBytes) {
+    std::unique_ptr<ComputePipeline>& slot = secondary_[{addressed, chunkBytes}];
     if (!slot) {
         std::vector<std::uint32_t> values(DACRT_SPEC_COUNT, 0);
         values[DACRT_SPEC_WORKGROUP_SIZE] = kSecondaryWorkgroup;
         values[DACRT_SPEC_MAX_DEPTH] = 1;  // the kernel has no traversal stack to size
         values[DACRT_SPEC_CHUNK_BYTES] = chunkBytes;
-        slot = std::make_unique<ComputePipeline>(context_, chunkBytes ? secondaryAddressedSpirv() : secondarySpirv(),
+        slot = std::make_unique<ComputePipeline>(context_, addressed ? secondaryAddressedSpirv() : secondarySpirv(),
                                                  DACRT_BINDING_COUNT, sizeof(SecondaryPush), values, "secondary");
         // As prime() does for the kernel: a step that does nothing, so that lavapipe compiles now.
-        DacrtBindingSet set(context_, primingPlan(chunkBytes));
+        DacrtBindingSet set(context_, primingPlan(addressed));
         set.bindTo(*slot);
         DispatchRecorder recorder(context_, 1);
         SecondaryPush push{};

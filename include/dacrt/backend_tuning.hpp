@@ -17,11 +17,13 @@ struct GpuTuning {
     std::uint32_t workgroupSize = 0;  // 0: the profile's default (gpu::defaultWorkgroupSize)
     std::uint32_t rayGroups = 0;      // 0: the profile's default (gpu::defaultRayGroups)
     GpuProfile profile = GpuProfile::Auto;
-    // Caps below the device's own limits, for tests: with bufferBytes every array larger than
-    // it is reached by device address in chunks of at most it (rounded down to 192 bytes), as
-    // arrays beyond maxStorageBufferRange are; memoryBytes lowers the memory a frame's device
-    // buffers may take together. 0: the device's limits (docs/gpu.md).
+    // Caps below the device's own limits, for tests (docs/gpu.md): every array larger than
+    // bufferBytes is reached by device address, as arrays beyond maxStorageBufferRange are, in
+    // chunks of at most chunkBytes (rounded down to a multiple of 192 bytes; else of
+    // maxMemoryAllocationSize); memoryBytes lowers the memory a frame's device buffers may take
+    // together. 0: the device's limit.
     std::uint64_t bufferBytes = 0;
+    std::uint64_t chunkBytes = 0;
     std::uint64_t memoryBytes = 0;
 };
 
