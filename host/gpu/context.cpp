@@ -91,15 +91,20 @@ std::uint64_t deviceLocalBytes(VkPhysicalDevice d) {
     return local ? local : any;
 }
 
+// Fills the feature structs of `chain` (a pNext chain) for the device.
+void queryFeatures(VkPhysicalDevice d, void* chain) {
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    features.pNext = chain;
+    vkGetPhysicalDeviceFeatures2(d, &features);
+}
+
 // Whether the device has the bufferDeviceAddress feature (core in Vulkan 1.2).
 bool hasBufferDeviceAddress(VkPhysicalDevice d, std::uint32_t apiVersion) {
     if (apiVersion < VK_API_VERSION_1_2) return false;
     VkPhysicalDeviceBufferDeviceAddressFeatures bda{};
     bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
-    VkPhysicalDeviceFeatures2 features{};
-    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    features.pNext = &bda;
-    vkGetPhysicalDeviceFeatures2(d, &features);
+    queryFeatures(d, &bda);
     return bda.bufferDeviceAddress == VK_TRUE;
 }
 
@@ -133,10 +138,7 @@ std::vector<std::string> rayQueryMissing(VkPhysicalDevice d, std::uint32_t apiVe
         VkPhysicalDeviceBufferDeviceAddressFeatures bda{};
         bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
         bda.pNext = &as;
-        VkPhysicalDeviceFeatures2 features{};
-        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-        features.pNext = &bda;
-        vkGetPhysicalDeviceFeatures2(d, &features);
+        queryFeatures(d, &bda);
         if (!rq.rayQuery) missing.push_back("the rayQuery feature");
         if (!as.accelerationStructure) missing.push_back("the accelerationStructure feature");
         if (!bda.bufferDeviceAddress) missing.push_back("the bufferDeviceAddress feature");
@@ -149,10 +151,7 @@ std::vector<std::string> rayQueryMissing(VkPhysicalDevice d, std::uint32_t apiVe
 bool computeFullSubgroups(VkPhysicalDevice d) {
     VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
     control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
-    VkPhysicalDeviceFeatures2 features{};
-    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    features.pNext = &control;
-    vkGetPhysicalDeviceFeatures2(d, &features);
+    queryFeatures(d, &control);
     return control.computeFullSubgroups == VK_TRUE;
 }
 
