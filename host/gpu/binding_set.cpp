@@ -96,6 +96,15 @@ bool addressLargeArrays(DacrtBufferPlan& plan, const BufferLimits& limits) {
     if (limits.bindings && DACRT_BINDING_COUNT > limits.bindings)
         throw InputError("the gpu kernel binds " + std::to_string(DACRT_BINDING_COUNT) + " storage buffers, more than " +
                          "the device's maxPerStageDescriptorStorageBuffers of " + std::to_string(limits.bindings));
+    // Element indices are 32-bit in the kernels, and signed where they index memory.
+    constexpr std::array<std::uint64_t, DACRT_ADDRESSED_ARRAYS> kElementBytes = {64, 48, 32, 16, 4, 4, 64, 16};
+    for (std::size_t a = 0; a < kAddressedBindings.size(); ++a) {
+        const PlannedBuffer& b = plan[kAddressedBindings[a]];
+        if (b.bytes / kElementBytes[a] > (std::uint64_t(1) << 31))
+            throw InputError(std::string("the device array of ") + b.name + " has " + std::to_string(b.bytes / kElementBytes[a]) +
+                             " elements, more than the kernels' 32-bit indices reach (2^31); render fewer pixels or " +
+                             "split the scene");
+    }
     bool beyondBinding = false;
     for (std::uint32_t k = 0; k < plan.size(); ++k) {
         const PlannedBuffer& b = plan[k];
@@ -135,7 +144,7 @@ void addToMemoryPlan(const DacrtBufferPlan& buffers, const BufferLimits& limits,
                      " bytes (" + limits.chunkLimit + ")");
     }
     if (limits.memoryBytes && total > limits.memoryBytes)
-        throw InputError(overBy("the frame's device buffers together", total, limits.memoryLimit, limits.memoryBytes) +
+        throw InputError(overBy("the frame's device memory", total, limits.memoryLimit, limits.memoryBytes) +
                          "; render fewer pixels or split the scene");
 }
 
