@@ -39,9 +39,8 @@ BufferLimits bufferLimits(const DeviceInfo& device, const GpuTuning& tuning) {
     limits.addresses = device.bufferDeviceAddress;
     limits.bindings = device.maxPerStageStorageBuffers;
     // The kernel's chunk size is a 32-bit specialization constant.
-    const std::uint64_t allocation = std::min<std::uint64_t>(device.maxMemoryAllocationSize ? device.maxMemoryAllocationSize
-                                                                                          : device.maxStorageBufferRange,
-                                                             0xFFFFFFFFu);
+    const std::uint64_t largest = device.maxMemoryAllocationSize ? device.maxMemoryAllocationSize : device.maxStorageBufferRange;
+    const std::uint64_t allocation = std::min<std::uint64_t>(largest, 0xFFFFFFFFu);
     limits.bindingBytes = limits.deviceBindingBytes = device.maxStorageBufferRange;
     limits.chunkBytes = allocation / DACRT_CHUNK_ALIGNMENT * DACRT_CHUNK_ALIGNMENT;
     limits.memoryBytes = device.deviceLocalBytes;
