@@ -82,6 +82,7 @@ void loadFrameParameters() {
     gOrder = push.order;
     gRayScratchHalf = push.rayScratchHalf;
     gTriScratchHalf = push.triScratchHalf;
+    loadArrayBases();
 }
 
 // Earlier work items may finish during this very dispatch: one invocation reads the counters

@@ -14,6 +14,45 @@ layout(constant_id = DACRT_SPEC_SHARED_START) const bool kSharedStart = false;
 // Shadow and occlusion rays: a ray ends at its first hit in its segment, wherever it lies.
 layout(constant_id = DACRT_SPEC_ANY_HIT) const bool kAnyHit = false;
 
+#ifdef DACRT_ADDRESSED
+// Arrays larger than one binding may be (maxStorageBufferRange) are reached by device address,
+// in chunks of kChunkBytes (the last one shorter), each its own allocation: an element's chunk
+// and place come from its index, with a division by a constant once specialized. The host
+// plans the chunks (host/gpu/binding_set.cpp) and writes their addresses to the chunk table.
+// kChunkBytes 0: every array is one chunk, whose address each invocation reads once.
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
+layout(constant_id = DACRT_SPEC_CHUNK_BYTES) const uint kChunkBytes = 0;
+const uint kChunkDivisor = kChunkBytes == 0u ? DACRT_CHUNK_ALIGNMENT : kChunkBytes;
+layout(std430, binding = DACRT_BINDING_ADDRESSES) readonly buffer ChunkTable {
+    uint firstChunk[DACRT_ADDRESSED_ARRAYS];
+    uvec2 chunkAddresses[];
+};
+layout(buffer_reference, std430, buffer_reference_align = 16) coherent buffer RayChunk { Ray v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer TriangleChunk { Triangle v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BoundsChunk { Bounds v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) coherent buffer HitChunk { Hit v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) coherent buffer IdChunk { uint v[]; };
+uvec2 gArrayBase[DACRT_ADDRESSED_ARRAYS];  // each array's first chunk
+void loadArrayBases() {
+    for (uint a = 0u; a < DACRT_ADDRESSED_ARRAYS; ++a) gArrayBase[a] = chunkAddresses[firstChunk[a]];
+}
+uvec2 chunkAddress(uint array, uint chunk) {
+    return kChunkBytes == 0u ? gArrayBase[array] : chunkAddresses[firstChunk[array] + chunk];
+}
+// Element i of an addressed array (an lvalue); i is read twice, so it must have no side effects.
+#define DACRT_CHUNKED(Chunk, array, elementBytes, i) \
+    Chunk(chunkAddress(array, (i) / (kChunkDivisor / elementBytes))) \
+        .v[kChunkBytes == 0u ? (i) : (i) % (kChunkDivisor / elementBytes)]
+#define RAYS(i) DACRT_CHUNKED(RayChunk, DACRT_ARRAY_RAYS, 64u, i)
+#define TRIANGLES(i) DACRT_CHUNKED(TriangleChunk, DACRT_ARRAY_TRIANGLES, 48u, i)
+#define TRIANGLE_BOUNDS(i) DACRT_CHUNKED(BoundsChunk, DACRT_ARRAY_TRIANGLE_BOUNDS, 32u, i)
+#define HITS(i) DACRT_CHUNKED(HitChunk, DACRT_ARRAY_HITS, 16u, i)
+#define RAY_IDS(i) DACRT_CHUNKED(IdChunk, DACRT_ARRAY_RAY_IDS, 4u, i)
+#define TRI_IDS(i) DACRT_CHUNKED(IdChunk, DACRT_ARRAY_TRI_IDS, 4u, i)
+#define SOURCE_RAYS(i) DACRT_CHUNKED(RayChunk, DACRT_ARRAY_SOURCE_RAYS, 64u, i)
+#define SOURCE_HITS(i) DACRT_CHUNKED(HitChunk, DACRT_ARRAY_SOURCE_HITS, 16u, i)
+#else
 // Rays are read-only but where a kernel makes them (secondary.comp defines DACRT_MAKES_RAYS).
 #ifdef DACRT_MAKES_RAYS
 layout(std430, binding = DACRT_BINDING_RAYS) writeonly buffer RayBuffer { Ray rays[]; };
@@ -28,13 +67,24 @@ layout(std430, binding = DACRT_BINDING_HITS) coherent buffer HitBuffer { Hit hit
 // sides of a branch included).
 layout(std430, binding = DACRT_BINDING_RAY_IDS) coherent buffer RayIdBuffer { uint rayIds[]; };
 layout(std430, binding = DACRT_BINDING_TRI_IDS) coherent buffer TriIdBuffer { uint triIds[]; };
+layout(std430, binding = DACRT_BINDING_SOURCE_RAYS) readonly buffer SourceRayBuffer { Ray sourceRays[]; };
+layout(std430, binding = DACRT_BINDING_SOURCE_HITS) readonly buffer SourceHitBuffer { Hit sourceHits[]; };
+// The same elements as the addressed kernels name them.
+#define RAYS(i) rays[i]
+#define TRIANGLES(i) triangles[i]
+#define TRIANGLE_BOUNDS(i) triangleBounds[i]
+#define HITS(i) hits[i]
+#define RAY_IDS(i) rayIds[i]
+#define TRI_IDS(i) triIds[i]
+#define SOURCE_RAYS(i) sourceRays[i]
+#define SOURCE_HITS(i) sourceHits[i]
+void loadArrayBases() {}
+#endif
 layout(std430, binding = DACRT_BINDING_REGIONS) coherent buffer RegionBuffer { Region regions[]; };
 layout(std430, binding = DACRT_BINDING_WORK_ITEMS) readonly buffer WorkItemBuffer { WorkItem workItems[]; };
 layout(std430, binding = DACRT_BINDING_COUNTERS) coherent buffer CounterBuffer { GpuCounters counters; };
 layout(std430, binding = DACRT_BINDING_STATES) coherent buffer StateBuffer { TraversalState states[]; };
 layout(std430, binding = DACRT_BINDING_STACKS) coherent buffer StackBuffer { StackEntry stacks[]; };
-layout(std430, binding = DACRT_BINDING_SOURCE_RAYS) readonly buffer SourceRayBuffer { Ray sourceRays[]; };
-layout(std430, binding = DACRT_BINDING_SOURCE_HITS) readonly buffer SourceHitBuffer { Hit sourceHits[]; };
 
 // Frame parameters, set from push constants at the start of main.
 float gMargin;

@@ -67,23 +67,23 @@ uint crossingMovingRule(int axis, bool down) {
 // (llvmpipe loads a buffer component one invocation at a time, so every field counts).
 Ray rayStart(uint id) {
     Ray ray;
-    ray.origin = kSharedStart ? gRayOrigin : rays[id].origin;
-    ray.tmin = kSharedStart ? gRayTmin : rays[id].tmin;
+    ray.origin = kSharedStart ? gRayOrigin : RAYS(id).origin;
+    ray.tmin = kSharedStart ? gRayTmin : RAYS(id).tmin;
     return ray;
 }
 
 // The fields of a ray that its filters read: origin, tmin and invDir.
 Ray filterRay(uint id) {
     Ray ray = rayStart(id);
-    ray.invDir = rays[id].invDir;
+    ray.invDir = RAYS(id).invDir;
     return ray;
 }
 
 bool keepRay(uint id, uint rule, vec3 lo, vec3 hi) {
     Ray ray = filterRay(id);
-    float bestT = hits[id].t;
+    float bestT = HITS(id).t;
     if (rule == kKeepCrossing) return rayMayCrossCell(ray, lo, hi, bestT);
-    if (rule == kKeepFinished) return hits[id].prim != kMissPrim && (kAnyHit || hitEndsInBox(ray, lo, hi, bestT));
+    if (rule == kKeepFinished) return HITS(id).prim != kMissPrim && (kAnyHit || hitEndsInBox(ray, lo, hi, bestT));
     if (rule >= kKeepCrossingUp) {
         uint axis = (rule - kKeepCrossingUp) >> 1u;
         bool down = ((rule - kKeepCrossingUp) & 1u) == 1u;
@@ -133,7 +133,7 @@ uint leafRaysWithin(uint rayCount, uint triCount, uint available) {
 const uint kKeepOverlapping = 5u;  // triangles whose bounds overlap the (widened) cell
 
 bool keepId(uint id, uint rule, vec3 lo, vec3 hi) {
-    if (rule == kKeepOverlapping) return boundsOverlap(triangleBounds[id].lo, triangleBounds[id].hi, lo, hi);
+    if (rule == kKeepOverlapping) return boundsOverlap(TRIANGLE_BOUNDS(id).lo, TRIANGLE_BOUNDS(id).hi, lo, hi);
     return keepRay(id, rule, lo, hi);
 }
 
@@ -154,7 +154,7 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             uint index = first + e;
             bool inRange = index < end;
-            ids[e] = inRange ? (triangleIds ? triIds[index] : rayIds[index]) : 0u;
+            ids[e] = inRange ? (triangleIds ? TRI_IDS(index) : RAY_IDS(index)) : 0u;
             keeps[e] = inRange && keepId(ids[e], rule, lo, hi);
             myKept += keeps[e] ? 1u : 0u;
         }
@@ -169,8 +169,8 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             if (first + e >= end) continue;
             uint slot = keeps[e] ? k++ : d++;
-            if (triangleIds) triIds[slot] = ids[e];
-            else rayIds[slot] = ids[e];
+            if (triangleIds) TRI_IDS(slot) = ids[e];
+            else RAY_IDS(slot) = ids[e];
         }
         kept += total;
         dropped += min(kPartitionChunk, end - base) - total;
@@ -181,8 +181,8 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             uint offset = base + lane * kIdsPerInvocation + e;
             if (offset >= dropped) continue;
-            if (triangleIds) triIds[keptEnd + offset] = triIds[scratch + offset];
-            else rayIds[keptEnd + offset] = rayIds[scratch + offset];
+            if (triangleIds) TRI_IDS(keptEnd + offset) = TRI_IDS(scratch + offset);
+            else RAY_IDS(keptEnd + offset) = RAY_IDS(scratch + offset);
         }
     }
     workgroupSync();
@@ -207,8 +207,8 @@ uint leafLanesPerRay(uint rayCount) {
 // The fields of a ray that the triangle test reads: origin, tmin, axes and shear.
 Ray leafRay(uint id) {
     Ray ray = rayStart(id);
-    ray.axes = rays[id].axes;
-    ray.shear = rays[id].shear;
+    ray.axes = RAYS(id).axes;
+    ray.shear = RAYS(id).shear;
     return ray;
 }
 
@@ -230,13 +230,13 @@ void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
     for (uint first = rayBegin; first < rayEnd; first += raysPerPass) {
         uint index = first + myRay;
         bool rayActive = index < rayEnd;
-        uint id = rayActive ? rayIds[index] : 0u;
+        uint id = rayActive ? RAY_IDS(index) : 0u;
         Ray ray = leafRay(id);
-        Hit best = hits[id];
+        Hit best = HITS(id);
         for (uint tile = triBegin; tile < triEnd; tile += gl_SubgroupSize) {
             uint tileSize = min(gl_SubgroupSize, triEnd - tile);
-            uint myPrim = lane < tileSize ? triIds[tile + lane] : 0u;
-            Triangle mine = triangles[myPrim];
+            uint myPrim = lane < tileSize ? TRI_IDS(tile + lane) : 0u;
+            Triangle mine = TRIANGLES(myPrim);
             for (uint j = 0; j < tileSize; j += lanes) {  // uniform: every lane shuffles
                 uint k = j + slot;
                 uint prim = subgroupShuffle(myPrim, k);
@@ -265,7 +265,7 @@ void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
             other.v = subgroupShuffleXor(best.v, mask);
             if (hitPrecedes(other.t, other.prim, best.t, best.prim)) best = other;
         }
-        if (rayActive && slot == 0u) hits[id] = best;
+        if (rayActive && slot == 0u) HITS(id) = best;
     }
     workgroupSync();
 }

@@ -222,7 +222,28 @@ struct WorkgroupTestPush {
 #define DACRT_BINDING_STACKS 10
 #define DACRT_BINDING_SOURCE_RAYS 11   // secondary passes: the primary rays, read by shaders/secondary.comp
 #define DACRT_BINDING_SOURCE_HITS 12   // secondary passes: the primary hits
-#define DACRT_BINDING_COUNT 13
+// The addressed kernels (DACRT_ADDRESSED): where an array is larger than one binding may be
+// (maxStorageBufferRange), the arrays below are reached by device address instead, each in
+// chunks of at most DACRT_SPEC_CHUNK_BYTES (an allocation's limit). This buffer holds, per
+// array, the index of its first chunk (uint firstChunk[DACRT_ADDRESSED_ARRAYS]), then every
+// chunk's address (uvec2: low, high word) from byte DACRT_CHUNK_TABLE_ADDRESSES.
+#define DACRT_BINDING_ADDRESSES 13
+#define DACRT_BINDING_COUNT 14
+
+// The addressed arrays, by their index in the chunk table.
+#define DACRT_ARRAY_RAYS 0u
+#define DACRT_ARRAY_TRIANGLES 1u
+#define DACRT_ARRAY_TRIANGLE_BOUNDS 2u
+#define DACRT_ARRAY_HITS 3u
+#define DACRT_ARRAY_RAY_IDS 4u
+#define DACRT_ARRAY_TRI_IDS 5u
+#define DACRT_ARRAY_SOURCE_RAYS 6u
+#define DACRT_ARRAY_SOURCE_HITS 7u
+#define DACRT_ADDRESSED_ARRAYS 8
+#define DACRT_CHUNK_TABLE_ADDRESSES 32
+// A chunk's size is a multiple of every addressed element's (64, 48, 32, 16 and 4 bytes), so
+// that no element straddles two chunks.
+#define DACRT_CHUNK_ALIGNMENT 192u
 
 // A split whose child keeps every ray and every triangle of its parent made no progress;
 // after this many such splits in a row the node is a leaf. Identical rays meeting coincident
@@ -238,6 +259,8 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_LOOP_BUDGET 4
 #define DACRT_SPEC_SHARED_START 5   // 1: every ray has origin rayOrigin and tmin rayTmin (DacrtPush)
 #define DACRT_SPEC_ANY_HIT 6        // 1: a ray ends at its first hit in its segment (shadow, occlusion)
+#define DACRT_SPEC_CHUNK_BYTES 7    // the addressed kernels: bytes of every chunk but an array's last
+#define DACRT_SPEC_COUNT 8
 
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 32);
@@ -272,6 +295,9 @@ static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mod
 static_assert(offsetof(WorkgroupTestPush, rule) == 28 && offsetof(WorkgroupTestPush, begin) == 32);
 static_assert(offsetof(WorkgroupTestPush, triEnd) == 44 && offsetof(WorkgroupTestPush, axis) == 56);
 static_assert(offsetof(WorkgroupTestPush, loopProbe) == 60);
+static_assert(DACRT_CHUNK_ALIGNMENT % sizeof(Ray) == 0 && DACRT_CHUNK_ALIGNMENT % sizeof(Triangle) == 0);
+static_assert(DACRT_CHUNK_ALIGNMENT % sizeof(Bounds) == 0 && DACRT_CHUNK_ALIGNMENT % sizeof(Hit) == 0);
+static_assert(DACRT_CHUNK_TABLE_ADDRESSES == DACRT_ADDRESSED_ARRAYS * sizeof(uint));
 static_assert(sizeof(Ray) == 64);
 static_assert(offsetof(Ray, origin) == 0 && offsetof(Ray, tmin) == 12);
 static_assert(offsetof(Ray, dir) == 16 && offsetof(Ray, axes) == 28);

@@ -54,24 +54,24 @@ uint firstRegion(Ray ray) {
 void makeRay(uint slot) {
     uint source = slot / push.raysPerHit;
     uint k = slot - source * push.raysPerHit;
-    Hit primaryHit = sourceHits[source];
+    Hit primaryHit = SOURCE_HITS(source);
     SurfaceSample surface = noSurface();
-    if (primaryHit.prim != kMissPrim) surface = surfaceOfHit(sourceRays[source], primaryHit, triangles[primaryHit.prim]);
+    if (primaryHit.prim != kMissPrim) surface = surfaceOfHit(SOURCE_RAYS(source), primaryHit, TRIANGLES(primaryHit.prim));
     uint band = (push.sourceCount + push.groups - 1u) / push.groups;
     uint group = min(source / band, push.groups - 1u);
     uint stream = source * push.samplesPerHit + push.firstSample + k;
     GeneratedRay g = push.kind == kPassShadow ? shadowRay(surface, push.light)
                                               : occlusionRay(surface, stream, push.sampleSeed, push.occlusionDistance);
-    rays[slot] = g.ray;
+    RAYS(slot) = g.ray;
     Hit start;
     start.t = g.traced ? g.ray.tmax : 0.0;
     start.prim = g.traced ? kMissPrim : kNotTracedPrim;
     start.u = 0.0;
     start.v = 0.0;
-    hits[slot] = start;
+    HITS(slot) = start;
     uint region = g.traced ? firstRegion(g.ray) : kNoSlot;
     uint key = region == kNoSlot ? kNoSlot : region * push.groups + group;
-    rayIds[gRayScratchHalf + slot] = key;
+    RAY_IDS(gRayScratchHalf + slot) = key;
     if (key == kNoSlot) return;
     atomicAdd(regions[key].rayEnd, 1u);
     float d = g.ray.dir[push.axis];
@@ -96,13 +96,15 @@ void rangesFromCounts() {
 // Step 2, one invocation per ray slot: its id into its region slot's range (in no particular
 // order: no result depends on the order of a range's rays).
 void writeRayId(uint slot) {
-    uint key = rayIds[gRayScratchHalf + slot];
+    uint key = RAY_IDS(gRayScratchHalf + slot);
     if (key == kNoSlot) return;
-    rayIds[atomicAdd(regions[key].cursor, 1u)] = slot;
+    uint place = atomicAdd(regions[key].cursor, 1u);
+    RAY_IDS(place) = slot;
 }
 
 void main() {
     gRayScratchHalf = push.sourceCount * push.raysPerHit;
+    loadArrayBases();
     uint i = push.firstInvocation + gl_GlobalInvocationID.x;
     if (push.step == 0u && i < gRayScratchHalf) makeRay(i);
     if (push.step == 1u && i == 0u) rangesFromCounts();

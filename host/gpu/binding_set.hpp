@@ -4,7 +4,10 @@
 // and bound. The tracer, the building-block tests and the block benchmark all use it.
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
+
+#include <dacrt/backend_tuning.hpp>
 
 #include "core/shader_layout.hpp"
 #include "cpu/memory_plan.hpp"
@@ -35,19 +38,53 @@ std::uint64_t stackSlotsFor(std::uint64_t workItems, std::uint32_t maxDepth, con
 struct PlannedBuffer {
     const char* name;    // for the memory plan and error messages
     std::uint64_t bytes;
+    // 0: one allocation, bound whole; else reached by device address in chunks of this many
+    // bytes (the addressed kernels, DACRT_ADDRESSED in shaders/dacrt_bindings.glsl).
+    std::uint64_t chunkBytes = 0;
 };
 
 // Index k is binding k.
 using DacrtBufferPlan = std::array<PlannedBuffer, DACRT_BINDING_COUNT>;
 
+// The bindings of the arrays the addressed kernels reach by address, by DACRT_ARRAY_* index.
+constexpr std::array<std::uint32_t, DACRT_ADDRESSED_ARRAYS> kAddressedBindings = {
+    DACRT_BINDING_RAYS,    DACRT_BINDING_TRIANGLES, DACRT_BINDING_TRIANGLE_BOUNDS, DACRT_BINDING_HITS,
+    DACRT_BINDING_RAY_IDS, DACRT_BINDING_TRI_IDS,   DACRT_BINDING_SOURCE_RAYS,     DACRT_BINDING_SOURCE_HITS};
+
+// What bounds one buffer of a frame: the device's limits, or the lower caps GpuTuning sets
+// (bufferBytes, memoryBytes: tests split small scenes with them). Each names its limit.
+struct BufferLimits {
+    std::uint64_t bindingBytes = 0;  // one binding's reach: maxStorageBufferRange
+    std::uint64_t deviceBindingBytes = 0;  // the same, never capped: for the arrays always bound
+    std::uint64_t chunkBytes = 0;    // one addressed chunk: maxMemoryAllocationSize, a multiple of DACRT_CHUNK_ALIGNMENT
+    std::uint64_t memoryBytes = 0;   // every buffer of a frame together: the largest device-local heap
+    bool addresses = false;          // the device has bufferDeviceAddress
+    std::uint32_t bindings = 0;      // maxPerStageDescriptorStorageBuffers
+    std::string bindingLimit, chunkLimit, memoryLimit;  // "maxStorageBufferRange", ...
+};
+BufferLimits bufferLimits(const DeviceInfo& device, const GpuTuning& tuning);
+
+// Planned with the same counts, every array in one binding: whether the addressed kernels
+// must run (some addressed array exceeds limits.bindingBytes). If so, the addressed arrays
+// are planned in chunks of limits.chunkBytes. Throws InputError, naming the limit and the
+// excess, for a buffer no plan can hold: an array beyond one binding on a device without
+// buffer device addresses, or one that the addressed kernels do not address (regions, work
+// items, traversal states and stacks).
+bool addressLargeArrays(DacrtBufferPlan& plan, const BufferLimits& limits);
+// Plans the addressed arrays in chunks of chunkBytes, and the chunk table that names them.
+void chunkAddressedArrays(DacrtBufferPlan& plan, std::uint64_t chunkBytes);
+inline std::uint64_t chunkBytesOf(const DacrtBufferPlan& plan) { return plan[DACRT_BINDING_RAYS].chunkBytes; }
+
 DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& counts);
 
-// Appends "device: NAME" entries to plan, and throws InputError naming the first buffer that
-// exceeds the device's maxStorageBufferRange, with the limit and the excess. Bindings that
-// `reused` names (buffers that exist already) are checked but not added.
+// Appends "device: NAME" entries to plan (with their chunks, where addressed, and the limit
+// that made them so), and throws InputError when the frame's buffers together exceed the
+// device's memory (limits.memoryBytes), with the limit and the excess. Bindings that `reused`
+// names (buffers that exist already) are counted in that sum but not added to the plan;
+// `alsoKept` bytes (buffers the frame keeps from elsewhere) likewise.
 using ResidentBuffers = std::array<Buffer*, DACRT_BINDING_COUNT>;
-void addToMemoryPlan(const DacrtBufferPlan& buffers, const DeviceInfo& device, MemoryPlan& plan,
-                     const ResidentBuffers* reused = nullptr);
+void addToMemoryPlan(const DacrtBufferPlan& buffers, const BufferLimits& limits, MemoryPlan& plan,
+                     const ResidentBuffers* reused = nullptr, std::uint64_t alsoKept = 0);
 
 // Buffers that outlive a binding set, for the bindings that name one (null: the set makes it):
 // ResidentBuffers, above.
@@ -60,10 +97,18 @@ public:
     const Buffer& operator[](std::uint32_t binding) const { return *bound_[binding]; }
     // Points every binding of the pipeline's set at its buffer.
     void bindTo(ComputePipeline& pipeline) const;
+    // Whether the addressed kernels run on it, and their chunk size (DACRT_SPEC_CHUNK_BYTES):
+    // 0 where every addressed array is one chunk.
+    bool addressed() const { return addressed_; }
+    std::uint32_t kernelChunkBytes() const { return kernelChunkBytes_; }
 
 private:
+    void writeChunkTable(std::uint64_t chunkBytes);
+
     std::vector<Buffer> owned_;   // the bindings without a resident buffer
     ResidentBuffers bound_{};     // index = binding; into owned_ (its storage moves with it) or resident
+    bool addressed_ = false;
+    std::uint32_t kernelChunkBytes_ = 0;
 };
 
 }  // namespace dacrt::gpu

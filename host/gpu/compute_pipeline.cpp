@@ -108,7 +108,7 @@ void ComputePipeline::bind(const std::vector<const Buffer*>& buffers) {
         if (types_[b] != VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) continue;  // written by its owner (an acceleration structure)
         if (!buffers[b])
             throw std::logic_error("pipeline '" + name_ + "': storage buffer binding " + std::to_string(b) + " given no buffer");
-        infos[b] = VkDescriptorBufferInfo{buffers[b]->handle(), 0, VK_WHOLE_SIZE};
+        infos[b] = VkDescriptorBufferInfo{buffers[b]->handle(), 0, buffers[b]->bindingRange()};
         VkWriteDescriptorSet w{};
         w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
         w.dstSet = set_;

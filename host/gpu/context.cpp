@@ -78,6 +78,36 @@ std::vector<std::string> memoryHeaps(VkPhysicalDevice d) {
     return heaps;
 }
 
+// The largest device-local heap, else the largest heap: what the memory plan holds a frame to.
+std::uint64_t deviceLocalBytes(VkPhysicalDevice d) {
+    VkPhysicalDeviceMemoryProperties memory;
+    vkGetPhysicalDeviceMemoryProperties(d, &memory);
+    std::uint64_t local = 0, any = 0;
+    for (std::uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
+        any = std::max<std::uint64_t>(any, memory.memoryHeaps[h].size);
+        if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+            local = std::max<std::uint64_t>(local, memory.memoryHeaps[h].size);
+    }
+    return local ? local : any;
+}
+
+// Fills the feature structs of `chain` (a pNext chain) for the device.
+void queryFeatures(VkPhysicalDevice d, void* chain) {
+    VkPhysicalDeviceFeatures2 features{};
+    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    features.pNext = chain;
+    vkGetPhysicalDeviceFeatures2(d, &features);
+}
+
+// Whether the device has the bufferDeviceAddress feature (core in Vulkan 1.2).
+bool hasBufferDeviceAddress(VkPhysicalDevice d, std::uint32_t apiVersion) {
+    if (apiVersion < VK_API_VERSION_1_2) return false;
+    VkPhysicalDeviceBufferDeviceAddressFeatures bda{};
+    bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
+    queryFeatures(d, &bda);
+    return bda.bufferDeviceAddress == VK_TRUE;
+}
+
 std::vector<VkExtensionProperties> deviceExtensions(VkPhysicalDevice d) {
     std::uint32_t extensionCount = 0;
     VK_CHECK(vkEnumerateDeviceExtensionProperties(d, nullptr, &extensionCount, nullptr));
@@ -108,10 +138,7 @@ std::vector<std::string> rayQueryMissing(VkPhysicalDevice d, std::uint32_t apiVe
         VkPhysicalDeviceBufferDeviceAddressFeatures bda{};
         bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
         bda.pNext = &as;
-        VkPhysicalDeviceFeatures2 features{};
-        features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-        features.pNext = &bda;
-        vkGetPhysicalDeviceFeatures2(d, &features);
+        queryFeatures(d, &bda);
         if (!rq.rayQuery) missing.push_back("the rayQuery feature");
         if (!as.accelerationStructure) missing.push_back("the accelerationStructure feature");
         if (!bda.bufferDeviceAddress) missing.push_back("the bufferDeviceAddress feature");
@@ -124,10 +151,7 @@ std::vector<std::string> rayQueryMissing(VkPhysicalDevice d, std::uint32_t apiVe
 bool computeFullSubgroups(VkPhysicalDevice d) {
     VkPhysicalDeviceSubgroupSizeControlFeaturesEXT control{};
     control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
-    VkPhysicalDeviceFeatures2 features{};
-    features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-    features.pNext = &control;
-    vkGetPhysicalDeviceFeatures2(d, &features);
+    queryFeatures(d, &control);
     return control.computeFullSubgroups == VK_TRUE;
 }
 
@@ -158,6 +182,8 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     info.heaps = memoryHeaps(d);
     info.maxStorageBufferRange = l.maxStorageBufferRange;
     info.maxMemoryAllocationSize = maintenance3.maxMemoryAllocationSize;
+    info.deviceLocalBytes = deviceLocalBytes(d);
+    info.bufferDeviceAddress = hasBufferDeviceAddress(d, basic.apiVersion);
     info.maxComputeSharedMemorySize = l.maxComputeSharedMemorySize;
     info.maxComputeWorkGroupInvocations = l.maxComputeWorkGroupInvocations;
     info.maxComputeWorkGroupSizeX = l.maxComputeWorkGroupSize[0];
@@ -199,6 +225,7 @@ std::string DeviceInfo::describe() const {
     for (const std::string& h : heaps) s << " " << h << ";";
     s << "\n   max storage buffer range: " << maxStorageBufferRange << " bytes\n"
       << "   max allocation size: " << maxMemoryAllocationSize << " bytes\n"
+      << "   buffer device addresses: " << (bufferDeviceAddress ? "yes" : "no") << "\n"
       << "   compute shared memory: " << maxComputeSharedMemorySize << " bytes\n"
       << "   workgroup: " << maxComputeWorkGroupInvocations << " invocations, size x " << maxComputeWorkGroupSizeX
       << ", count x " << maxComputeWorkGroupCountX << "\n"
@@ -329,12 +356,17 @@ void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const De
     if (info.rayQuery) {
         rayQuery.rayQuery = VK_TRUE;
         accel.accelerationStructure = VK_TRUE;
-        addresses.bufferDeviceAddress = VK_TRUE;
         rayQuery.pNext = chain;
         accel.pNext = &rayQuery;
-        addresses.pNext = &accel;
-        chain = &addresses;
+        chain = &accel;
         for (const char* e : kRayQueryExtensions) enabled.push_back(e);
+    }
+    // Device addresses where the device has them: the acceleration structures' inputs, and the
+    // gpu kernels' arrays beyond maxStorageBufferRange.
+    if (info.bufferDeviceAddress || info.rayQuery) {
+        addresses.bufferDeviceAddress = VK_TRUE;
+        addresses.pNext = chain;
+        chain = &addresses;
     }
     deviceInfo.pNext = chain;
     deviceInfo.enabledExtensionCount = std::uint32_t(enabled.size());

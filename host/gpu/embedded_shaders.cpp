@@ -1,8 +1,10 @@
 #include "gpu/embedded_shaders.hpp"
 
 #include "dacrt.spv.h"
+#include "dacrt_addressed.spv.h"
 #include "rayquery.spv.h"
 #include "secondary.spv.h"
+#include "secondary_addressed.spv.h"
 #include "workgroup_test.spv.h"
 
 namespace dacrt::gpu {
@@ -11,6 +13,14 @@ std::span<const std::uint32_t> dacrtKernelSpirv() { return {dacrt_spv, sizeof(da
 
 std::span<const std::uint32_t> secondarySpirv() {
     return {secondary_spv, sizeof(secondary_spv) / sizeof(secondary_spv[0])};
+}
+
+std::span<const std::uint32_t> dacrtKernelAddressedSpirv() {
+    return {dacrt_addressed_spv, sizeof(dacrt_addressed_spv) / sizeof(dacrt_addressed_spv[0])};
+}
+
+std::span<const std::uint32_t> secondaryAddressedSpirv() {
+    return {secondary_addressed_spv, sizeof(secondary_addressed_spv) / sizeof(secondary_addressed_spv[0])};
 }
 
 std::span<const std::uint32_t> workgroupTestSpirv() {

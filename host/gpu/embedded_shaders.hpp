@@ -7,6 +7,9 @@ namespace dacrt::gpu {
 
 std::span<const std::uint32_t> dacrtKernelSpirv();    // shaders/dacrt.comp
 std::span<const std::uint32_t> secondarySpirv();      // shaders/secondary.comp
+// The same two kernels with DACRT_ADDRESSED: the large arrays by device address, in chunks.
+std::span<const std::uint32_t> dacrtKernelAddressedSpirv();
+std::span<const std::uint32_t> secondaryAddressedSpirv();
 std::span<const std::uint32_t> workgroupTestSpirv();  // shaders/workgroup_test.comp
 std::span<const std::uint32_t> rayQuerySpirv();       // shaders/rayquery.comp
 

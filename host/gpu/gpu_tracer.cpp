@@ -231,6 +231,7 @@ GpuTracer::GpuTracer(gpu::Context& context, ThreadPool& pool, const TraceOptions
       pool_(pool),
       options_(options),
       tuning_(tuning),
+      limits_(gpu::bufferLimits(context.info(), tuning)),
       ownPipelines_(pipelines ? nullptr : std::make_unique<gpu::PipelineCache>(context)),
       pipelines_(pipelines ? *pipelines : *ownPipelines_),
       resident_(resident) {
@@ -310,7 +311,8 @@ void GpuTracer::planMemory(Frame& frame) const {
     MemoryPlan& plan = frame.result.memory;
     for (const auto& [name, bytes] : frame.hostPlan.buffers) plan.add("host: " + name, bytes);
     plan.add("host: triangle ids per ray group", frame.triIdCount * 4);
-    gpu::addToMemoryPlan(frame.buffers, context_.info(), plan);
+    gpu::addressLargeArrays(frame.buffers, limits_);
+    gpu::addToMemoryPlan(frame.buffers, limits_, plan);
     plan.work.insert(plan.work.end(), frame.hostPlan.work.begin(), frame.hostPlan.work.end());
     gpu::addWorkItemLines(work, plan);
     const std::uint64_t triangleBytes = std::uint64_t(g.triangles->size()) * (sizeof(Triangle) + sizeof(Bounds));
@@ -331,7 +333,7 @@ void GpuTracer::planMemory(Frame& frame) const {
 void GpuTracer::upload(Frame& frame) const {
     const auto start = Clock::now();
     if (frame.keepsTriangles) {
-        resident_->prepare(context_, frame.geometry);
+        resident_->prepare(context_, frame.geometry, gpu::chunkBytesOf(frame.buffers));
         frame.kept[DACRT_BINDING_TRIANGLES] = &resident_->triangles();
         frame.kept[DACRT_BINDING_TRIANGLE_BOUNDS] = &resident_->bounds();
     }
@@ -376,6 +378,8 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .loopBudget = gpu::loopBudgetOf(context_.info()),
         .sharedStart = sharedStart,
         .anyHit = anyHit,
+        .addressed = frame.set->addressed(),
+        .chunkBytes = frame.set->kernelChunkBytes(),
     });
     // Compilation only (a first use; later frames find the pipeline in the cache), so that
     // render and bench can take it out of the frame.
@@ -461,7 +465,7 @@ TraceResult GpuTracer::traceSecondary(GpuPassSource& source, const FrameGeometry
     uploadPass(frame, source);
     compileKernel(frame, false, true);
     const auto start = Clock::now();
-    frame.rayMaker = &pipelines_.secondary();
+    frame.rayMaker = &pipelines_.secondary(frame.set->addressed(), frame.set->kernelChunkBytes());
     frame.set->bindTo(*frame.rayMaker);
     PhaseTimes::addTo(frame.result.phases.pipelineCompile, msSince(start));
     dispatchPass(frame, source, pass);
@@ -490,13 +494,12 @@ void GpuTracer::divideForSecondaryRays(GpuPassSource& source, const FrameGeometr
     const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, tuning_.profile, regions);
     source.work = gpu::planWorkItems(source.division, transferSchedule(source.division, false), groups);
     const std::vector<std::uint32_t> ids = gpu::groupTriangleIds(source.division, groups);
+    // Beyond one binding, in the chunks that the passes then address (planPass); on a device
+    // without buffer device addresses the buffer (or the pass's plan) names the limit.
     const std::uint64_t idBytes = std::max<std::uint64_t>(ids.size(), 1) * 8;
-    if (idBytes > device.maxStorageBufferRange)
-        throw InputError("the device buffer of the secondary passes' triangle ids and scratch needs " +
-                         std::to_string(idBytes) + " bytes, more than the device's maxStorageBufferRange of " +
-                         std::to_string(device.maxStorageBufferRange) + " bytes (over by " +
-                         std::to_string(idBytes - device.maxStorageBufferRange) + "); use fewer regions or ray groups");
-    source.triangleIds = std::make_unique<gpu::Buffer>(context_, idBytes, "triangle ids and scratch (secondary passes)");
+    const bool chunked = idBytes > limits_.bindingBytes && limits_.addresses;
+    source.triangleIds = std::make_unique<gpu::Buffer>(context_, idBytes, "triangle ids and scratch (secondary passes)",
+                                                       gpu::BufferUse::Storage, chunked ? limits_.chunkBytes : 0);
     source.triangleIds->upload(ids.data(), ids.size() * sizeof(std::uint32_t));
     source.divided = true;
     result.phases.divide = msSince(start);
@@ -522,10 +525,15 @@ void GpuTracer::planPass(Frame& frame, const GpuPassSource& source, const Second
     frame.kept[DACRT_BINDING_TRI_IDS] = source.triangleIds.get();
     frame.kept[DACRT_BINDING_SOURCE_RAYS] = &primary[DACRT_BINDING_RAYS];
     frame.kept[DACRT_BINDING_SOURCE_HITS] = &primary[DACRT_BINDING_HITS];
+    gpu::addressLargeArrays(frame.buffers, limits_);
+    std::uint64_t kept = source.triangleIds->size(), keptUnbound = 0;
+    for (std::uint32_t k = 0; k < DACRT_BINDING_COUNT; ++k) {
+        kept += primary[k].size();
+        const bool bound = std::find(frame.kept.begin(), frame.kept.end(), &primary[k]) != frame.kept.end();
+        if (!bound) keptUnbound += primary[k].size();
+    }
     MemoryPlan& plan = frame.result.memory;
-    gpu::addToMemoryPlan(frame.buffers, context_.info(), plan, &frame.kept);
-    std::uint64_t kept = source.triangleIds->size();
-    for (std::uint32_t k = 0; k < DACRT_BINDING_COUNT; ++k) kept += primary[k].size();
+    gpu::addToMemoryPlan(frame.buffers, limits_, plan, &frame.kept, keptUnbound);
     plan.add("device: kept from the primary pass (its rays, hits, triangles and work buffers)", kept);
     plan.addWork("rays made on the device", frame.rays,
                  std::to_string(pass.raysPerHit) + " per primary hit, where the surface can send one");

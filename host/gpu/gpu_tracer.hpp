@@ -12,6 +12,7 @@
 #include "cpu/options.hpp"
 #include "cpu/secondary_rays.hpp"
 #include "cpu/trace_result.hpp"
+#include "gpu/binding_set.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
 #include "gpu/resident_triangles.hpp"
@@ -79,6 +80,7 @@ private:
     ThreadPool& pool_;
     TraceOptions options_;
     GpuTuning tuning_;
+    gpu::BufferLimits limits_;  // what bounds each buffer: the device's limits or the tuning's caps
     std::unique_ptr<gpu::PipelineCache> ownPipelines_;  // without `pipelines`: this tracer's
     gpu::PipelineCache& pipelines_;
     gpu::ResidentTriangles* resident_;

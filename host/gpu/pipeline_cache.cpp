@@ -8,7 +8,7 @@
 namespace dacrt::gpu {
 
 std::vector<std::uint32_t> KernelSpecialization::values() const {
-    std::vector<std::uint32_t> v(7);
+    std::vector<std::uint32_t> v(DACRT_SPEC_COUNT);
     v[DACRT_SPEC_WORKGROUP_SIZE] = workgroupSize;
     v[DACRT_SPEC_RAY_LIMIT] = rayLimit;
     v[DACRT_SPEC_TRI_LIMIT] = triLimit;
@@ -16,18 +16,26 @@ std::vector<std::uint32_t> KernelSpecialization::values() const {
     v[DACRT_SPEC_LOOP_BUDGET] = loopBudget;
     v[DACRT_SPEC_SHARED_START] = sharedStart ? 1u : 0u;
     v[DACRT_SPEC_ANY_HIT] = anyHit ? 1u : 0u;
+    v[DACRT_SPEC_CHUNK_BYTES] = chunkBytes;
     return v;
 }
 
 namespace {
 
+// One of everything: the buffers a pipeline's first, empty dispatch binds.
+DacrtBufferPlan primingPlan(bool addressed) {
+    DacrtBufferPlan plan = planDacrtBuffers(DacrtBufferCounts{
+        .rays = 1, .triangles = 1, .rayIds = 1, .triangleIds = 1, .regions = 1, .workItems = 1, .maxDepth = 0});
+    if (addressed) chunkAddressedArrays(plan, DACRT_CHUNK_ALIGNMENT);
+    return plan;
+}
+
 // Runs the kernel once over a work item that is already finished, so that a driver that
 // compiles at the first dispatch (lavapipe does: about 10 s for this kernel on Mesa 25.0.7
 // without its shader cache) does so here, where the time is reported as the pipeline's, and
 // not inside a frame's dispatches.
-void prime(Context& context, ComputePipeline& pipeline) {
-    DacrtBindingSet set(context, planDacrtBuffers(DacrtBufferCounts{
-                                     .rays = 1, .triangles = 1, .rayIds = 1, .triangleIds = 1, .regions = 1, .workItems = 1, .maxDepth = 0}));
+void prime(Context& context, ComputePipeline& pipeline, bool addressed) {
+    DacrtBindingSet set(context, primingPlan(addressed));
     TraversalState finished{};
     finished.phase = 2;  // kPhaseFinished in shaders/dacrt.comp
     set[DACRT_BINDING_STATES].upload(&finished, sizeof(finished));
@@ -44,33 +52,36 @@ void prime(Context& context, ComputePipeline& pipeline) {
 
 ComputePipeline& PipelineCache::kernel(const KernelSpecialization& specialization) {
     const std::vector<std::uint32_t> values = specialization.values();
-    std::unique_ptr<ComputePipeline>& slot = pipelines_[values];
+    const bool addressed = specialization.addressed;
+    std::unique_ptr<ComputePipeline>& slot = pipelines_[{addressed, values}];
     if (!slot) {
-        slot = std::make_unique<ComputePipeline>(context_, dacrtKernelSpirv(), DACRT_BINDING_COUNT, sizeof(DacrtPush),
-                                                 values, "dacrt");
-        prime(context_, *slot);
+        slot = std::make_unique<ComputePipeline>(context_, addressed ? dacrtKernelAddressedSpirv() : dacrtKernelSpirv(),
+                                                 DACRT_BINDING_COUNT, sizeof(DacrtPush), values,
+                                                 addressed ? "dacrt (addressed)" : "dacrt");
+        prime(context_, *slot, addressed);
     }
     return *slot;
 }
 
-ComputePipeline& PipelineCache::secondary() {
-    if (!secondary_) {
-        std::vector<std::uint32_t> values(7, 0);
+ComputePipeline& PipelineCache::secondary(bool addressed, std::uint32_t chunkBytes) {
+    std::unique_ptr<ComputePipeline>& slot = secondary_[{addressed, chunkBytes}];
+    if (!slot) {
+        std::vector<std::uint32_t> values(DACRT_SPEC_COUNT, 0);
         values[DACRT_SPEC_WORKGROUP_SIZE] = kSecondaryWorkgroup;
         values[DACRT_SPEC_MAX_DEPTH] = 1;  // the kernel has no traversal stack to size
-        secondary_ = std::make_unique<ComputePipeline>(context_, secondarySpirv(), DACRT_BINDING_COUNT,
-                                                       sizeof(SecondaryPush), values, "secondary");
+        values[DACRT_SPEC_CHUNK_BYTES] = chunkBytes;
+        slot = std::make_unique<ComputePipeline>(context_, addressed ? secondaryAddressedSpirv() : secondarySpirv(),
+                                                 DACRT_BINDING_COUNT, sizeof(SecondaryPush), values, "secondary");
         // As prime() does for the kernel: a step that does nothing, so that lavapipe compiles now.
-        DacrtBindingSet set(context_, planDacrtBuffers(DacrtBufferCounts{
-                                          .rays = 1, .triangles = 1, .rayIds = 1, .triangleIds = 1, .regions = 1, .workItems = 1, .maxDepth = 0}));
-        set.bindTo(*secondary_);
+        DacrtBindingSet set(context_, primingPlan(addressed));
+        set.bindTo(*slot);
         DispatchRecorder recorder(context_, 1);
         SecondaryPush push{};
         push.step = 3;  // none of shaders/secondary.comp's steps
-        recorder.dispatch("prime", *secondary_, 1, &push);
+        recorder.dispatch("prime", *slot, 1, &push);
         recorder.submitAndWait();
     }
-    return *secondary_;
+    return *slot;
 }
 
 ComputePipeline& PipelineCache::rayQuery() {

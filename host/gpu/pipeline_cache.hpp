@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "gpu/compute_pipeline.hpp"
@@ -19,6 +20,10 @@ struct KernelSpecialization {
     std::uint32_t loopBudget = 0;
     bool sharedStart = false;
     bool anyHit = false;
+    // The addressed kernel (DACRT_ADDRESSED) rather than the one that binds every array, with
+    // chunks of chunkBytes (0: every array one chunk): DacrtBindingSet::addressed, kernelChunkBytes.
+    bool addressed = false;
+    std::uint32_t chunkBytes = 0;
     std::vector<std::uint32_t> values() const;  // in constant_id order
 };
 
@@ -29,8 +34,8 @@ public:
     explicit PipelineCache(Context& context) : context_(context) {}
     ComputePipeline& kernel(const KernelSpecialization& specialization);
     // shaders/secondary.comp: a secondary pass's rays made and binned on the device (the DACRT
-    // binding set; kSecondaryWorkgroup invocations a workgroup).
-    ComputePipeline& secondary();
+    // binding set; kSecondaryWorkgroup invocations a workgroup); addressed as the kernel is.
+    ComputePipeline& secondary(bool addressed = false, std::uint32_t chunkBytes = 0);
     // shaders/rayquery.comp: rays, hits, the top-level acceleration structure.
     ComputePipeline& rayQuery();
     // Whether the ray-query pipeline has run once (its caller primes it: the shader binds an
@@ -41,9 +46,9 @@ public:
 private:
     Context& context_;
     std::unique_ptr<ComputePipeline> rayQuery_;
-    std::unique_ptr<ComputePipeline> secondary_;
+    std::map<std::pair<bool, std::uint32_t>, std::unique_ptr<ComputePipeline>> secondary_;  // by addressed, chunkBytes
     bool rayQueryPrimed_ = false;
-    std::map<std::vector<std::uint32_t>, std::unique_ptr<ComputePipeline>> pipelines_;
+    std::map<std::pair<bool, std::vector<std::uint32_t>>, std::unique_ptr<ComputePipeline>> pipelines_;
 };
 
 }  // namespace dacrt::gpu

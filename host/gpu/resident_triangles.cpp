@@ -6,14 +6,15 @@ bool ResidentTriangles::holds(const FrameGeometry& g) const {
     return triangles_ && g.trianglesVersion != 0 && g.trianglesVersion == version_ && g.triangles->size() == count_;
 }
 
-void ResidentTriangles::prepare(const Context& context, const FrameGeometry& g) {
-    if (holds(g)) return;
+void ResidentTriangles::prepare(const Context& context, const FrameGeometry& g, std::uint64_t chunkBytes) {
+    if (holds(g) && chunkBytes == chunkBytes_) return;
     const std::uint64_t n = g.triangles->size();
-    if (!triangles_ || count_ != n) {
+    if (!triangles_ || count_ != n || chunkBytes != chunkBytes_) {
         triangles_.reset();
         bounds_.reset();
-        triangles_ = std::make_unique<Buffer>(context, n * sizeof(Triangle), "triangles");
-        bounds_ = std::make_unique<Buffer>(context, n * sizeof(Bounds), "triangle bounds");
+        triangles_ = std::make_unique<Buffer>(context, n * sizeof(Triangle), "triangles", BufferUse::Storage, chunkBytes);
+        bounds_ = std::make_unique<Buffer>(context, n * sizeof(Bounds), "triangle bounds", BufferUse::Storage, chunkBytes);
+        chunkBytes_ = chunkBytes;
     }
     triangles_->upload(g.triangles->data(), n * sizeof(Triangle));
     bounds_->upload(g.triangleBounds->data(), n * sizeof(Bounds));

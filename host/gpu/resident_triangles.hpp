@@ -15,8 +15,9 @@ class ResidentTriangles {
 public:
     // Whether the buffers already hold g's triangles and bounds.
     bool holds(const FrameGeometry& g) const;
-    // Makes them hold g's (allocating and uploading unless holds(g)).
-    void prepare(const Context& context, const FrameGeometry& g);
+    // Makes them hold g's (allocating and uploading unless holds(g)), in chunks of chunkBytes
+    // where the frame addresses its arrays (0: one binding each).
+    void prepare(const Context& context, const FrameGeometry& g, std::uint64_t chunkBytes = 0);
     Buffer& triangles() { return *triangles_; }
     Buffer& bounds() { return *bounds_; }
 
@@ -24,6 +25,7 @@ private:
     std::unique_ptr<Buffer> triangles_, bounds_;
     std::uint64_t version_ = 0;
     std::uint64_t count_ = 0;
+    std::uint64_t chunkBytes_ = 0;
 };
 
 }  // namespace dacrt::gpu

@@ -17,6 +17,14 @@ struct GpuTuning {
     std::uint32_t workgroupSize = 0;  // 0: the profile's default (gpu::defaultWorkgroupSize)
     std::uint32_t rayGroups = 0;      // 0: the profile's default (gpu::defaultRayGroups)
     GpuProfile profile = GpuProfile::Auto;
+    // Caps below the device's own limits, for tests (docs/gpu.md): every array larger than
+    // bufferBytes is reached by device address, as arrays beyond maxStorageBufferRange are, in
+    // chunks of at most chunkBytes (rounded down to a multiple of 192 bytes; else of
+    // maxMemoryAllocationSize); memoryBytes lowers the memory a frame's device buffers may take
+    // together. 0: the device's limit.
+    std::uint64_t bufferBytes = 0;
+    std::uint64_t chunkBytes = 0;
+    std::uint64_t memoryBytes = 0;
 };
 
 // How the BVH follows the frames, as Embree's users configure each case.

@@ -25,6 +25,7 @@ struct VulkanDeviceProperties {
     std::vector<std::string> heaps;  // "N MiB (device-local)"
     std::uint64_t maxStorageBufferRange = 0;
     std::uint64_t maxMemoryAllocationSize = 0;
+    std::uint64_t deviceLocalBytes = 0;  // the largest device-local heap (else the largest heap)
     std::uint32_t maxComputeSharedMemorySize = 0;
     std::uint32_t maxComputeWorkGroupInvocations = 0;
     std::uint32_t maxComputeWorkGroupSizeX = 0;
@@ -34,6 +35,9 @@ struct VulkanDeviceProperties {
     bool subgroupOperations = false;  // compute-stage arithmetic and shuffle operations (the gpu kernel's)
     bool fullSubgroups = false;       // VK_EXT_subgroup_size_control's computeFullSubgroups
     bool timestamps = false;
+    // The bufferDeviceAddress feature (Vulkan 1.2): the gpu backend reaches arrays larger than
+    // maxStorageBufferRange by device address (docs/gpu.md).
+    bool bufferDeviceAddress = false;
     // VK_KHR_acceleration_structure, VK_KHR_ray_query and buffer device addresses, with their
     // features, on Vulkan 1.2 or later: what the rayquery backend needs. Otherwise, what lacks.
     bool rayQuery = false;

@@ -258,7 +258,7 @@ TEST(Cli, DevicesListsTheLimitsThatMatter) {
     if (r.code == 2 && r.output.find("no Vulkan") != std::string::npos) GTEST_SKIP() << r.output;
     ASSERT_EQ(r.code, 0) << r.output;
     for (const char* key : {"0: ", "driver:", "Vulkan:", "memory heaps:", "max storage buffer range:", "max allocation size:",
-                            "compute shared memory:", "workgroup:", "subgroup size:"})
+                            "buffer device addresses:", "compute shared memory:", "workgroup:", "subgroup size:"})
         EXPECT_NE(r.output.find(key), std::string::npos) << key << "\n" << r.output;
 }
 

@@ -1,6 +1,8 @@
 // Whole images: the gpu backend against cpu-seq, bit for bit, under the validation layers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
 #include "support/gpu_support.hpp"
@@ -13,6 +15,12 @@ using namespace dacrt;
 using namespace dacrt::test;
 
 namespace {
+
+const WorkLine* workLine(const MemoryPlan& plan, const std::string& name) {
+    for (const WorkLine& w : plan.work)
+        if (w.name == name) return &w;
+    return nullptr;
+}
 
 Scene shapes() {
     return sceneFromMeshes({icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 3), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 40, 16),
@@ -134,31 +142,35 @@ TEST(GpuImages, SecondaryPassesMadeOnTheDeviceMatchTheHost) {
     view.eye = glm::dvec3(-1.0, 2.0, 4.0);
     const Frame frame(shapes(), 40, 30, view);
     const SecondaryPass directional = directionalShadowPass({0.4, -1.0, -0.3});
-    for (unsigned regions : {1u, 3u})
-        for (std::uint32_t groups : {1u, 2u}) {
-            const TraceOptions o = gpuOptions(regions);
-            ThreadPool pool(2);
-            GpuPassSourcePtr source;
-            GpuTracer tracer(*context, pool, o, GpuTuning{0, groups});
-            const TraceResult primary = tracer.trace(frame.geometry, {}, &source);
-            ASSERT_TRUE(source);
-            for (const SecondaryPass& p : {occlusionPass(3, 0.8f), pointShadowPass({0.3f, 1.6f, 0.4f}), directional}) {
-                SCOPED_TRACE(p.name + ", " + std::to_string(regions) + " regions, " + std::to_string(groups) + " groups");
-                const PassFrame host(frame, primary.hits, p);
-                const std::vector<Hit> expected = hitsPerSlot(host.rays, host.trace(Backend::CpuSeq).hits);
-                const TraceResult device = tracer.traceSecondary(*source, frame.geometry, p);
-                ASSERT_EQ(device.hits.size(), expected.size());
-                std::size_t notTraced = 0, occluded = 0;
-                for (std::size_t i = 0; i < expected.size(); ++i) {
-                    ASSERT_EQ(device.hits[i].prim == kNotTracedPrim, expected[i].prim == kNotTracedPrim) << "slot " << i;
-                    notTraced += expected[i].prim == kNotTracedPrim;
-                    occluded += expected[i].prim != kNotTracedPrim && expected[i].prim != kMissPrim;
-                }
-                EXPECT_TRUE(identicalVisibility(expected, device.hits));
-                EXPECT_GT(occluded, expected.size() / 50);
-                EXPECT_GT(notTraced, 0u);
+    // The last configuration reaches every array by address, in chunks of 4032 bytes.
+    std::vector<std::pair<unsigned, GpuTuning>> configurations = {{1, GpuTuning{0, 1}}, {1, GpuTuning{0, 2}}, {3, GpuTuning{0, 1}},
+                                                                   {3, GpuTuning{0, 2}}};
+    if (context->info().bufferDeviceAddress) configurations.push_back({3, GpuTuning{.rayGroups = 2, .bufferBytes = 4096, .chunkBytes = 4096}});
+    for (const auto& [regions, tuning] : configurations) {
+        const std::uint32_t groups = tuning.rayGroups;
+        const TraceOptions o = gpuOptions(regions);
+        ThreadPool pool(2);
+        GpuPassSourcePtr source;
+        GpuTracer tracer(*context, pool, o, tuning);
+        const TraceResult primary = tracer.trace(frame.geometry, {}, &source);
+        ASSERT_TRUE(source);
+        for (const SecondaryPass& p : {occlusionPass(3, 0.8f), pointShadowPass({0.3f, 1.6f, 0.4f}), directional}) {
+            SCOPED_TRACE(p.name + ", " + std::to_string(regions) + " regions, " + std::to_string(groups) + " groups");
+            const PassFrame host(frame, primary.hits, p);
+            const std::vector<Hit> expected = hitsPerSlot(host.rays, host.trace(Backend::CpuSeq).hits);
+            const TraceResult device = tracer.traceSecondary(*source, frame.geometry, p);
+            ASSERT_EQ(device.hits.size(), expected.size());
+            std::size_t notTraced = 0, occluded = 0;
+            for (std::size_t i = 0; i < expected.size(); ++i) {
+                ASSERT_EQ(device.hits[i].prim == kNotTracedPrim, expected[i].prim == kNotTracedPrim) << "slot " << i;
+                notTraced += expected[i].prim == kNotTracedPrim;
+                occluded += expected[i].prim != kNotTracedPrim && expected[i].prim != kMissPrim;
             }
+            EXPECT_TRUE(identicalVisibility(expected, device.hits));
+            EXPECT_GT(occluded, expected.size() / 50);
+            EXPECT_GT(notTraced, 0u);
         }
+    }
     EXPECT_TRUE(noValidationErrors(*context));
 }
 
@@ -276,7 +288,10 @@ TEST(GpuImages, UnknownDeviceListsTheChoices) {
     }
 }
 
-TEST(GpuImages, ABufferOverTheDeviceLimitIsAClearError) {
+TEST(GpuImages, ARayBufferOverTheBindingLimitIsAddressedOrAClearError) {
+    // One row more rays than one binding holds: planned by device address in chunks where the
+    // device has buffer device addresses (the plan names the limit; the frame stops there),
+    // refused with the limit and the excess where it has not.
     DACRT_REQUIRE_GPU(context);
     const std::uint64_t limit = context->info().maxStorageBufferRange;
     if (limit > (256ull << 20)) GTEST_SKIP() << "the device's storage buffer range is too large to exceed cheaply";
@@ -289,13 +304,87 @@ TEST(GpuImages, ABufferOverTheDeviceLimitIsAClearError) {
     o.regions = 2;
     ThreadPool pool(2);
     try {
-        GpuTracer(*context, pool, o, GpuTuning{}).trace(frame.geometry);
-        FAIL() << "a " << frame.rays.size() * sizeof(Ray) << "-byte ray buffer was accepted";
+        const TraceResult r = GpuTracer(*context, pool, o, GpuTuning{}).trace(frame.geometry, [](const MemoryPlan&) { return false; });
+        ASSERT_TRUE(context->info().bufferDeviceAddress)
+            << "a " << frame.rays.size() * sizeof(Ray) << "-byte ray buffer was accepted without device addresses";
+        const WorkLine* chunks = workLine(r.memory, "addressed chunks");
+        ASSERT_NE(chunks, nullptr);
+        EXPECT_NE(chunks->why.find("maxStorageBufferRange: " + std::to_string(limit)), std::string::npos) << chunks->why;
+        EXPECT_NE(chunks->why.find("maxMemoryAllocationSize"), std::string::npos) << chunks->why;
     } catch (const InputError& e) {
+        EXPECT_FALSE(context->info().bufferDeviceAddress) << e.what();
         const std::string what = e.what();
         EXPECT_NE(what.find("maxStorageBufferRange of " + std::to_string(limit)), std::string::npos) << what;
         EXPECT_NE(what.find("over by"), std::string::npos) << what;
     }
+}
+
+TEST(GpuImages, ArraysInAddressedChunksGiveTheSameHits) {
+    // Caps of 4 KiB address every array of these small frames in chunks of 4032 bytes (84
+    // triangles): with one region, chunk boundaries fall inside its triangles, bounds and ids;
+    // with the camera inside, through transfer rounds and ray groups too.
+    DACRT_REQUIRE_GPU(context);
+    if (!context->info().bufferDeviceAddress) GTEST_SKIP() << "the device lacks bufferDeviceAddress";
+    constexpr GpuTuning kSmallChunks{.bufferBytes = 4096, .chunkBytes = 4096};
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
+    expectGpuMatchesCpu(*context, frame, {1}, kSmallChunks);
+    const Frame inside = insideView({box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)},
+                                    {0.1, 0.0, 0.2}, {0.3, 0.0, -1.0}, 40, 30);
+    EXPECT_GT(expectGpuMatchesCpu(*context, inside, {4}, GpuTuning{.rayGroups = 3, .bufferBytes = 4096, .chunkBytes = 4096}), 0u)
+        << "expected transfer rounds";
+
+    ThreadPool pool(2);
+    const TraceResult r = GpuTracer(*context, pool, gpuOptions(1), kSmallChunks).trace(frame.geometry, [](const MemoryPlan&) { return false; });
+    const WorkLine* chunks = workLine(r.memory, "addressed chunks");
+    ASSERT_NE(chunks, nullptr);
+    EXPECT_NE(chunks->why.find("buffer cap (GpuTuning::bufferBytes): 4096 bytes"), std::string::npos) << chunks->why;
+    EXPECT_NE(chunks->why.find("4032 bytes (chunk cap (GpuTuning::chunkBytes))"), std::string::npos) << chunks->why;
+    const std::uint64_t triangleChunks = (frame.scene.triangles.size() * sizeof(Triangle) + 4031) / 4032;
+    EXPECT_GT(triangleChunks, 2u);
+    const std::string trianglesLine = "device: triangles (" + std::to_string(triangleChunks) + " chunks)";
+    EXPECT_TRUE(std::any_of(r.memory.buffers.begin(), r.memory.buffers.end(),
+                            [&](const auto& b) { return b.first == trianglesLine; }))
+        << r.memory.describe();
+}
+
+TEST(GpuImages, StanfordBunnyAddressed) {
+    // Every array beyond a 1 MiB binding cap, and each in one chunk (the chunk cap is the
+    // device's): the addressed kernel's path for arrays beyond one binding on lavapipe.
+    DACRT_REQUIRE_GPU(context);
+    DACRT_REQUIRE_SHARED_SCENE(path, "bunny.glb");
+    if (!context->info().bufferDeviceAddress) GTEST_SKIP() << "the device lacks bufferDeviceAddress";
+    Scene s = loadGltf(path);
+    const Camera cam = defaultCamera(s, 64, 48);
+    const Frame frame(std::move(s), cam, 64, 48);
+    constexpr GpuTuning kAddressed{.bufferBytes = 1 << 20};
+    expectGpuMatchesCpu(*context, frame, {4}, kAddressed);
+    ThreadPool pool(2);
+    const TraceResult r = GpuTracer(*context, pool, gpuOptions(4), kAddressed).trace(frame.geometry, [](const MemoryPlan&) { return false; });
+    const WorkLine* chunks = workLine(r.memory, "addressed chunks");
+    ASSERT_NE(chunks, nullptr);
+    EXPECT_EQ(chunks->count, std::uint64_t(DACRT_ADDRESSED_ARRAYS)) << r.memory.describeWork();
+}
+
+TEST(GpuImages, AFrameBeyondTheDeviceMemoryIsRefusedBeforeAllocation) {
+    // Every buffer of the frame together against the device's memory (here a cap below it):
+    // refused at the plan, with the limit and the excess, before the plan hook or any upload.
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
+    ThreadPool pool(2);
+    bool planned = false;
+    try {
+        GpuTracer(*context, pool, gpuOptions(2), GpuTuning{.memoryBytes = 65536}).trace(frame.geometry, [&](const MemoryPlan&) {
+            planned = true;
+            return true;
+        });
+        FAIL() << "a frame beyond the memory cap was accepted";
+    } catch (const InputError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("memory cap (GpuTuning::memoryBytes) of 65536 bytes (over by "), std::string::npos) << what;
+    }
+    EXPECT_FALSE(planned);
 }
 
 TEST(GpuImages, TrianglesStayOnTheDeviceAcrossFramesUntilTheyChange) {
