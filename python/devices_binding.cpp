@@ -12,7 +12,9 @@ py::dict vulkanDeviceOf(const VulkanDevice& d) {
     using namespace py::literals;
     return py::dict("index"_a = d.index, "name"_a = d.name, "driver"_a = d.driver, "type"_a = d.type,
                     "api_version"_a = d.apiVersion, "max_storage_buffer_range"_a = d.maxStorageBufferRange,
-                    "max_memory_allocation_size"_a = d.maxMemoryAllocationSize, "ray_query"_a = d.rayQuery,
+                    "max_memory_allocation_size"_a = d.maxMemoryAllocationSize,
+                    "device_local_bytes"_a = d.deviceLocalBytes, "buffer_device_address"_a = d.bufferDeviceAddress,
+                    "ray_query"_a = d.rayQuery,
                     "ray_query_missing"_a = d.rayQueryMissing);
 }
 
