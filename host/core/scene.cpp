@@ -141,4 +141,16 @@ void validateScene(const Scene& scene, ThreadPool* pool) {
         if (i < n) refuseTriangle(scene, i);
 }
 
+std::vector<std::pair<std::string, std::uint64_t>> sceneArrayBytes(const Scene& scene) {
+    auto bytes = [](const auto& v) { return std::uint64_t(v.size()) * sizeof(v[0]); };
+    std::uint64_t textures = 0;
+    for (const Texture& t : scene.textures) textures += t.rgba.size();
+    return {{"triangle sources", bytes(scene.sources)},
+            {"triangle materials", bytes(scene.materialOfTriangle)},
+            {"corner normals", bytes(scene.corners.normals)},
+            {"corner texture coordinates", bytes(scene.corners.texCoords)},
+            {"corner colours", bytes(scene.corners.colors)},
+            {"textures", textures}};
+}
+
 }  // namespace dacrt

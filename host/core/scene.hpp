@@ -152,6 +152,11 @@ struct Scene {
     std::size_t triangleCount() const { return triangles.size(); }
 };
 
+// The bytes of the scene's per-triangle arrays that no tracer's memory plan counts (the plans
+// count the triangles themselves): provenance, materials, corner attributes, and the decoded
+// textures; by name, as render --stats reports them beside the plan.
+std::vector<std::pair<std::string, std::uint64_t>> sceneArrayBytes(const Scene& scene);
+
 struct Box {
     glm::vec3 lo{kNoHitT};
     glm::vec3 hi{-kNoHitT};

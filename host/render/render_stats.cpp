@@ -172,6 +172,14 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     j["memory_plan_bytes"] = memoryJson(r.plan);
     // What the plan is measured against: the whole process, so its peak holds the parsed file,
     // the scene and every earlier frame and pass as well as this frame's buffers.
+    nlohmann::ordered_json sceneBytes;
+    std::uint64_t sceneTotal = 0;
+    for (const auto& [name, bytes] : sceneArrayBytes(scene)) {
+        sceneBytes[jsonKey(name)] = bytes;
+        sceneTotal += bytes;
+    }
+    sceneBytes["total"] = sceneTotal;
+    j["memory_scene_bytes"] = sceneBytes;  // held beside every plan, counted in none
     if (const std::optional<ResidentMemory> m = residentMemory())
         j["memory_measured_bytes"] = {{"resident", m->current}, {"peak_resident", m->peak}};
     nlohmann::ordered_json dropped = nlohmann::ordered_json::array();

@@ -47,6 +47,9 @@ TEST(Cli, StatsMeasureTheResidentMemoryThePlanIsHeldTo) {
     EXPECT_GE(peak, resident);
     EXPECT_GT(j["memory_plan_bytes"]["rays"].get<std::uint64_t>(), 30u << 20);
     EXPECT_GE(peak, j["memory_plan_bytes"]["rays"].get<std::uint64_t>());
+    // The quad's two triangles: 16 bytes of provenance and 4 of material each, no attribute.
+    EXPECT_EQ(j["memory_scene_bytes"]["triangle_sources"].get<std::uint64_t>(), 2u * 16u) << j["memory_scene_bytes"];
+    EXPECT_EQ(j["memory_scene_bytes"]["total"].get<std::uint64_t>(), 2u * (16u + 4u)) << j["memory_scene_bytes"];
 }
 
 TEST(Cli, RenderWritesImageAovAndStats) {

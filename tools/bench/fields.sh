@@ -3,7 +3,8 @@
 # key light's shadow pass, one process per backend so that each process's peak resident
 # memory is its own; the table gives the set-up stages, the primary and shadow passes, the
 # peak (render --stats: memory_measured_bytes) against the plan (memory_plan_bytes.total of
-# the primary pass and of the shadow pass), then checks that the dacrt backends' AOVs agree bit
+# the primary pass and of the shadow pass; Embree's structure is in no plan) plus the scene's
+# arrays that no plan counts (memory_scene_bytes), then checks that the dacrt backends' AOVs agree bit
 # for bit at 160x120. Usage (from the repository root, after building build/dacrt):
 #   tools/bench/fields.sh [N ...]            (default: 3)
 #   BACKENDS="cpu gpu embree" MESA25=1 OUT=dir tools/bench/fields.sh 3 8
@@ -28,7 +29,7 @@ run() {  # run BACKEND[@mesa25] FIELD STATS EXTRA...
   "${prefix[@]}" build/dacrt render "$field" --backend "${backend%@*}" --stats "$stats" "$@"
 }
 
-echo "field | backend | triangles | load ms | evaluate ms | prepare ms | trace ms | shadow ms | total ms | peak MB | plan MB (primary, shadow)"
+echo "field | backend | triangles | load ms | evaluate ms | prepare ms | trace ms | shadow ms | total ms | peak MB | plan MB (primary, shadow) | scene arrays MB | peak / (largest plan + scene arrays)"
 for n in "${sizes[@]}"; do
   field=$out/dragon_field$n.glb
   [ -f "$field" ] || python3 tools/scenes/make_instance_field.py "$dragon" "$n" "$field" >/dev/null
@@ -46,9 +47,13 @@ passes = j.get("passes", [])
 shadow = sum(p["trace_ms"] for p in passes if p.get("kind") == "shadow")
 plans = [j["memory_plan_bytes"].get("total", 0)] + [p["memory_plan_bytes"].get("total", 0) for p in passes if p.get("kind")]
 peak = j.get("memory_measured_bytes", {}).get("peak_resident", 0)
+scene = j.get("memory_scene_bytes", {}).get("total", 0)
+expected = max(plans) + scene
 mb = lambda b: f"{b / 2**20:.0f}"
+ratio = f"{peak / expected:.2f}" if expected and max(plans) else "-"
 print(f"{sys.argv[2]}x{sys.argv[2]} | {sys.argv[3]} | {j['triangles']} | {t['load']:.0f} | {t['evaluate_animation']:.0f} | "
-      f"{t['prepare']:.0f} | {t['trace']:.0f} | {shadow:.0f} | {t['total']:.0f} | {mb(peak)} | {', '.join(mb(p) for p in plans)}")
+      f"{t['prepare']:.0f} | {t['trace']:.0f} | {shadow:.0f} | {t['total']:.0f} | {mb(peak)} | {', '.join(mb(p) for p in plans)} | "
+      f"{mb(scene)} | {ratio}")
 PY
   done
   # The dacrt backends bit for bit at a small size (Embree is a peer, not held to them).
