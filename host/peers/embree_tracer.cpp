@@ -45,7 +45,8 @@ using GeometryHandle = std::unique_ptr<RTCGeometryTy, GeometryReleaser>;
 // One Embree device per thread count for the whole process: a device is Embree's thread pool
 // and ISA dispatch, which a renderer creates once, so a dynamic scene's frame must not pay
 // for it. Deliberately never released: releasing it during static destruction could run
-// after TBB's own teardown.
+// after TBB's own teardown. Held through a pointer that is never destroyed either, so that
+// they stay reachable to the end (LeakSanitizer checks after static destruction).
 struct SharedDevice {
     RTCDevice device = nullptr;
     // Embree passes the error text only to the callback, and may call it from any thread
@@ -62,9 +63,9 @@ struct SharedDevice {
 
 SharedDevice& sharedDevice(unsigned threads) {
     static std::mutex mutex;
-    static std::map<unsigned, SharedDevice*> devices;
+    static auto* const devices = new std::map<unsigned, SharedDevice*>;
     std::lock_guard<std::mutex> lock(mutex);
-    SharedDevice*& slot = devices[threads];
+    SharedDevice*& slot = (*devices)[threads];
     if (!slot) {
         const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
         RTCDevice device = rtcNewDevice(config.c_str());
