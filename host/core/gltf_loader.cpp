@@ -90,6 +90,26 @@ void checkGlbVersion(std::span<const unsigned char> bytes, const std::string& na
         throw InputError(name + ": the GLB header's version is " + str(version) + ", not 2 (glTF 2.0's binary container)");
 }
 
+// tinygltf copies a .glb's BIN chunk by the length the chunk declares, without holding it to
+// the bytes that follow (the glb fuzzer read past a file's end this way): every chunk's
+// declared length is checked against what is left of the file first.
+void checkGlbChunks(std::span<const unsigned char> bytes, const std::string& name) {
+    if (!isBinaryGltf(bytes) || bytes.size() < 12 || readU32(bytes, 8) != bytes.size()) return;  // the parser's to refuse
+    std::size_t at = 12;
+    for (int k = 0; at < bytes.size(); ++k) {
+        if (bytes.size() - at < 8)
+            throw InputError(name + ": the GLB's chunk " + str(k) + " has " + str(bytes.size() - at) +
+                             " bytes, fewer than a chunk header's 8");
+        const std::uint64_t length = readU32(bytes, at);
+        const std::uint32_t type = readU32(bytes, at + 4);
+        const char* kind = type == 0x4E4F534Au ? " (JSON)" : type == 0x004E4942u ? " (BIN)" : "";
+        if (length > bytes.size() - at - 8)
+            throw InputError(name + ": the GLB's chunk " + str(k) + kind + " declares " + str(length) + " bytes, but " +
+                             str(bytes.size() - at - 8) + " follow its header");
+        at += 8 + std::size_t(length);
+    }
+}
+
 // ---- parsing ----------------------------------------------------------------------------
 
 // Memory input never reads files: an external buffer is reported as missing.
@@ -1154,6 +1174,7 @@ std::unique_ptr<GltfDocument::Impl> openDocument(std::span<const unsigned char> 
     d->name = name;
     d->limits = limits;
     checkGlbVersion(bytes, name);
+    checkGlbChunks(bytes, name);
     nlohmann::json json = gltf::parseGltfJson(bytes);
     if (!json.is_discarded()) gltf::checkJsonRules(json, name);
     d->prepared = gltf::prepareForParser(bytes, std::move(json));

@@ -38,6 +38,35 @@ TEST_P(GltfHostile, EndsInOneInputErrorNamingTheFileAndTheProblem) {
 INSTANTIATE_TEST_SUITE_P(Files, GltfHostile, ::testing::ValuesIn(test::hostileGltfFiles()),
                          [](const ::testing::TestParamInfo<HostileGltf>& info) { return info.param.name; });
 
+// A .glb whose BIN chunk declares more bytes than the file holds after it (the glb fuzzer's
+// finding: tinygltf copied the declared length, reading past the file's end).
+TEST(GltfHostile, AGlbChunkLongerThanTheFileIsRefusedBeforeTheParserReadsIt) {
+    auto u32 = [](std::vector<unsigned char>& out, std::uint32_t v) {
+        for (int b = 0; b < 4; ++b) out.push_back((unsigned char)(v >> (8 * b)));
+    };
+    std::string json = R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36}]})";
+    json.resize((json.size() + 3) / 4 * 4, ' ');
+    std::vector<unsigned char> chunks;
+    u32(chunks, std::uint32_t(json.size()));
+    u32(chunks, 0x4E4F534Au);
+    chunks.insert(chunks.end(), json.begin(), json.end());
+    u32(chunks, 36);
+    u32(chunks, 0x004E4942u);
+    chunks.resize(chunks.size() + 34, 0);  // two bytes short of what the chunk declares
+    std::vector<unsigned char> glb = {'g', 'l', 'T', 'F'};
+    u32(glb, 2);
+    u32(glb, std::uint32_t(12 + chunks.size()));
+    glb.insert(glb.end(), chunks.begin(), chunks.end());
+    try {
+        loadGltfFromMemory(glb, "short_bin.glb");
+        FAIL() << "loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("short_bin.glb: the GLB's chunk 1 (BIN) declares 36 bytes, but 34 follow its header"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(GltfHostile, TheSameBytesFromMemoryNeverReadFiles) {
     // A .gltf whose buffer is an external file that exists beside it: read from the file, it
     // loads; from memory, the file is not read.
