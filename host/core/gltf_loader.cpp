@@ -946,24 +946,18 @@ private:
         auto transformOf = [&](std::uint32_t vertex) -> const glm::dmat4& { return skin >= 0 ? placed.skinning[vertex] : world; };
 
         placed.worldPositions = mappedArray<glm::vec3>(vertices);
-        // On the document's threads, each chunk up to its first non-finite vertex; the first of all is reported.
-        std::vector<std::size_t> nonFinite((vertices + kChunk - 1) / kChunk, kNone);
-        document_.threadPool().parallelFor(nonFinite.size(), [&](std::size_t c, unsigned) {
-            for (std::size_t i = c * kChunk; i < std::min(vertices, (c + 1) * kChunk); ++i) {
-                const glm::dvec3 local = localAt(i);
-                if (!finite3(local)) {
-                    nonFinite[c] = i;
-                    return;
-                }
-                placed.worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(local, 1.0));
-            }
+        // On the document's threads; the first non-finite vertex of all is reported.
+        const std::size_t nonFinite = firstFailureInChunks(vertices, kChunk, &document_.threadPool(), [&](std::size_t i) {
+            const glm::dvec3 local = localAt(i);
+            if (!finite3(local)) return false;
+            placed.worldPositions[i] = glm::vec3(transformOf(std::uint32_t(i)) * glm::dvec4(local, 1.0));
+            return true;
         });
-        for (const std::size_t i : nonFinite)
-            if (i != kNone) {
-                const glm::dvec3 p = localAt(i);
-                check_.fail(where + ": vertex " + std::to_string(i) + " has a non-finite position (" + std::to_string(p.x) +
-                            ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
-            }
+        if (nonFinite < vertices) {
+            const glm::dvec3 p = localAt(nonFinite);
+            check_.fail(where + ": vertex " + std::to_string(nonFinite) + " has a non-finite position (" + std::to_string(p.x) +
+                        ", " + std::to_string(p.y) + ", " + std::to_string(p.z) + ")");
+        }
         placed.localNormals = std::move(morphed.normals);
         placed.nodeNormalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
         placed.nodeMirrored = glm::determinant(glm::dmat3(world)) < 0.0;

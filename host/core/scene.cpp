@@ -121,24 +121,13 @@ void validateScene(const Scene& scene, ThreadPool* pool) {
                               : std::string()));
     if (scene.triangles.size() >= kMissPrim)
         throw InputError(scene.name + ": too many triangles for 32-bit primitive ids");
-    // In chunks, each up to its first offending triangle; the first of all is refused.
-    constexpr std::size_t kChunk = 65536;
+    // In chunks on the pool; the first offending triangle of all is refused.
     const std::size_t n = scene.triangles.size();
-    std::vector<std::size_t> firstOffending((n + kChunk - 1) / kChunk, n);
-    const auto checkChunk = [&](std::size_t c, unsigned) {
-        for (std::size_t i = c * kChunk; i < std::min(n, (c + 1) * kChunk); ++i) {
-            const Triangle& t = scene.triangles[i];
-            if (!placeable(t.v0) || !placeable(t.v1) || !placeable(t.v2)) {
-                firstOffending[c] = i;
-                return;
-            }
-        }
-    };
-    if (pool) pool->parallelFor(firstOffending.size(), checkChunk);
-    else
-        for (std::size_t c = 0; c < firstOffending.size(); ++c) checkChunk(c, 0);
-    for (const std::size_t i : firstOffending)
-        if (i < n) refuseTriangle(scene, i);
+    const std::size_t first = firstFailureInChunks(n, 65536, pool, [&](std::size_t i) {
+        const Triangle& t = scene.triangles[i];
+        return placeable(t.v0) && placeable(t.v1) && placeable(t.v2);
+    });
+    if (first < n) refuseTriangle(scene, first);
 }
 
 std::vector<std::pair<std::string, std::uint64_t>> sceneArrayBytes(const Scene& scene) {

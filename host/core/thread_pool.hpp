@@ -1,6 +1,7 @@
 #pragma once
 // A fixed set of worker threads running one parallel loop at a time. The calling thread
 // takes part, so a pool of size 1 runs everything inline.
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
@@ -39,5 +40,27 @@ private:
     unsigned long generation_ = 0;
     bool stopping_ = false;
 };
+
+// Calls visit(i) for every i in [0, n), in chunks of `chunk` on the pool (in order on the
+// calling thread without one), each chunk stopping at its first i for which visit returns
+// false; returns the least such i, or n when there is none. What a sequential loop that stops
+// at its first failure reports, on every thread count.
+template <typename Visit>
+std::size_t firstFailureInChunks(std::size_t n, std::size_t chunk, ThreadPool* pool, Visit&& visit) {
+    std::vector<std::size_t> first((n + chunk - 1) / chunk, n);
+    const auto scan = [&](std::size_t c, unsigned) {
+        for (std::size_t i = c * chunk, end = std::min(n, (c + 1) * chunk); i < end; ++i)
+            if (!visit(i)) {
+                first[c] = i;
+                return;
+            }
+    };
+    if (pool) pool->parallelFor(first.size(), scan);
+    else
+        for (std::size_t c = 0; c < first.size(); ++c) scan(c, 0);
+    for (const std::size_t i : first)
+        if (i < n) return i;
+    return n;
+}
 
 }  // namespace dacrt
