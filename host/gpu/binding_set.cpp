@@ -4,6 +4,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "gpu/buffer_arena.hpp"
 
 namespace dacrt::gpu {
 
@@ -147,8 +148,8 @@ void addToMemoryPlan(const DacrtBufferPlan& buffers, const BufferLimits& limits,
                          "; render fewer pixels or split the scene");
 }
 
-DacrtBindingSet::DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan, const ResidentBuffers& resident) {
-    owned_.reserve(plan.size());  // no reallocation: bound_ points into it
+DacrtBindingSet::DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan, const ResidentBuffers& resident,
+                                 BufferArena* arena) {
     for (std::size_t k = 0; k < plan.size(); ++k) {
         if (resident[k]) {
             if (resident[k]->size() < plan[k].bytes)
@@ -156,8 +157,10 @@ DacrtBindingSet::DacrtBindingSet(const Context& context, const DacrtBufferPlan& 
             bound_[k] = resident[k];
             continue;
         }
-        owned_.emplace_back(context, plan[k].bytes, plan[k].name, BufferUse::Storage, plan[k].chunkBytes);
-        bound_[k] = &owned_.back();
+        held_.push_back(arena ? arena->lease(context, std::uint32_t(k), plan[k])
+                              : std::make_shared<Buffer>(context, plan[k].bytes, plan[k].name, BufferUse::Storage,
+                                                         plan[k].chunkBytes));
+        bound_[k] = held_.back().get();
     }
     if (chunkBytesOf(plan)) writeChunkTable(chunkBytesOf(plan));
 }

@@ -4,6 +4,7 @@
 // and bound. The tracer, the building-block tests and the block benchmark all use it.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -89,9 +90,14 @@ void addToMemoryPlan(const DacrtBufferPlan& buffers, const BufferLimits& limits,
 // Buffers that outlive a binding set, for the bindings that name one (null: the set makes it):
 // ResidentBuffers, above.
 
+class BufferArena;
+
 class DacrtBindingSet {
 public:
-    DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan, const ResidentBuffers& resident = {});
+    // Bindings without a resident buffer get one leased from `arena` (kept there for later
+    // frames once this set is gone), else one of their own.
+    DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan, const ResidentBuffers& resident = {},
+                    BufferArena* arena = nullptr);
 
     Buffer& operator[](std::uint32_t binding) { return *bound_[binding]; }
     const Buffer& operator[](std::uint32_t binding) const { return *bound_[binding]; }
@@ -105,8 +111,8 @@ public:
 private:
     void writeChunkTable(std::uint64_t chunkBytes);
 
-    std::vector<Buffer> owned_;   // the bindings without a resident buffer
-    ResidentBuffers bound_{};     // index = binding; into owned_ (its storage moves with it) or resident
+    std::vector<std::shared_ptr<Buffer>> held_;  // the bindings without a resident buffer: leased or own
+    ResidentBuffers bound_{};     // index = binding; into held_ or resident
     bool addressed_ = false;
     std::uint32_t kernelChunkBytes_ = 0;
 };

@@ -226,7 +226,7 @@ Prelude makeRaysOnDevice(gpu::ComputePipeline& pipeline, const SecondaryPush& ba
 void checkGpuOptions(const TraceOptions& options) { checkTraceOptions(options); }
 
 GpuTracer::GpuTracer(gpu::Context& context, ThreadPool& pool, const TraceOptions& options, const GpuTuning& tuning,
-                     gpu::PipelineCache* pipelines, gpu::ResidentTriangles* resident)
+                     gpu::PipelineCache* pipelines, gpu::ResidentTriangles* resident, gpu::BufferArena* arena)
     : context_(context),
       pool_(pool),
       options_(options),
@@ -234,7 +234,8 @@ GpuTracer::GpuTracer(gpu::Context& context, ThreadPool& pool, const TraceOptions
       limits_(gpu::bufferLimits(context.info(), tuning)),
       ownPipelines_(pipelines ? nullptr : std::make_unique<gpu::PipelineCache>(context)),
       pipelines_(pipelines ? *pipelines : *ownPipelines_),
-      resident_(resident) {
+      resident_(resident),
+      arena_(arena) {
     checkGpuOptions(options);
 }
 
@@ -313,6 +314,7 @@ void GpuTracer::planMemory(Frame& frame) const {
     plan.add("host: triangle ids per ray group", frame.triIdCount * 4);
     gpu::addressLargeArrays(frame.buffers, limits_);
     gpu::addToMemoryPlan(frame.buffers, limits_, plan);
+    planBufferReuse(frame);
     plan.work.insert(plan.work.end(), frame.hostPlan.work.begin(), frame.hostPlan.work.end());
     gpu::addWorkItemLines(work, plan);
     const std::uint64_t triangleBytes = std::uint64_t(g.triangles->size()) * (sizeof(Triangle) + sizeof(Bounds));
@@ -329,6 +331,16 @@ void GpuTracer::planMemory(Frame& frame) const {
                  work.items.size() * sizeof(TraversalState), "hits, regions and work item states (their costs)");
 }
 
+// The frame's buffers that an earlier frame left in the arena: reused, not allocated.
+void GpuTracer::planBufferReuse(Frame& frame) const {
+    if (!arena_) return;
+    gpu::BoundElsewhere elsewhere{};
+    for (std::uint32_t k = 0; k < DACRT_BINDING_COUNT; ++k) elsewhere[k] = frame.kept[k] != nullptr;
+    elsewhere[DACRT_BINDING_TRIANGLES] = elsewhere[DACRT_BINDING_TRIANGLE_BOUNDS] = frame.keepsTriangles || elsewhere[DACRT_BINDING_TRIANGLES];
+    frame.result.memory.addWork("device buffers reused from an earlier frame (bytes)", arena_->reusableBytes(frame.buffers, elsewhere),
+                                "the rest allocated now, then kept for the next frame");
+}
+
 // Creates the frame's buffers and fills them.
 void GpuTracer::upload(Frame& frame) const {
     const auto start = Clock::now();
@@ -337,7 +349,7 @@ void GpuTracer::upload(Frame& frame) const {
         frame.kept[DACRT_BINDING_TRIANGLES] = &resident_->triangles();
         frame.kept[DACRT_BINDING_TRIANGLE_BOUNDS] = &resident_->bounds();
     }
-    frame.set = std::make_unique<gpu::DacrtBindingSet>(context_, frame.buffers, frame.kept);
+    frame.set = std::make_unique<gpu::DacrtBindingSet>(context_, frame.buffers, frame.kept, arena_);
     gpu::DacrtBindingSet& set = *frame.set;
     const FrameGeometry& g = frame.geometry;
     const gpu::WorkPlan& work = *frame.work;
@@ -535,6 +547,7 @@ void GpuTracer::planPass(Frame& frame, const GpuPassSource& source, const Second
     MemoryPlan& plan = frame.result.memory;
     gpu::addToMemoryPlan(frame.buffers, limits_, plan, &frame.kept, keptUnbound);
     plan.add("device: kept from the primary pass (its rays, hits, triangles and work buffers)", kept);
+    planBufferReuse(frame);
     plan.addWork("rays made on the device", frame.rays,
                  std::to_string(pass.raysPerHit) + " per primary hit, where the surface can send one");
     gpu::addWorkItemLines(source.work, plan);
@@ -542,7 +555,7 @@ void GpuTracer::planPass(Frame& frame, const GpuPassSource& source, const Second
 
 void GpuTracer::uploadPass(Frame& frame, const GpuPassSource& source) const {
     const auto start = Clock::now();
-    frame.set = std::make_unique<gpu::DacrtBindingSet>(context_, frame.buffers, frame.kept);
+    frame.set = std::make_unique<gpu::DacrtBindingSet>(context_, frame.buffers, frame.kept, arena_);
     gpu::DacrtBindingSet& set = *frame.set;
     const GpuCounters zero{};
     const std::vector<TraversalState> fresh(source.work.items.size(), TraversalState{});

@@ -15,6 +15,7 @@
 #include "gpu/binding_set.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
+#include "gpu/buffer_arena.hpp"
 #include "gpu/resident_triangles.hpp"
 
 namespace dacrt {
@@ -39,10 +40,12 @@ class GpuTracer {
 public:
     // Pipelines come from `pipelines` when given (kept across frames), else are made for this
     // tracer alone. With `resident` (and options.skips.uploads), the triangles and bounds stay
-    // on the device between frames of the same FrameGeometry::trianglesVersion.
+    // on the device between frames of the same FrameGeometry::trianglesVersion. With `arena`,
+    // every other buffer is leased from it, and kept there for the next frame.
     // Throws InputError for options the kernel does not run (checkGpuOptions).
     GpuTracer(gpu::Context& context, ThreadPool& pool, const TraceOptions& options, const GpuTuning& tuning,
-              gpu::PipelineCache* pipelines = nullptr, gpu::ResidentTriangles* resident = nullptr);
+              gpu::PipelineCache* pipelines = nullptr, gpu::ResidentTriangles* resident = nullptr,
+              gpu::BufferArena* arena = nullptr);
     ~GpuTracer();
 
     // Traces one frame. With `keep`, the frame's device buffers are kept there for
@@ -63,6 +66,7 @@ private:
     // A primary frame's stages.
     void divide(Frame& frame);
     void planMemory(Frame& frame) const;
+    void planBufferReuse(Frame& frame) const;
     void upload(Frame& frame) const;
     void dispatch(Frame& frame) const;
     void readBack(Frame& frame) const;
@@ -84,6 +88,7 @@ private:
     std::unique_ptr<gpu::PipelineCache> ownPipelines_;  // without `pipelines`: this tracer's
     gpu::PipelineCache& pipelines_;
     gpu::ResidentTriangles* resident_;
+    gpu::BufferArena* arena_;
 };
 
 }  // namespace dacrt

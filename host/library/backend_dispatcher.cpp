@@ -39,6 +39,7 @@ BackendDispatcher::BackendDispatcher(const DeviceChoice& devices, const std::vec
         gpu_ = std::make_unique<gpu::Context>(gpu::ContextOptions{devices.device, devices.validate});
         pipelines_ = std::make_unique<gpu::PipelineCache>(*gpu_);
         resident_ = std::make_unique<gpu::ResidentTriangles>();
+        arena_ = std::make_unique<gpu::BufferArena>();
     }
 }
 
@@ -103,7 +104,10 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
     switch (request.trace.backend) {
         case Backend::Gpu:
             if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
-            return GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get())
+            // The last frame's buffers kept for its passes go back to the arena for this one.
+            if (request.keepForPasses) passSource_.reset();
+            return GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get(),
+                             arena_.get())
                 .trace(geometry, onPlan,
                        request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
         case Backend::Embree: {
@@ -132,7 +136,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     // On gpu the rays are made where the primary pass left its hits; a frame the skips left
     // empty (no triangle: every primary ray misses) kept nothing there, and makes no ray.
     if (request.trace.backend == Backend::Gpu && passSource_) {
-        out.result = GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get())
+        out.result = GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), nullptr, arena_.get())
                          .traceSecondary(*passSource_, primary, pass, onPlan);
         for (const Hit& h : out.result.hits) out.rays += h.prim != kNotTracedPrim;
         return out;

@@ -103,6 +103,7 @@ private:
     std::unique_ptr<gpu::Context> gpu_;
     std::unique_ptr<gpu::PipelineCache> pipelines_;
     std::unique_ptr<gpu::ResidentTriangles> resident_;  // gpu: the triangles kept on the device
+    std::unique_ptr<gpu::BufferArena> arena_;           // gpu: every other buffer, kept for the next frame
     GpuPassSourcePtr passSource_;                       // gpu: the last frame kept for its secondary passes
     PeerScenes peers_;                                  // embree, rayquery: their structures
     PassCull passCull_;                                 // the last pass's cull, its buffers reused

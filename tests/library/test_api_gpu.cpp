@@ -113,6 +113,44 @@ TEST(ApiGpu, MovedVerticesAreUploadedAgain) {
     EXPECT_EQ(gpu->validationErrors(), 0u);
 }
 
+std::uint64_t reusedBytes(const FramePlan& plan) {
+    for (const FramePlan::Work& w : plan.work)
+        if (w.name == "device buffers reused from an earlier frame (bytes)") return w.count;
+    ADD_FAILURE() << "the plan has no line for reused device buffers";
+    return 0;
+}
+
+// Frames of growing, shrinking and equal ray counts, on two scenes, lease their buffers from
+// what earlier frames left: stale contents of a reused buffer (a larger frame's rays, ids,
+// states) must not reach a later frame's hits.
+TEST(ApiGpu, BuffersKeptBetweenFramesOfEverySizeGiveCpuSeqHits) {
+    std::string why;
+    std::optional<Tracer> gpu = gpuTracer(why);
+    if (!gpu) GTEST_SKIP() << "no Vulkan device: " << why;
+    Tracer cpuSeq(onBackend(Backend::CpuSeq));
+    const test::SceneArrays small = test::randomSceneArrays(71, 600), large = test::randomSceneArrays(72, 3000);
+    const TraceScene scenes[] = {TraceScene::fromArrays(small.positions, small.indices, small.singleSided),
+                                 TraceScene::fromArrays(large.positions, large.indices, large.singleSided)};
+    const struct {
+        int scene;
+        std::uint32_t rays;
+        bool reuses;  // every buffer of the frame fits one an earlier frame left
+    } frames[] = {{0, 9000, false}, {0, 9000, true}, {0, 5000, true}, {1, 2000, false}, {1, 9000, false},
+                  {0, 9000, false}, {1, 7000, true}};
+    for (std::size_t f = 0; f < std::size(frames); ++f) {
+        const TraceScene& scene = scenes[frames[f].scene];
+        const test::RayArrays r = test::randomRayArrays(80 + std::uint32_t(f), frames[f].rays);
+        const RayBatch rays = RayBatch::fromArrays(r.origins, r.directions, {}, r.tmax);
+        const TraceOutput out = gpu->trace(scene, rays);
+        EXPECT_TRUE(sameHits(out.hits, cpuSeq.trace(scene, rays).hits)) << "frame " << f;
+        if (frames[f].reuses) EXPECT_GT(reusedBytes(out.plan), 0u) << "frame " << f;
+        if (f == 0) EXPECT_EQ(reusedBytes(out.plan), 0u);
+        const std::vector<RayHit> any = gpu->occluded(scene, rays).hits;
+        for (std::size_t i = 0; i < any.size(); ++i) ASSERT_EQ(any[i].hit(), out.hits[i].hit()) << "frame " << f << " ray " << i;
+    }
+    EXPECT_EQ(gpu->validationErrors(), 0u);
+}
+
 TEST(ApiGpu, RayQueriesKeepTheirStructureAndFollowTheMove) {
     std::string why;
     std::optional<Tracer> gpu = gpuTracer(why);
