@@ -1,5 +1,6 @@
 #include "gpu/buffer_arena.hpp"
 
+#include "core/errors.hpp"
 #include "gpu/binding_set.hpp"
 
 namespace dacrt::gpu {
@@ -39,18 +40,26 @@ std::uint64_t BufferArena::reusableBytes(const DacrtBufferPlan& plan, const Boun
     return bytes;
 }
 
+void BufferArena::releaseFree(std::uint32_t binding, std::uint64_t before) {
+    std::vector<Kept>& kept = kept_.at(binding);
+    std::erase_if(kept, [&](const Kept& k) { return k.buffer.use_count() == 1 && k.lastFrame < before; });
+}
+
 std::shared_ptr<Buffer> BufferArena::lease(const Context& context, std::uint32_t binding, const PlannedBuffer& planned) {
     std::vector<Kept>& kept = kept_.at(binding);
-    if (const int fit = bestFit(binding, planned); fit >= 0) return kept[std::size_t(fit)].buffer;
-    // A free kept buffer that does not fit is released first, so that its memory is back
-    // before the new one is allocated.
-    for (auto it = kept.begin(); it != kept.end(); ++it)
-        if (it->buffer.use_count() == 1) {
-            kept.erase(it);
-            break;
-        }
-    auto buffer = std::make_shared<Buffer>(context, planned.bytes, planned.name, BufferUse::Storage, planned.chunkBytes);
-    kept.push_back(Kept{buffer, planned.chunkBytes});
+    if (const int fit = bestFit(binding, planned); fit >= 0) {
+        kept[std::size_t(fit)].lastFrame = frame_;
+        return kept[std::size_t(fit)].buffer;
+    }
+    releaseFree(binding, frame_ - 1);
+    std::shared_ptr<Buffer> buffer;
+    try {
+        buffer = std::make_shared<Buffer>(context, planned.bytes, planned.name, BufferUse::Storage, planned.chunkBytes);
+    } catch (const InputError&) {  // out of device memory: what no frame holds now goes first
+        for (std::uint32_t k = 0; k < kept_.size(); ++k) releaseFree(k, frame_ + 1);
+        buffer = std::make_shared<Buffer>(context, planned.bytes, planned.name, BufferUse::Storage, planned.chunkBytes);
+    }
+    kept.push_back(Kept{buffer, planned.chunkBytes, frame_});
     return buffer;
 }
 

@@ -21,10 +21,15 @@ using BoundElsewhere = std::array<bool, DACRT_BINDING_COUNT>;
 
 class BufferArena {
 public:
+    // A new frame begins (its primary pass): buffers that neither it nor the last frame leased
+    // may be released to make room.
+    void startFrame() { ++frame_; }
     // A buffer for `binding` of at least planned.bytes, in planned.chunkBytes chunks (0: one
-    // allocation), that no one else holds now: a kept one that fits, else a new one (which
-    // replaces a kept one that does not fit, so that the arena holds, per binding, no more
-    // buffers than were ever held at once).
+    // allocation), that no one else holds now: a kept one that fits, else a new one. A frame's
+    // passes of different sizes (a primary pass, a shadow pass, four occlusion rays per pixel)
+    // each find their own from the last frame. Before a new one is allocated, the free buffers
+    // of the binding that the last two frames did not use are released; if the device's memory
+    // is still short, every free buffer is.
     std::shared_ptr<Buffer> lease(const Context& context, std::uint32_t binding, const PlannedBuffer& planned);
     // Whether lease() would reuse a kept buffer (for the memory plan, before anything is leased).
     bool wouldReuse(std::uint32_t binding, const PlannedBuffer& planned) const;
@@ -37,10 +42,14 @@ private:
     struct Kept {
         std::shared_ptr<Buffer> buffer;
         std::uint64_t chunkBytes = 0;  // as requested: 0 for one allocation
+        std::uint64_t lastFrame = 0;   // the frame that leased it last
     };
+    // Releases the free buffers of `binding` last leased before frame `before`.
+    void releaseFree(std::uint32_t binding, std::uint64_t before);
     // The free kept buffer of `binding` that suits `planned` best (the smallest that fits), or -1.
     int bestFit(std::uint32_t binding, const PlannedBuffer& planned) const;
     std::array<std::vector<Kept>, DACRT_BINDING_COUNT> kept_;
+    std::uint64_t frame_ = 1;
 };
 
 }  // namespace dacrt::gpu

@@ -106,6 +106,7 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
             if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
             // The last frame's buffers kept for its passes go back to the arena for this one.
             if (request.keepForPasses) passSource_.reset();
+            arena_->startFrame();
             return GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get(),
                              arena_.get())
                 .trace(geometry, onPlan,

@@ -8,8 +8,10 @@
 
 #include "core/camera.hpp"
 #include "cpu/traversal.hpp"
-#include "gpu/buffer.hpp"
-#include "workgroup_test.spv.h"
+#include "gpu/binding_set.hpp"
+#include "gpu/compute_pipeline.hpp"
+#include "gpu/dispatch_recorder.hpp"
+#include "gpu/embedded_shaders.hpp"
 
 using namespace dacrt;
 
@@ -38,25 +40,27 @@ int main(int argc, char** argv) {
     std::vector<std::uint32_t> rayIds(rayCount), triIds(triCount);
     std::iota(rayIds.begin(), rayIds.end(), 0u);
     std::iota(triIds.begin(), triIds.end(), 0u);
-    const std::uint64_t sizes[DACRT_BINDING_COUNT] = {
-        rayCount * sizeof(Ray), triCount * sizeof(Triangle), triCount * sizeof(Bounds), rayCount * sizeof(Hit),
-        rayCount * 8ull, triCount * 8ull, sizeof(Region), sizeof(WorkItem),
-        sizeof(GpuCounters), sizeof(TraversalState), sizeof(StackEntry)};
-    std::vector<gpu::Buffer> buffers;
-    for (std::uint32_t b = 0; b < DACRT_BINDING_COUNT; ++b) buffers.emplace_back(context, sizes[b], "bench");
-    buffers[DACRT_BINDING_RAYS].upload(rays.data(), sizes[DACRT_BINDING_RAYS]);
-    buffers[DACRT_BINDING_TRIANGLES].upload(tris.data(), sizes[DACRT_BINDING_TRIANGLES]);
-    buffers[DACRT_BINDING_TRIANGLE_BOUNDS].upload(bounds.data(), sizes[DACRT_BINDING_TRIANGLE_BOUNDS]);
-    buffers[DACRT_BINDING_HITS].upload(hits.data(), sizes[DACRT_BINDING_HITS]);
-    buffers[DACRT_BINDING_RAY_IDS].upload(rayIds.data(), rayCount * 4ull);
-    buffers[DACRT_BINDING_TRI_IDS].upload(triIds.data(), triCount * 4ull);
+    gpu::DacrtBindingSet set(context, gpu::planDacrtBuffers(gpu::DacrtBufferCounts{
+                                          .rays = rayCount,
+                                          .triangles = triCount,
+                                          .rayIds = rayCount,
+                                          .triangleIds = triCount,
+                                          .regions = 1,
+                                          .workItems = 1,
+                                          .maxDepth = 0,
+                                      }));
+    auto upload = [&](std::uint32_t binding, const auto& v) { set[binding].upload(v.data(), v.size() * sizeof(v[0])); };
+    upload(DACRT_BINDING_RAYS, rays);
+    upload(DACRT_BINDING_TRIANGLES, tris);
+    upload(DACRT_BINDING_TRIANGLE_BOUNDS, bounds);
+    upload(DACRT_BINDING_HITS, hits);
+    upload(DACRT_BINDING_RAY_IDS, rayIds);
+    upload(DACRT_BINDING_TRI_IDS, triIds);
     const std::uint32_t subgroup = context.info().subgroupSize;
     for (std::uint32_t workgroup : {subgroup, 4 * subgroup}) {
-        gpu::ComputePipeline pipeline(context, std::span<const std::uint32_t>(workgroup_test_spv, sizeof(workgroup_test_spv) / 4),
+        gpu::ComputePipeline pipeline(context, gpu::workgroupTestSpirv(),
                                      DACRT_BINDING_COUNT, sizeof(WorkgroupTestPush), {workgroup, 16, 16, 48}, "bench");
-        std::vector<const gpu::Buffer*> bound;
-        for (const gpu::Buffer& b : buffers) bound.push_back(&b);
-        pipeline.bind(bound);
+        set.bindTo(pipeline);
         // Each block runs twice and the second run is reported: the first also pays for the
         // first touch of the scratch memory and the driver's lazy set-up.
         auto run = [&](const char* name, const WorkgroupTestPush& push, double elements) {
