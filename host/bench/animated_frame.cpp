@@ -19,14 +19,48 @@ void nameNewStructure(const BenchConfig& c, std::vector<std::pair<std::string, d
         if (name == made) name += " (new structure)";
 }
 
+// A peer's frame after its work: a new structure's build named apart, the vertex copy
+// reported, the hits kept.
+void finishPeerFrame(const AnimatedConfig& a, bool newScene, double copyMs, const TraceOutput& out, AnimatedWork& w) {
+    if (newScene) nameNewStructure(a.config, w.parts);
+    w.rebuilt = newScene && refits(a.config);
+    w.copyMs = copyMs;
+    w.parts.emplace_back("not counted: vertex copy", copyMs);
+    w.hits = hitsOf(out.hits);
+}
+
+// The frame of embree with its rays made in the loop: a new structure for a new scene (as the
+// Tracer builds one when it meets another scene), else the structure rebuilt or refitted; then
+// the camera's rays made and traced together.
+AnimatedWork traceInLoop(AnimatedConfig& a, const TraceScene& scene, const Camera& camera, int width, int height,
+                         bool newScene, double copyMs, BenchRun& run) {
+    ThreadPool& pool = run.pools.of(a.config.threads());
+    AnimatedWork w;
+    const auto start = Clock::now();
+    PhaseTimes phases;
+    if (newScene) phases.build = a.embree.build(scene, a.config);
+    else phases = a.embree.nextFrame();
+    phases.add(a.embree.tracePrimary(camera, width, height, pool));
+    w.workMs = msSince(start);
+    w.buildMs = phases.structureMs();
+    w.traceMs = w.workMs - *w.buildMs;
+    const TraceOutput out = outputOf(a.embree.hits(), phases, pool.size(), w.workMs);
+    addTraceParts(out, w.parts);
+    finishPeerFrame(a, newScene, copyMs, out, w);
+    return w;
+}
+
 }  // namespace
 
 AnimatedConfig startAnimatedConfig(const BenchConfig& config, const TraceScene& first, BenchRun& run) {
-    return AnimatedConfig{config, {}, prepareStructure(run, config, first)};
+    AnimatedConfig a{config, {}, 0.0, {}};
+    a.initialBuildMs = prepareStructure(run, config, first, a.embree);
+    return a;
 }
 
 AnimatedWork traceAnimatedFrame(AnimatedConfig& a, const TraceScene& scene, const Camera& camera, int width, int height,
                                 bool newScene, double copyMs, BenchRun& run) {
+    if (a.config.raysInLoop) return traceInLoop(a, scene, camera, width, height, newScene, copyMs, run);
     useConfig(run.tracer, a.config);
     AnimatedWork w;
     const bool peer = isPeer(a.config.backend());
@@ -47,13 +81,8 @@ AnimatedWork traceAnimatedFrame(AnimatedConfig& a, const TraceScene& scene, cons
     w.traceMs = tracerMs - compiled - w.buildMs.value_or(0.0);
     w.workMs = w.prepareMs + w.buildMs.value_or(0.0) + w.traceMs;
     addTraceParts(out, w.parts);
-    if (peer) {
-        if (newScene) nameNewStructure(a.config, w.parts);
-        w.rebuilt = newScene && refits(a.config);
-        w.copyMs = copyMs;
-        w.parts.emplace_back("not counted: vertex copy", copyMs);
-    }
-    w.hits = hitsOf(out.hits);
+    if (peer) finishPeerFrame(a, newScene, copyMs, out, w);
+    else w.hits = hitsOf(out.hits);
     return w;
 }
 

@@ -22,6 +22,7 @@ struct AnimatedConfig {
     BenchConfig config;
     std::vector<Ray> rays;        // the camera rays' memory, kept from frame to frame
     double initialBuildMs = 0.0;  // a peer's structure built from the first frame, before the timing
+    InLoopEmbree embree;          // embree with its rays made in the loop: its structure and frame buffer
 };
 
 // The configuration's state for the first frame's scene. A peer's structure is built here,

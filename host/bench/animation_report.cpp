@@ -35,8 +35,6 @@ double mraysOf(std::size_t rays, double ms) { return ms > 0.0 ? double(rays) / (
 
 bool sameConfig(const BenchConfig& a, const BenchConfig& b) { return a.series == b.series && a.name == b.name; }
 
-std::string configLabel(const BenchConfig& c) { return c.name == "default" ? c.series : c.series + " " + c.name; }
-
 Json statsJson(const PhaseStats& s) { return Json{{"mean", s.mean}, {"min", s.min}, {"max", s.max}}; }
 
 Json frameRowJson(const AnimationFrameRow& r) {

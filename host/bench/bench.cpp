@@ -149,6 +149,7 @@ struct Accumulator {
     std::vector<std::string> partOrder;
     std::vector<double> cameraMs;
     std::vector<Ray> rays;  // the camera rays' memory, kept from frame to frame
+    InLoopEmbree embree;    // embree with its rays made in the loop: its structure and frame buffer
 };
 
 // The rows of the scene, each peer's structure built before the frames.
@@ -162,7 +163,7 @@ std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd,
         row.raysPerFrame = std::size_t(cmd.width) * std::size_t(cmd.height);
         row.cameras = int(s.cameras.size());
         row.config = configs[c];
-        prepareStructure(run, row.config, s.traced);
+        prepareStructure(run, row.config, s.traced, acc[c].embree);
     }
     return acc;
 }
@@ -190,7 +191,7 @@ void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, 
         for (Accumulator& a : acc) {
             const BenchConfig& config = a.row.config;
             progress.step(s.name + " " + config.series + " " + config.name + " camera " + std::to_string(k));
-            const FrameOutcome frame = traceStillFrame(config, s.traced, camera, cmd.width, cmd.height, run, a.rays);
+            const FrameOutcome frame = traceStillFrame(config, s.traced, camera, cmd.width, cmd.height, run, a.rays, a.embree);
             settleAfter(config.backend());
             if (w < cmd.warmup) continue;
             a.cameraMs.push_back(frame.ms);

@@ -155,7 +155,9 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
                 if (w == cmd.warmup && c > 0) {  // every backend is deterministic: one run's hits stand for all
                     const bool exact = !isPeer(a.config.backend());
                     if (!exact && bounds.empty()) bounds = allTriangleBounds(posed.triangles);
-                    checkHits(perConfig[0].runs.front().hits, work.hits, exact, posed, bounds, a.rays,
+                    // The frame's camera rays, as cpu-seq's (the first configuration's) trace
+                    // left them: embree with its rays made in the loop stores none.
+                    checkHits(perConfig[0].runs.front().hits, work.hits, exact, posed, bounds, states.front().rays,
                               run.pools.of(a.config.threads()), perConfig[c]);
                 }
                 perConfig[c].runs.push_back(std::move(work));

@@ -15,12 +15,15 @@ void recordConfig(nlohmann::ordered_json& row, const BenchConfig& c) {
     row["threads"] = c.threads();
 }
 
+std::string configLabel(const BenchConfig& c) { return c.name == "default" ? c.series : c.series + " " + c.name; }
+
 std::string optionText(const BenchConfig& c) {
     std::ostringstream s;
     if (c.backend() == Backend::RayQuery) return "build=" + toString(c.options.rayQueryBuild);
     if (c.backend() == Backend::Embree) {
         s << "build=" << toString(c.options.embree.build) << " robust=" << (c.options.embree.robust ? "on" : "off")
-          << " rays=" << (c.options.embree.packets ? "rtcIntersect16_4x4" : "rtcIntersect1") << " threads=" << c.threads()
+          << " rays=" << (c.options.embree.packets ? "rtcIntersect16_4x4" : "rtcIntersect1")
+          << " rays_made=" << (c.raysInLoop ? "in_loop" : "stored_first") << " threads=" << c.threads()
           << " face_filter=" << (c.options.embree.faceFilter ? "on" : "off");
         return s.str();
     }
@@ -48,6 +51,7 @@ BenchConfig baseConfig(Backend b, unsigned hardwareThreads) {
     // (they report every core's, as the threads their host work may use).
     c.options.trace.threads = b == Backend::CpuSeq ? 1u : b == Backend::RayQuery ? 0u : hardwareThreads;
     c.isDefault = true;
+    c.raysInLoop = b == Backend::Embree;  // as Embree's users run it
     return c;
 }
 
@@ -74,8 +78,11 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         return out;
     }
     if (b == Backend::Embree) {
-        // As Embree's users run each case: a series per build mode, robust mode on (the
-        // default, exact on the models) and off, and single rays against packets once.
+        // As Embree's users run each case: a series per build mode, its rays made in the
+        // tracing loop, robust mode on (the default, exact on the models) and off; then the
+        // same with its rays made and stored first and traced through the Tracer (what the
+        // rows were before issue 32), and single rays against packets once (on stored rays:
+        // the in-loop tracer is the packets').
         for (EmbreeBuild build : {EmbreeBuild::Dynamic, EmbreeBuild::Refit, EmbreeBuild::Static}) {
             BenchConfig c = base;
             c.series = "embree " + toString(build);
@@ -83,11 +90,18 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
             c.isDefault = build == EmbreeBuild::Dynamic;
             out.push_back(c);
             c.isDefault = false;
+            BenchConfig stored = c;
+            stored.name = kStoredRays;
+            stored.raysInLoop = false;
             c.name = "robust=off";
             c.options.embree.robust = false;
             out.push_back(c);
+            out.push_back(stored);
         }
-        variant("rtcIntersect1", [](BenchConfig& c) { c.options.embree.packets = false; });
+        variant("rtcIntersect1, " + std::string(kStoredRays), [](BenchConfig& c) {
+            c.options.embree.packets = false;
+            c.raysInLoop = false;
+        });
         out.back().series = "embree dynamic";
         // Without the face rule's filter: what a user whose meshes show no back face runs.
         variant("face-filter=off", [](BenchConfig& c) { c.options.embree.faceFilter = false; });
@@ -170,7 +184,7 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
     std::vector<BenchConfig> out;
     if (isPeer(b)) {
         for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0))
-            if (c.name == "default") out.push_back(c);
+            if (c.name == "default" || c.name == kStoredRays) out.push_back(c);
         return out;
     }
     out.push_back(baseConfig(b, hardwareThreads));

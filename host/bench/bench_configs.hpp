@@ -10,6 +10,13 @@
 
 namespace dacrt {
 
+// The name of the embree rows whose rays are made and stored first, then traced through the
+// Tracer (BenchConfig::raysInLoop false), beside each build mode's default.
+inline constexpr const char* kStoredRays = "stored rays";
+
+// The configuration as the summaries name it: its series, then its name unless "default".
+std::string configLabel(const BenchConfig& c);
+
 // The options of a configuration in full, as the CSV and JSON record them.
 std::string optionText(const BenchConfig& c);
 
@@ -33,7 +40,7 @@ std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads);
 std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads);
 
 // passes: each DACRT backend's default and each build mode of the peers (their defaults
-// otherwise), as the peers suite configures them.
+// otherwise), as the peers suite configures them; for embree also each mode's stored-ray row.
 std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads);
 
 // animation: each DACRT backend's default, and each peer's per-frame modes with their defaults

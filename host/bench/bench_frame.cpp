@@ -24,8 +24,9 @@ void useConfig(Tracer& tracer, const BenchConfig& c) {
     tracer.setOptions(o);
 }
 
-double prepareStructure(BenchRun& run, const BenchConfig& c, const TraceScene& scene) {
+double prepareStructure(BenchRun& run, const BenchConfig& c, const TraceScene& scene, InLoopEmbree& embree) {
     if (!isPeer(c.backend())) return 0.0;
+    if (c.raysInLoop) return embree.build(scene, c);
     useConfig(run.tracer, c);
     const std::vector<float> origin = {0.0f, 0.0f, 0.0f}, direction = {0.0f, 0.0f, -1.0f};
     const RayBatch ray = RayBatch::fromArrays(origin, direction);
@@ -83,9 +84,19 @@ RayBatch makeCameraRays(const Camera& camera, int width, int height, ThreadPool&
 // made on the configuration's threads; dacrt's backends compute the triangles' bounds within
 // the trace, on its threads.
 FrameOutcome traceStillFrame(const BenchConfig& c, const TraceScene& scene, const Camera& camera, int width, int height,
-                             BenchRun& run, std::vector<Ray>& rayBuffer) {
-    useConfig(run.tracer, c);
+                             BenchRun& run, std::vector<Ray>& rayBuffer, InLoopEmbree& embree) {
     FrameOutcome out;
+    if (c.raysInLoop) {
+        ThreadPool& pool = run.pools.of(c.threads());
+        const auto start = Clock::now();
+        PhaseTimes phases = embree.nextFrame();
+        phases.add(embree.tracePrimary(camera, width, height, pool));
+        out.ms = msSince(start);
+        out.output = outputOf(embree.hits(), phases, pool.size(), out.ms);
+        addTraceParts(out.output, out.parts);
+        return out;
+    }
+    useConfig(run.tracer, c);
     const auto start = Clock::now();
     RayBatch rays = makeCameraRays(camera, width, height, run.pools.of(c.threads()), rayBuffer);
     const double raysMs = msSince(start);

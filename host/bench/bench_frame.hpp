@@ -13,6 +13,7 @@
 
 #include "bench/bench.hpp"
 #include "bench/bench_rows.hpp"
+#include "bench/in_loop_embree.hpp"
 #include "core/camera.hpp"
 #include "core/scene.hpp"
 #include "core/thread_pool.hpp"
@@ -44,9 +45,9 @@ void useConfig(Tracer& tracer, const BenchConfig& c);
 
 // A peer's structure over `scene`, built before the frames as its users build it when a scene
 // appears (a trace of one ray: the Tracer builds at a scene's first trace, and the ray queries
-// compile their pipeline there); nothing for dacrt's backends. Returns the milliseconds it
-// took, the pipeline's compilation aside.
-double prepareStructure(BenchRun& run, const BenchConfig& c, const TraceScene& scene);
+// compile their pipeline there; in `embree` where the rays are made in the loop); nothing for
+// dacrt's backends. Returns the milliseconds it took, the pipeline's compilation aside.
+double prepareStructure(BenchRun& run, const BenchConfig& c, const TraceScene& scene, InLoopEmbree& embree);
 
 // The public hits as the oracle, the shading and the checks read them.
 std::vector<Hit> hitsOf(const std::vector<RayHit>& hits);
@@ -82,9 +83,10 @@ struct FrameOutcome {
 
 // A whole primary frame as a user pays for it: the camera's rays, then the Tracer's trace
 // (dacrt's backends: the triangles' bounds, then the backend; a peer: its structure rebuilt,
-// refitted or kept as its build mode says, then the trace).
+// refitted or kept as its build mode says, then the trace); or, for embree with its rays made
+// in the loop, `embree`'s frame (the structure, then the rays made and traced together).
 FrameOutcome traceStillFrame(const BenchConfig& c, const TraceScene& scene, const Camera& camera, int width, int height,
-                             BenchRun& run, std::vector<Ray>& rayBuffer);
+                             BenchRun& run, std::vector<Ray>& rayBuffer, InLoopEmbree& embree);
 
 // After a frame of a Vulkan backend: an untimed pause, so that lavapipe's spinning worker
 // threads do not slow whatever runs next on the same cores.

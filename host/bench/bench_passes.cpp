@@ -58,11 +58,41 @@ PassFrame secondaryPassFrame(const BenchConfig& c, PassOutput& pass) {
     return f;
 }
 
+// One lit frame of embree with its rays made in the loop (in_loop_embree.hpp): the primary
+// pass (the structure, then the camera's rays made and traced), then each secondary pass from
+// its hits (the rays made per packet and traced), each timed around its call.
+std::vector<PassFrame> traceLitFrameInLoop(const BenchConfig& c, const Camera& camera, const BenchCommand& cmd,
+                                           const std::vector<FramePass>& passes, BenchRun& run, InLoopEmbree& embree) {
+    ThreadPool& pool = run.pools.of(c.threads());
+    std::vector<PassFrame> frame(1 + passes.size());
+    // The answers and parts as the Tracer's passes report them, after the pass's time was taken.
+    const auto record = [&](PassFrame& f, double ms, const std::vector<Hit>& hits, const PhaseTimes& phases,
+                            std::uint64_t rays) {
+        f.ms = ms;
+        f.rays = rays;
+        TraceOutput out = outputOf(hits, phases, pool.size(), ms);
+        addTraceParts(out, f.parts);
+        f.hits = std::move(out.hits);
+    };
+    auto start = Clock::now();
+    PhaseTimes primary = embree.nextFrame();
+    primary.add(embree.tracePrimary(camera, cmd.width, cmd.height, pool));
+    record(frame[0], msSince(start), embree.hits(), primary, embree.hits().size());
+    for (std::size_t p = 0; p < passes.size(); ++p) {
+        start = Clock::now();
+        std::uint64_t rays = 0;
+        const PhaseTimes phases = embree.occludeSecondary(passes[p], pool, rays);
+        record(frame[1 + p], msSince(start), embree.slots(), phases, rays);
+    }
+    return frame;
+}
+
 // One lit frame of a configuration: the camera's rays, then the Tracer's frame (traceFrame):
 // the primary pass, then each secondary pass from its hits, back to back as render runs them.
 std::vector<PassFrame> traceLitFrame(const BenchConfig& c, const BenchScene& s, const Camera& camera,
                                      const BenchCommand& cmd, const std::vector<FramePass>& passes, BenchRun& run,
-                                     std::vector<Ray>& rayBuffer) {
+                                     std::vector<Ray>& rayBuffer, InLoopEmbree& embree) {
+    if (c.raysInLoop) return traceLitFrameInLoop(c, camera, cmd, passes, run, embree);
     useConfig(run.tracer, c);
     const auto start = Clock::now();
     RayBatch rays = makeCameraRays(camera, cmd.width, cmd.height, run.pools.of(c.threads()), rayBuffer);
@@ -128,6 +158,7 @@ struct PassTotals {
 struct ConfigRun {
     BenchConfig config;
     std::vector<Ray> rays;
+    InLoopEmbree embree;  // embree with its rays made in the loop: its structure and frame buffers
     std::vector<PassTotals> totals;
 };
 
@@ -148,8 +179,8 @@ void measureCamera(SceneRun& run, std::size_t k, const BenchCommand& cmd, BenchR
     for (int w = 0; w < cmd.warmup + cmd.repeat; ++w) {
         for (std::size_t c = 0; c < run.runs.size(); ++c) {
             ConfigRun& r = run.runs[c];
-            progress.step(s.name + " " + r.config.series + " camera " + std::to_string(k));
-            std::vector<PassFrame> frame = traceLitFrame(r.config, s, s.cameras[k], cmd, run.passes, bench, r.rays);
+            progress.step(s.name + " " + configLabel(r.config) + " camera " + std::to_string(k));
+            std::vector<PassFrame> frame = traceLitFrame(r.config, s, s.cameras[k], cmd, run.passes, bench, r.rays, r.embree);
             settleAfter(r.config.backend());
             if (w < cmd.warmup) continue;
             double frameMs = 0.0;
@@ -193,7 +224,7 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
     for (const BenchConfig& config : configs) {
         ConfigRun r;
         r.config = config;
-        prepareStructure(bench, r.config, s.traced);
+        prepareStructure(bench, r.config, s.traced, r.embree);
         r.totals.resize(run.passes.size() + 2);
         run.runs.push_back(std::move(r));
     }
@@ -275,7 +306,7 @@ nlohmann::ordered_json passRowJson(const PassRow& r) {
 }
 
 void printPassSummary(const std::vector<PassRow>& rows) {
-    std::cout << std::left << std::setw(18) << "series" << std::setw(28) << "pass" << std::right << std::setw(12)
+    std::cout << std::left << std::setw(30) << "series" << std::setw(28) << "pass" << std::right << std::setw(12)
               << "rays" << std::setw(10) << "min ms" << std::setw(10) << "median" << std::setw(9) << "Mray/s"
               << std::setw(10) << "build ms" << std::setw(12) << "mismatches" << "\n";
     std::string scene;
@@ -288,7 +319,7 @@ void printPassSummary(const std::vector<PassRow>& rows) {
         const std::optional<double> build = buildMsOf(r);
         std::ostringstream b;
         if (build) b << std::fixed << std::setprecision(1) << *build;
-        std::cout << std::left << std::setw(18) << r.config.series << std::setw(28) << r.pass << std::right
+        std::cout << std::left << std::setw(30) << configLabel(r.config) << std::setw(28) << r.pass << std::right
                   << std::fixed << std::setprecision(0) << std::setw(12) << r.raysPerFrame << std::setprecision(1)
                   << std::setw(10) << r.msMin << std::setw(10) << r.msMedian << std::setprecision(2) << std::setw(9)
                   << (r.msMedian > 0.0 ? r.raysPerFrame / (r.msMedian * 1e3) : 0.0) << std::setw(10) << b.str()
@@ -329,7 +360,7 @@ int runPassesSuite(const BenchCommand& cmd, const std::vector<BenchConfig>& conf
     int code = (reportValidationErrors(run.tracer, std::cerr) ? kExitValidation : kExitSuccess);
     for (const PassRow& r : rows) {
         if (!r.exactRequired || r.mismatches == 0 || r.kind == "frame") continue;
-        std::cerr << "dacrt bench: error: " << r.scene << ", " << r.config.series << ", " << r.pass << ": "
+        std::cerr << "dacrt bench: error: " << r.scene << ", " << configLabel(r.config) << ", " << r.pass << ": "
                   << r.mismatches << " of " << r.checkedSlots << " slots differ from cpu-seq's (dacrt's backends must "
                   << "match it exactly)\n";
         if (code == kExitSuccess) code = kExitCheckFailed;

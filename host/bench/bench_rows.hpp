@@ -20,6 +20,10 @@ struct BenchConfig {
     std::string name;    // "default" or the option values that differ from it
     TracerOptions options;  // the Vulkan device and validation are the run's (Tracer::setOptions)
     bool isDefault = false;
+    // embree: Embree held by the bench and every ray made in its tracing loop, as a renderer on
+    // it runs (bench/in_loop_embree.hpp); false: rays made and stored first, then traced through
+    // the Tracer (the rows named "stored rays").
+    bool raysInLoop = false;
     Backend backend() const { return options.trace.backend; }
     unsigned threads() const { return traceThreads(options.trace); }
 };

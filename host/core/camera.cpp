@@ -114,7 +114,7 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
 
 std::optional<ViewFrustum> viewFrustum(const Camera& camera, int width, int height) {
     if (camera.projection == Projection::Orthographic) return std::nullopt;
-    // primaryRayRow's directions are forward + sx right + sy up with |sx| <= x and |sy| <= y;
+    // PixelRays' directions are forward + sx right + sy up with |sx| <= x and |sy| <= y;
     // n . d is affine in (sx, sy), so the rectangle's edges bound it.
     const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
     const double y = std::tan(0.5 * camera.yfovRadians), x = y * double(width) / double(height);
@@ -125,14 +125,24 @@ std::optional<ViewFrustum> viewFrustum(const Camera& camera, int width, int heig
     return f;
 }
 
-Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
+namespace {
+
+// makeRay's checks and direction: normalized in double, rounded to float, components below
+// 2^-64 flushed to zero (so 1/dir <= 2^64).
+glm::vec3 checkedUnitDirection(const glm::vec3& origin, const glm::dvec3& direction) {
     if (!finite(glm::dvec3(origin)) || !finite(direction) || glm::length(direction) == 0.0)
         throw InputError("ray: origin " + str(glm::dvec3(origin)) + " and direction " + str(direction) +
                          " must be finite and the direction non-zero");
     glm::vec3 d = glm::vec3(glm::normalize(direction));
     for (int a = 0; a < 3; ++a)
         if (std::abs(d[a]) < 0x1p-64f) d[a] = 0.0f;  // keeps every slab bound finite (predicates.glsl)
+    return d;
+}
 
+}  // namespace
+
+Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
+    const glm::vec3 d = checkedUnitDirection(origin, direction);
     Ray r{};
     r.origin = origin;
     r.tmin = tmin;
@@ -149,39 +159,59 @@ Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin) {
     return r;
 }
 
+PixelRays::PixelRays(const Camera& camera, int width, int height, glm::dvec2 offset)
+    : camera_(camera),
+      width_(width),
+      height_(height),
+      offset_(offset),
+      right_(glm::normalize(glm::cross(camera.forward, camera.up))),
+      aspect_(double(width) / double(height)),
+      halfHeight_(camera.projection == Projection::Orthographic ? camera.ymag : std::tan(0.5 * camera.yfovRadians)),
+      orthographic_(camera.projection == Projection::Orthographic),
+      origin_(glm::vec3(camera.eye)) {}
+
+std::pair<glm::vec3, glm::dvec3> PixelRays::unrounded(int x, int y) const {
+    const double sx = (2.0 * (x + offset_.x) / width_ - 1.0) * halfHeight_ * aspect_;
+    const double sy = (1.0 - 2.0 * (y + offset_.y) / height_) * halfHeight_;
+    const glm::dvec3 offPlane = sx * right_ + sy * camera_.up;
+    if (orthographic_) return {glm::vec3(camera_.eye + offPlane), camera_.forward};
+    return {origin_, camera_.forward + offPlane};
+}
+
+Ray PixelRays::ray(int x, int y) const {
+    const auto [origin, direction] = unrounded(x, y);
+    return makeRay(origin, direction);
+}
+
+PixelRays::OriginAndDirection PixelRays::originAndDirection(int x, int y) const {
+    const auto [origin, direction] = unrounded(x, y);
+    return {origin, checkedUnitDirection(origin, direction)};
+}
+
 namespace {
 
-void primaryRayRow(const Camera& camera, int width, int height, glm::dvec2 offset, int y, Ray* row) {
-    const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
-    const double aspect = double(width) / double(height);
-    const bool orthographic = camera.projection == Projection::Orthographic;
-    const double halfHeight = orthographic ? camera.ymag : std::tan(0.5 * camera.yfovRadians);
-    const glm::vec3 origin = glm::vec3(camera.eye);
-    for (int x = 0; x < width; ++x) {
-        const double sx = (2.0 * (x + offset.x) / width - 1.0) * halfHeight * aspect;
-        const double sy = (1.0 - 2.0 * (y + offset.y) / height) * halfHeight;
-        const glm::dvec3 offPlane = sx * right + sy * camera.up;
-        row[x] = orthographic ? makeRay(glm::vec3(camera.eye + offPlane), camera.forward)
-                              : makeRay(origin, camera.forward + offPlane);
-    }
+void primaryRayRow(const PixelRays& pixels, int width, int y, Ray* row) {
+    for (int x = 0; x < width; ++x) row[x] = pixels.ray(x, y);
 }
 
 }  // namespace
 
 std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::dvec2 offset) {
     std::vector<Ray> rays(std::size_t(width) * std::size_t(height));
-    for (int y = 0; y < height; ++y) primaryRayRow(camera, width, height, offset, y, &rays[std::size_t(y) * std::size_t(width)]);
+    const PixelRays pixels(camera, width, height, offset);
+    for (int y = 0; y < height; ++y) primaryRayRow(pixels, width, y, &rays[std::size_t(y) * std::size_t(width)]);
     return rays;
 }
 
 void primaryRays(const Camera& camera, int width, int height, ThreadPool& pool, std::vector<Ray>& rays,
                  glm::dvec2 offset) {
     rays.resize(std::size_t(width) * std::size_t(height));
+    const PixelRays pixels(camera, width, height, offset);
     std::exception_ptr failure;
     std::mutex failureMutex;
     pool.parallelFor(std::size_t(height), [&](std::size_t y, unsigned) {
         try {
-            primaryRayRow(camera, width, height, offset, int(y), &rays[y * std::size_t(width)]);
+            primaryRayRow(pixels, width, int(y), &rays[y * std::size_t(width)]);
         } catch (...) {  // the pool's threads must not throw: the first error is rethrown here
             const std::lock_guard<std::mutex> lock(failureMutex);
             if (!failure) failure = std::current_exception();

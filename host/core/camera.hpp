@@ -3,6 +3,7 @@
 // backend traces exactly these rays.
 #include <array>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -51,6 +52,38 @@ std::optional<ViewFrustum> viewFrustum(const Camera& camera, int width, int heig
 // watertight-test permutation and shear precomputed. Throws InputError on a zero or
 // non-finite direction or origin.
 Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin = 0.0f);
+
+// primaryRays' arithmetic one pixel at a time, for a tracer that makes each ray where it traces
+// it (the Embree peer's packets, peers/embree_in_loop.hpp), never storing a frame of rays:
+// ray(x, y) is primaryRays' ray of pixel (x, y) bit for bit, and origin and direction are its
+// fields of the same names alone, without the reciprocals and shear that only dacrt reads.
+class PixelRays {
+public:
+    PixelRays(const Camera& camera, int width, int height, glm::dvec2 offset = {0.5, 0.5});
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+    Ray ray(int x, int y) const;
+
+    struct OriginAndDirection {
+        glm::vec3 origin;
+        glm::vec3 direction;  // unit up to rounding
+    };
+    OriginAndDirection originAndDirection(int x, int y) const;
+
+private:
+    // The ray's float32 origin and its direction before makeRay rounds it.
+    std::pair<glm::vec3, glm::dvec3> unrounded(int x, int y) const;
+
+    Camera camera_;
+    int width_ = 1, height_ = 1;
+    glm::dvec2 offset_;
+    glm::dvec3 right_;
+    double aspect_ = 1.0, halfHeight_ = 0.0;
+    bool orthographic_ = false;
+    glm::vec3 origin_;
+};
 
 // One ray per pixel through the point `offset` of the pixel (in pixel units from its top-left
 // corner; the centre by default), row-major from the top-left pixel. Perspective rays start at

@@ -54,22 +54,12 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
         const std::size_t begin = primary.size() * c / chunks, end = primary.size() * (c + 1) / chunks;
         std::size_t next = firstSlot(c);
-        for (std::size_t i = begin; i < end; ++i) {
-            const Hit& hit = primaryHits[i];
-            if (hit.prim == kMissPrim || hit.prim == kNotTracedPrim) continue;
-            const shared::SurfaceSample surface = shared::surfaceOfHit(primary[i], hit, triangles[hit.prim]);
-            for (std::uint32_t k = 0; k < perHit; ++k) {
-                const std::uint32_t slot = std::uint32_t(i) * perHit + k;
-                const shared::GeneratedRay g =
-                    pass.kind == shared::kPassShadow
-                        ? shared::shadowRay(surface, pass.light)
-                        : shared::occlusionRay(surface, occlusionStream(pass, std::uint32_t(i), k), pass.sampleSeed,
-                                               pass.occlusionDistance);
-                if (!g.traced) continue;
-                out.rays[next] = g.ray;
-                out.slots[next++] = slot;
-            }
-        }
+        for (std::size_t i = begin; i < end; ++i)
+            secondaryRaysOf(pass, std::uint32_t(i), primaryHits[i], [&]() -> const Ray& { return primary[i]; }, triangles,
+                            [&](std::uint32_t slot, const Ray& ray) {
+                                out.rays[next] = ray;
+                                out.slots[next++] = slot;
+                            });
         made[c] = next - firstSlot(c);
     });
     std::size_t total = 0;

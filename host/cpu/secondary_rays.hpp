@@ -56,6 +56,24 @@ ShadowLight shadowLightOf(const Light& light);
 // that a pass split into batches of samples makes the rays the whole pass would.
 std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, std::uint32_t k);
 
+// The rays primary ray i sends in the pass, in slot order: emit(slot, ray) for each one made
+// (slot i * raysPerHit + k): none from a miss, a shadow ray only where the light can reach the
+// surface, the occlusion samples. primaryRay() returns ray i (a Ray), asked for only where it
+// hit: a tracer that makes rays in its loop (peers/embree_in_loop.hpp) makes it only there.
+template <typename PrimaryRay, typename Emit>
+void secondaryRaysOf(const SecondaryPass& pass, std::uint32_t i, const Hit& hit, PrimaryRay&& primaryRay,
+                     const std::vector<Triangle>& triangles, Emit&& emit) {
+    if (hit.prim == kMissPrim || hit.prim == kNotTracedPrim) return;
+    const shared::SurfaceSample surface = shared::surfaceOfHit(primaryRay(), hit, triangles[hit.prim]);
+    for (std::uint32_t k = 0; k < pass.raysPerHit; ++k) {
+        const shared::GeneratedRay g =
+            pass.kind == shared::kPassShadow
+                ? shared::shadowRay(surface, pass.light)
+                : shared::occlusionRay(surface, occlusionStream(pass, i, k), pass.sampleSeed, pass.occlusionDistance);
+        if (g.traced) emit(i * pass.raysPerHit + k, g.ray);
+    }
+}
+
 // The rays of a pass: one slot per primary ray and sample (slot = primary index * raysPerHit
 // + sample); slots without a ray (a miss, a surface the light cannot reach) are left out.
 struct SecondaryRays {

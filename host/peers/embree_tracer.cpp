@@ -2,17 +2,15 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <map>
 #include <mutex>
 #include <stdexcept>
 #include <string>
 
 #include <embree3/rtcore.h>
-#include <pmmintrin.h>
-#include <xmmintrin.h>
 
 #include "core/timing.hpp"
+#include "peers/embree_packets.hpp"
 
 namespace dacrt {
 
@@ -95,20 +93,6 @@ const std::vector<std::uint32_t>& identityIndices(std::size_t triangles) {
     return v;
 }
 
-// Flush-to-zero and denormals-are-zero for the calling thread while it lives, as Embree
-// recommends for speed; the previous mode comes back after (dacrt's tracers share the threads).
-class FlushDenormals {
-public:
-    FlushDenormals() : csr_(_mm_getcsr()) {
-        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
-        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
-    }
-    ~FlushDenormals() { _mm_setcsr(csr_); }
-
-private:
-    unsigned csr_;
-};
-
 RTCBuildQuality geometryQualityOf(EmbreeBuild build) {
     switch (build) {
         case EmbreeBuild::Dynamic: return RTC_BUILD_QUALITY_LOW;
@@ -135,59 +119,6 @@ void rejectCulledBackFaces(const RTCFilterFunctionNArguments* args) {
     }
 }
 
-// Embree's end of a ray's segment: dacrt's whole ray (kNoHitT, finite only so that dacrt's
-// arithmetic stays finite) is Embree's unbounded one, so primary rays are traced as before.
-float segmentEnd(const Ray& ray) {
-    return ray.tmax == kNoHitT ? std::numeric_limits<float>::infinity() : ray.tmax;
-}
-
-// dacrt accepts only t > tmin while Embree's tnear is inclusive (t >= tnear). The two differ
-// only for a triangle through the point at exactly tmin, which for primary rays (tmin 0)
-// means a triangle through the eye, and for secondary rays (tmin 0, origins offset off their
-// surface) a triangle through the offset origin; that case is left to Embree rather than
-// nudging tnear, which would move every other answer too.
-RTCRay embreeRay(const Ray& ray) {
-    RTCRay r{};
-    r.org_x = ray.origin.x;
-    r.org_y = ray.origin.y;
-    r.org_z = ray.origin.z;
-    r.tnear = ray.tmin;
-    r.dir_x = ray.dir.x;
-    r.dir_y = ray.dir.y;
-    r.dir_z = ray.dir.z;
-    r.tfar = segmentEnd(ray);
-    r.mask = ~0u;
-    return r;
-}
-
-void setLane(RTCRay16& packet, int lane, const Ray& ray) {
-    const RTCRay r = embreeRay(ray);
-    packet.org_x[lane] = r.org_x;
-    packet.org_y[lane] = r.org_y;
-    packet.org_z[lane] = r.org_z;
-    packet.tnear[lane] = r.tnear;
-    packet.dir_x[lane] = r.dir_x;
-    packet.dir_y[lane] = r.dir_y;
-    packet.dir_z[lane] = r.dir_z;
-    packet.time[lane] = 0.0f;
-    packet.tfar[lane] = r.tfar;
-    packet.mask[lane] = r.mask;
-    packet.id[lane] = unsigned(lane);
-    packet.flags[lane] = 0;
-}
-
-Hit closestHitOf(const Ray& ray, float tfar, unsigned geomID, unsigned primID, float u, float v) {
-    if (geomID == RTC_INVALID_GEOMETRY_ID) return missHit(ray);
-    return Hit{tfar, primID, u, v};  // Embree's u and v weight v1 and v2, as dacrt's do
-}
-
-// rtcOccluded marks an occluded ray by setting its tfar to -infinity and keeps nothing of the
-// hit; the segment's start is the one depth known to precede it.
-Hit occlusionOf(const Ray& ray, float tfar) {
-    if (tfar == -std::numeric_limits<float>::infinity()) return Hit{ray.tmin, kUnnamedHitPrim, 0.0f, 0.0f};
-    return missHit(ray);
-}
-
 }  // namespace
 
 struct EmbreeScene::Impl {
@@ -208,7 +139,7 @@ struct EmbreeScene::Impl {
     }
 
     // The error code is per thread, so this reports failures of calls made on this thread.
-    std::string pendingError(const char* call) {
+    std::string pendingError(const char* call) const {
         const RTCError code = rtcGetDeviceError(device);
         if (code == RTC_ERROR_NONE) return {};
         std::lock_guard<std::mutex> lock(shared->messageMutex);
@@ -221,11 +152,9 @@ struct EmbreeScene::Impl {
         if (!error.empty()) throw std::runtime_error(error);
     }
 
-    void traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, HitQuery query,
-                     std::vector<Hit>& hits) const;
-    // One packet: lane l traces rays[index[l]] where valid[l] is -1.
-    void tracePacket(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16], bool coherent,
-                     HitQuery query, std::vector<Hit>& hits) const;
+    // Rays [begin, end) that are not an image: packets of 16 consecutive rays, or single rays.
+    void traceRun(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, HitQuery query,
+                  std::vector<Hit>& hits) const;
 };
 
 EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOptions& options)
@@ -300,58 +229,34 @@ double EmbreeScene::update() {
     return msSince(start);
 }
 
-void EmbreeScene::Impl::traceSingle(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, HitQuery query,
-                                    std::vector<Hit>& hits) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    for (std::size_t i = begin; i < end; ++i) {
-        const Ray& ray = rays[i];
-        if (query == HitQuery::Any) {
-            RTCRay occlusion = embreeRay(ray);
-            rtcOccluded1(scene, &context, &occlusion);
-            hits[i] = occlusionOf(ray, occlusion.tfar);
-            continue;
-        }
-        RTCRayHit closest{};
-        closest.ray = embreeRay(ray);
-        closest.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        closest.hit.primID = RTC_INVALID_GEOMETRY_ID;
-        closest.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(scene, &context, &closest);
-        hits[i] = closestHitOf(ray, closest.ray.tfar, closest.hit.geomID, closest.hit.primID, closest.hit.u, closest.hit.v);
-    }
-}
+RTCSceneTy* EmbreeScene::handle() const { return impl_->scene; }
 
-void EmbreeScene::Impl::tracePacket(const std::vector<Ray>& rays, const std::size_t (&index)[16], const int (&valid)[16],
-                                    bool coherent, HitQuery query, std::vector<Hit>& hits) const {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    if (coherent) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    // Inactive lanes carry a copy of an active lane's ray (they are masked out, but their
-    // fields must still be finite); a packet with no active lane is skipped.
-    int active = 0;
-    while (active < 16 && !valid[active]) ++active;
-    if (active == 16) return;
-    auto rayOfLane = [&](int l) -> const Ray& { return rays[valid[l] ? index[l] : index[active]]; };
-    if (query == HitQuery::Any) {
-        alignas(64) RTCRay16 q;
-        for (int l = 0; l < 16; ++l) setLane(q, l, rayOfLane(l));
-        rtcOccluded16(valid, scene, &context, &q);
-        for (int l = 0; l < 16; ++l)
-            if (valid[l]) hits[index[l]] = occlusionOf(rays[index[l]], q.tfar[l]);
+std::string EmbreeScene::pendingError(const char* call) const { return impl_->pendingError(call); }
+
+void EmbreeScene::Impl::traceRun(const std::vector<Ray>& rays, std::size_t begin, std::size_t end, HitQuery query,
+                                 std::vector<Hit>& hits) const {
+    const bool any = query == HitQuery::Any;
+    if (!options.packets) {
+        for (std::size_t i = begin; i < end; ++i)
+            hits[i] = any ? embree::occluded1(scene, embree::laneRayOf(rays[i]))
+                          : embree::intersect1(scene, embree::laneRayOf(rays[i]));
         return;
     }
-    alignas(64) RTCRayHit16 q;
-    for (int l = 0; l < 16; ++l) {
-        setLane(q.ray, l, rayOfLane(l));
-        q.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
-        q.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
-        q.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+    // Rays that are not an image (secondary rays leave surfaces every way) have no
+    // neighbourhood to exploit: no coherent flag. The last packet's missing lanes trace a
+    // copy of its first ray, masked out.
+    for (std::size_t first = begin; first < end; first += 16) {
+        embree::Packet16 packet;
+        for (std::size_t l = 0; l < 16; ++l) {
+            const bool inside = first + l < end;
+            packet.valid[l] = inside ? -1 : 0;
+            packet.rays[l] = embree::laneRayOf(rays[inside ? first + l : first]);
+        }
+        Hit answers[16];
+        if (any) embree::occluded16(scene, packet, false, answers);
+        else embree::intersect16(scene, packet, false, answers);
+        for (std::size_t l = 0; l < 16 && first + l < end; ++l) hits[first + l] = answers[l];
     }
-    rtcIntersect16(valid, scene, &context, &q);
-    for (int l = 0; l < 16; ++l)
-        if (valid[l])
-            hits[index[l]] = closestHitOf(rays[index[l]], q.ray.tfar[l], q.hit.geomID[l], q.hit.primID[l], q.hit.u[l], q.hit.v[l]);
 }
 
 TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool, HitQuery query,
@@ -362,64 +267,32 @@ TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool, H
     result.regions = 1;
     result.axis = -1;
 
-    // The pool's workers must not throw (nothing would catch it there), so the first
-    // failure is kept and thrown from this thread once every chunk is done.
     const bool packets = impl_->options.packets, any = query == HitQuery::Any;
     const char* call = packets ? (any ? "rtcOccluded16" : "rtcIntersect16") : (any ? "rtcOccluded1" : "rtcIntersect1");
-    std::mutex failureMutex;
-    std::string failure;
-    auto keepFailure = [&] {
-        const std::string error = impl_->pendingError(call);
-        if (error.empty()) return;
-        std::lock_guard<std::mutex> lock(failureMutex);
-        if (failure.empty()) failure = error;
-    };
-
+    auto pendingError = [&] { return impl_->pendingError(call); };
     const Clock::time_point start = Clock::now();
     const std::size_t width = imageWidth.value_or(impl_->options.imageWidth);
-    if (packets && width != 0) {
-        // Tiles of 4x4 pixels, a row of tiles per work unit: rays of one camera through
-        // neighbouring pixels, what the coherent flag is for.
-        const std::size_t height = (rays.size() + width - 1) / width;
-        const std::size_t tileColumns = (width + 3) / 4, tileRows = (height + 3) / 4;
-        pool.parallelFor(tileRows, [&](std::size_t row, unsigned) {
-            const FlushDenormals ftz;
-            for (std::size_t column = 0; column < tileColumns; ++column) {
-                std::size_t index[16];
-                alignas(64) int valid[16];  // the 16-wide calls want the mask, like the packet, 64-byte aligned
-                for (int l = 0; l < 16; ++l) {
-                    const std::size_t x = column * 4 + std::size_t(l % 4), y = row * 4 + std::size_t(l / 4);
-                    index[l] = y * width + x;
-                    valid[l] = x < width && index[l] < rays.size() ? -1 : 0;
-                }
-                impl_->tracePacket(rays, index, valid, true, query, result.hits);
-            }
-            keepFailure();
-        });
+    if (packets && width != 0 && !rays.empty()) {
+        // The image's 4x4 pixel tiles: rays of one camera through neighbouring pixels, what the
+        // coherent flag is for.
+        embree::traceTiles(
+            width, rays.size(), pool,
+            [&](const embree::Tile& tile) {
+                embree::traceTile(impl_->scene, tile, query,
+                                  [&](int l) { return embree::laneRayOf(rays[tile.index[l]]); }, result.hits.data());
+            },
+            pendingError);
     } else {
-        // Rays that are not an image (secondary rays leave surfaces every way) have no
-        // neighbourhood to exploit: packets of 16 consecutive rays, without the coherent flag.
         const std::size_t chunks = (rays.size() + kRaysPerChunk - 1) / kRaysPerChunk;
+        embree::FirstFailure failure;
         pool.parallelFor(chunks, [&](std::size_t chunk, unsigned) {
-            const FlushDenormals ftz;
+            const embree::FlushDenormals ftz;
             const std::size_t begin = chunk * kRaysPerChunk, end = std::min(rays.size(), begin + kRaysPerChunk);
-            if (!packets) {
-                impl_->traceSingle(rays, begin, end, query, result.hits);
-            } else {
-                for (std::size_t first = begin; first < end; first += 16) {
-                    std::size_t index[16];
-                    alignas(64) int valid[16];
-                    for (int l = 0; l < 16; ++l) {
-                        index[l] = first + std::size_t(l);
-                        valid[l] = index[l] < end ? -1 : 0;
-                    }
-                    impl_->tracePacket(rays, index, valid, false, query, result.hits);
-                }
-            }
-            keepFailure();
+            impl_->traceRun(rays, begin, end, query, result.hits);
+            failure.keepError(pendingError());
         });
+        failure.rethrow();
     }
-    if (!failure.empty()) throw std::runtime_error(failure);
     result.phases.trace = msSince(start);
     return result;
 }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <dacrt/backend_tuning.hpp>
@@ -14,6 +15,8 @@
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/trace_result.hpp"
+
+struct RTCSceneTy;  // Embree's scene (embree3/rtcore_scene.h: RTCScene is a pointer to it)
 
 namespace dacrt {
 
@@ -44,6 +47,12 @@ public:
     // phases holds trace; counters stay zero (Embree does not report them).
     TraceResult trace(const std::vector<Ray>& rays, ThreadPool& pool, HitQuery query = HitQuery::Closest,
                       std::optional<std::uint32_t> imageWidth = std::nullopt) const;
+
+    // For the tracers that make their rays in the loop (peers/embree_in_loop.hpp): the
+    // committed scene, and the text of the last failed Embree call on the calling thread, named
+    // `call` (empty: none failed).
+    RTCSceneTy* handle() const;
+    std::string pendingError(const char* call) const;
 
 private:
     struct Impl;

@@ -45,6 +45,12 @@ std::size_t lines(const fs::path& p) {
     return n;
 }
 
+// Embree held by the bench with every ray made in its tracing loop (the embree rows not named
+// "stored rays"): no camera rays made first, no Tracer call.
+bool raysMadeInLoop(const nlohmann::json& row) {
+    return row["options"].get<std::string>().find("rays_made=in_loop") != std::string::npos;
+}
+
 void expectDefaultsExact(const nlohmann::json& j, std::set<std::string> backends) {
     for (const auto& row : j["rows"]) {
         if (!row["default"].get<bool>()) continue;
@@ -64,14 +70,18 @@ TEST(Bench, SweepWritesRowsAndCacheAndDefaultsAreExact) {
     ASSERT_EQ(r.code, 0) << r.output;
     const nlohmann::json j = out.json();
     const std::size_t rows = j["rows"].size();
-    EXPECT_GE(rows, 30u);  // every option value of cpu-seq and cpu, seven embree rows
+    EXPECT_GE(rows, 33u);  // every option value of cpu-seq and cpu, eleven embree rows
     EXPECT_EQ(lines(out.dir / "b.csv"), rows + 1);
     expectDefaultsExact(j, {"cpu-seq", "cpu", "embree"});
     std::set<std::string> configs;
     for (const auto& row : j["rows"]) {
         configs.insert(row["series"].get<std::string>() + " " + row["config"].get<std::string>());
         EXPECT_EQ(row["pixels"].get<std::uint64_t>(), 2u * 48u * 36u);
-        EXPECT_TRUE(row["parts_ms"].contains("tracer"));
+        // The Tracer's call, or for embree with its rays made in the loop its own trace.
+        EXPECT_TRUE(row["parts_ms"].contains(raysMadeInLoop(row) ? "trace" : "tracer")) << row["config"];
+        EXPECT_EQ(raysMadeInLoop(row), row["backend"] == "embree" && row["config"].get<std::string>().find("stored rays") ==
+                                                                         std::string::npos)
+            << row["series"] << " " << row["config"];
         // What tools/bench/plot.py draws (its test runs on tests/scenes/bench_sample.json).
         for (const char* field : {"scene", "series", "config", "default", "frame_ms_min", "real_error_fraction", "pareto"})
             EXPECT_TRUE(row.contains(field)) << field;
@@ -79,7 +89,8 @@ TEST(Bench, SweepWritesRowsAndCacheAndDefaultsAreExact) {
     for (const char* expected : {"cpu-seq intersector=moller-trumbore", "cpu-seq triangle-filter=sat",
                                  "cpu-seq triangle-filter=mora", "cpu-seq precision=f64", "cpu-seq split=sampled-mean",
                                  "cpu regions=64", "cpu axis=z", "embree static default", "embree dynamic robust=off",
-                                 "embree refit default", "embree refit robust=off", "embree dynamic rtcIntersect1"})
+                                 "embree refit default", "embree refit robust=off", "embree refit stored rays",
+                                 "embree dynamic rtcIntersect1, stored rays"})
         EXPECT_TRUE(configs.count(expected)) << expected;
 
     std::size_t cached = 0;
@@ -129,12 +140,30 @@ TEST(Bench, PeersSuiteRunsEachDefaultAgainstEveryPeerMode) {
     EXPECT_EQ(j["command"]["suite"].get<std::string>(), "peers");
     std::set<std::string> configs;
     for (const auto& row : j["rows"]) configs.insert(row["series"].get<std::string>() + " " + row["config"].get<std::string>());
-    const std::set<std::string> expected = {"cpu-seq default",       "cpu default",          "embree dynamic default",
-                                            "embree dynamic robust=off", "embree refit default", "embree refit robust=off",
-                                            "embree static default", "embree static robust=off", "embree dynamic rtcIntersect1",
+    const std::set<std::string> expected = {"cpu-seq default",
+                                            "cpu default",
+                                            "embree dynamic default",
+                                            "embree dynamic robust=off",
+                                            "embree dynamic stored rays",
+                                            "embree refit default",
+                                            "embree refit robust=off",
+                                            "embree refit stored rays",
+                                            "embree static default",
+                                            "embree static robust=off",
+                                            "embree static stored rays",
+                                            "embree dynamic rtcIntersect1, stored rays",
                                             "embree dynamic face-filter=off"};
     EXPECT_EQ(configs, expected);
     expectDefaultsExact(j, {"cpu-seq", "cpu", "embree"});
+    // Each build mode's rows with their rays made in the loop and stored first find the same
+    // hits: the same errors against the reference.
+    std::map<std::string, nlohmann::json> byConfig;
+    for (const auto& row : j["rows"]) byConfig[row["series"].get<std::string>() + " " + row["config"].get<std::string>()] = row;
+    for (const char* series : {"embree dynamic", "embree refit", "embree static"})
+        for (const char* field : {"differing_prim", "near_ties", "real_errors", "leaks", "depth_rel_max", "psnr_db"})
+            EXPECT_EQ(byConfig.at(std::string(series) + " default")[field],
+                      byConfig.at(std::string(series) + " stored rays")[field])
+                << series << " " << field;
 }
 
 TEST(Bench, SkipsSuiteTurnsEachSkipOffAndEveryRowIsExact) {
@@ -160,10 +189,14 @@ TEST(Bench, SkipsSuiteTurnsEachSkipOffAndEveryRowIsExact) {
     EXPECT_EQ(configs, expected);
 }
 
-// The rows of a --suite passes run, by series and then pass index.
+// The rows of a --suite passes run, by configuration (the series, then the name where it is
+// not the default: "embree refit stored rays") and then pass index.
 std::map<std::string, std::vector<nlohmann::json>> passRowsBySeries(const nlohmann::json& j) {
     std::map<std::string, std::vector<nlohmann::json>> bySeries;
-    for (const auto& row : j["rows"]) bySeries[row["series"].get<std::string>()].push_back(row);
+    for (const auto& row : j["rows"]) {
+        const std::string config = row["config"];
+        bySeries[row["series"].get<std::string>() + (config == "default" ? "" : " " + config)].push_back(row);
+    }
     return bySeries;
 }
 
@@ -219,18 +252,30 @@ TEST(Bench, PassesSuiteTimesEachPassAndDacrtMatchesCpuSeqExactly) {
     EXPECT_EQ(j["rows"].front()["series"].get<std::string>(), "cpu-seq");
     EXPECT_EQ(lines(out.dir / "b.csv"), j["rows"].size() + 1);
     const auto bySeries = passRowsBySeries(j);
-    const std::set<std::string> expected = {"cpu-seq", "cpu", "embree dynamic", "embree refit", "embree static"};
+    const std::set<std::string> expected = {"cpu-seq",        "cpu",
+                                            "embree dynamic", "embree dynamic stored rays",
+                                            "embree refit",   "embree refit stored rays",
+                                            "embree static",  "embree static stored rays"};
     std::set<std::string> series;
     for (const auto& [name, rows] : bySeries) {
         series.insert(name);
         expectPassRows(rows, 2, 2, 32 * 24, 2);
         // A peer's build or refit is the primary pass's, reported apart; the others have none.
-        const bool rebuilds = name == "embree dynamic" || name == "embree refit";
+        const bool rebuilds = name.starts_with("embree dynamic") || name.starts_with("embree refit");
         EXPECT_EQ(rows.front()["build_ms"].is_number(), rebuilds) << name;
         for (std::size_t p = 1; p < rows.size(); ++p) EXPECT_TRUE(rows[p]["build_ms"].is_null()) << name;
         EXPECT_EQ(rows.front()["exact_required"].get<bool>(), name == "cpu-seq" || name == "cpu") << name;
     }
     EXPECT_EQ(series, expected);
+    // Embree with its rays made in the loop answers as on the rays made and stored first: the
+    // same rays made, the same slots differing from cpu-seq's, in every pass.
+    for (const char* mode : {"embree dynamic", "embree refit", "embree static"}) {
+        const auto& inLoop = bySeries.at(mode);
+        const auto& stored = bySeries.at(std::string(mode) + " stored rays");
+        for (std::size_t p = 0; p < inLoop.size(); ++p)
+            for (const char* field : {"rays_per_frame", "visibility_mismatches"})
+                EXPECT_EQ(inLoop[p][field], stored[p][field]) << mode << ", pass " << p << ", " << field;
+    }
     // The floor faces the directional light: its pass makes rays (which the ceiling stops).
     EXPECT_GT(bySeries.at("cpu")[2]["rays_per_frame"].get<double>(), 0.0);
 
@@ -332,8 +377,11 @@ void expectAnimationRows(const nlohmann::json& j, const std::vector<std::string>
         EXPECT_EQ(r["rays_per_frame"].get<std::size_t>(), pixels);
         // One evaluation per frame, reported beside every backend's work.
         EXPECT_EQ(r["evaluate_ms"], j["rows"][i - i % series.size()]["evaluate_ms"]) << name;
-        for (const char* phase : {"evaluate_ms", "prepare_ms", "trace_ms", "work_ms", "total_ms", "mrays_per_s"})
+        for (const char* phase : {"evaluate_ms", "trace_ms", "work_ms", "total_ms", "mrays_per_s"})
             EXPECT_GT(r[phase].get<double>(), 0.0) << name << " " << phase;
+        // The camera's rays, made before the trace; embree makes them in its tracing loop.
+        if (raysMadeInLoop(r)) EXPECT_EQ(r["prepare_ms"].get<double>(), 0.0) << name;
+        else EXPECT_GT(r["prepare_ms"].get<double>(), 0.0) << name;
         const bool peer = name.rfind("embree", 0) == 0 || name.rfind("rayquery", 0) == 0;
         EXPECT_EQ(r["build_ms"].is_number(), peer) << name;
         const double build = peer ? r["build_ms"].get<double>() : 0.0;

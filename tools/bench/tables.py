@@ -186,12 +186,15 @@ def passes(paths, scene):
     for j in runs:
         driver = driver_of(j)
         rows = [r for r in j["rows"] if r["scene"] == scene]
-        configs = list(dict.fromkeys(r["series"] for r in rows))
+        # A configuration: its series, and its name where a series has more than its default
+        # (embree's "stored rays" rows beside the rows whose rays are made in the loop).
+        configs = list(dict.fromkeys((r["series"], r["config"]) for r in rows))
         cpu = next((r for r in rows if r["series"] == "cpu" and r["pass_kind"] == "frame"), None)
-        for series in configs:
-            mine = {r["pass_index"]: r for r in rows if r["series"] == series}
+        for series, config in configs:
+            mine = {r["pass_index"]: r for r in rows if r["series"] == series and r["config"] == config}
             frame = next(r for r in mine.values() if r["pass_kind"] == "frame")
-            cells = [series, "CPU" if series.startswith(("cpu", "embree")) else driver]
+            label = series if config == "default" else f"{series}, {config}"
+            cells = [label, "CPU" if series.startswith(("cpu", "embree")) else driver]
             differ = []
             for i, name in enumerate(names):
                 r = mine[i]
