@@ -189,6 +189,7 @@ struct GpuCounters {
     uint tooLarge;       // work items with a single step beyond the loop budget
     uint terminatedStep1;  // rays finished by Step 1 work items (hit or retired), as the cpu backend counts them
     uint stackSlotsTaken;  // work items that saved a stack (more than DacrtPush::stackSlots: the frame fails)
+    uint raysCulled;       // secondary.comp: rays made that miss the division's widened box (no region)
 };
 
 // Push constants of workgroup_test.comp, which runs one building block of the DACRT kernel
@@ -287,8 +288,9 @@ static_assert(offsetof(SecondaryPush, firstInvocation) == 88);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
-static_assert(sizeof(GpuCounters) == 56 && offsetof(GpuCounters, raysRetired) == 20);
+static_assert(sizeof(GpuCounters) == 60 && offsetof(GpuCounters, raysRetired) == 20);
 static_assert(offsetof(GpuCounters, terminatedStep1) == 48 && offsetof(GpuCounters, stackSlotsTaken) == 52);
+static_assert(offsetof(GpuCounters, raysCulled) == 56);
 static_assert(offsetof(GpuCounters, itemsFinished) == 32 && offsetof(GpuCounters, tooLarge) == 44);
 static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, loopLimitHits) == 28);
 static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);

@@ -49,8 +49,10 @@ uint firstRegion(Ray ray) {
 
 // Step 0, one invocation per slot (source ray s, sample k): its ray, its starting hit, and its
 // slot (region and ray group: the rays of the g-th band of the image go to group g), counted
-// in each slot's rayEnd, with the directions they move along the axis. One ray an invocation
-// keeps its loops (16 tries, two walks over at most 4096 regions) far below llvmpipe's 65535.
+// in each slot's rayEnd, with the directions they move along the axis; a ray that meets no
+// region is counted as culled, as the host's division counts those it drops. One ray an
+// invocation keeps its loops (16 tries, two walks over at most 4096 regions) far below
+// llvmpipe's 65535.
 void makeRay(uint slot) {
     uint source = slot / push.raysPerHit;
     uint k = slot - source * push.raysPerHit;
@@ -72,6 +74,7 @@ void makeRay(uint slot) {
     uint region = g.traced ? firstRegion(g.ray) : kNoSlot;
     uint key = region == kNoSlot ? kNoSlot : region * push.groups + group;
     RAY_IDS(gRayScratchHalf + slot) = key;
+    if (g.traced && key == kNoSlot) atomicAdd(counters.raysCulled, 1u);
     if (key == kNoSlot) return;
     atomicAdd(regions[key].rayEnd, 1u);
     float d = g.ray.dir[push.axis];

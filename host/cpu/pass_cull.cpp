@@ -21,6 +21,9 @@ constexpr double kPiecesPerTriangle = 0.5;
 // triangles it dropped saved; its shadow pass (42,331 rays, 21 each) gained.
 constexpr std::size_t kTrianglesPerRayForTheGrid = 8;
 
+// Whether marking the grid for a pass of `rays` rays pays for itself.
+bool gridPaysFor(std::uint64_t rays, std::size_t triangles) { return rays * kTrianglesPerRayForTheGrid < triangles; }
+
 // Rays whose segments' lengths the grid's resolution is chosen from.
 constexpr std::size_t kSurveySamples = 4096;
 
@@ -241,7 +244,7 @@ void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPoo
     RayGrid grid;
     // A pass of many rays for its triangles spends its time on the rays: the grid would cost
     // more than it saves (measured: docs/benchmarks.md, "Secondary passes").
-    if (switches.passRays && (cellsAlongLongest || rays.size() * kTrianglesPerRayForTheGrid < g.triangles->size())) {
+    if (switches.passRays && (cellsAlongLongest || gridPaysFor(rays.size(), g.triangles->size()))) {
         // Cells along the longest side: as many as the marking budget allows, up to kMaxCells.
         const double budget = kPiecesPerTriangle * double(g.triangles->size());
         const double cells = std::clamp(budget / std::max(survey.cellSpans, 1e-30), 1.0, double(RayGrid::kMaxCells));
@@ -253,6 +256,10 @@ void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPoo
     const glm::dvec3 direction(rays.front().dir);
     keepTriangles(g, cull.raysTested ? &grid : nullptr, cull.directionShared ? &direction : nullptr,
                   farthestReach(survey, g.sceneBox), pool, cull);
+}
+
+bool passCullMayDrop(std::uint64_t mostRays, std::size_t triangles, bool oneDirection, const SkipSwitches& switches) {
+    return (switches.passRays && gridPaysFor(mostRays, triangles)) || (switches.backFaces && oneDirection);
 }
 
 void planPassCull(const FrameGeometry& g, const SkipSwitches& switches, const PassCull& cull, MemoryPlan& plan) {

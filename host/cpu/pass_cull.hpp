@@ -71,6 +71,11 @@ struct PassCull {
 void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool, PassCull& cull,
                  unsigned cellsAlongLongest = 0);
 
+// Whether cullForPass may drop triangles of a pass of at most mostRays rays over `triangles`
+// triangles (oneDirection: its rays share one, as a directional light's shadow rays do): the
+// gpu, which makes a pass's rays on the device, makes them on the host for the cull only then.
+bool passCullMayDrop(std::uint64_t mostRays, std::size_t triangles, bool oneDirection, const SkipSwitches& switches);
+
 // The pass cull's lines of the work plan.
 void planPassCull(const FrameGeometry& g, const SkipSwitches& switches, const PassCull& cull, MemoryPlan& plan);
 

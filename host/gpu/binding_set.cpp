@@ -176,7 +176,7 @@ void DacrtBindingSet::writeChunkTable(std::uint64_t chunkBytes) {
         if (bound_[binding]->chunkCount() > 1) kernelChunkBytes_ = std::uint32_t(chunkBytes);
     for (std::uint32_t binding : kAddressedBindings) {
         const Buffer& b = *bound_[binding];
-        if (b.chunkCount() > 1 ? b.chunkBytes() != chunkBytes : b.size() > chunkBytes)
+        if (!b.suitsChunks(chunkBytes))
             throw InternalError("the buffer of " + b.name() + " is not in the frame's chunks of " + std::to_string(chunkBytes) +
                                 " bytes");
         first.push_back(std::uint32_t(addresses.size()));

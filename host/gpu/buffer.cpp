@@ -49,6 +49,11 @@ Buffer::Buffer(const Context& context, std::uint64_t bytes, std::string name, Bu
     }
 }
 
+bool Buffer::suitsChunks(std::uint64_t frameChunkBytes) const {
+    if (chunks_.size() > 1) return chunkBytes_ == frameChunkBytes;
+    return frameChunkBytes == 0 || bytes_ <= frameChunkBytes;
+}
+
 Buffer::Chunk Buffer::allocateChunk(const Context& context, std::uint64_t bytes, BufferUse use) const {
     const DeviceInfo& info = context.info();
     Chunk c;

@@ -35,6 +35,10 @@ public:
     std::uint64_t bindingRange() const { return bindingRange_; }  // what a descriptor covers
     std::size_t chunkCount() const { return chunks_.size(); }
     std::uint64_t chunkBytes() const { return chunkBytes_; }  // every chunk's but the last
+    // Whether a frame whose addressed arrays are in chunks of frameChunkBytes (0: each bound
+    // whole) reaches this buffer as it is: in those chunks, or in one chunk no longer than them
+    // (with 0, in one chunk: the frame's plan holds it within one binding).
+    bool suitsChunks(std::uint64_t frameChunkBytes) const;
     // A chunk's device address: for the acceleration structures and the addressed kernels.
     VkDeviceAddress deviceAddress(std::size_t chunk = 0) const;
     std::uint64_t size() const { return bytes_; }

@@ -34,6 +34,26 @@ struct GpuPassSource {
 
 void GpuPassSourceDeleter::operator()(GpuPassSource* source) const { delete source; }
 
+PassCapacity secondaryPassCapacity(const GpuPassSource* source, const gpu::BufferLimits& limits) {
+    if (!limits.addresses)
+        return {limits.bindingBytes / sizeof(Ray), "one binding of rays (" + limits.bindingLimit + ", " +
+                                                        std::to_string(limits.bindingBytes) + " bytes) on a device " +
+                                                        "without bufferDeviceAddress"};
+    // The ray ids and their scratch half: 2 of the kernels' 32-bit indices a slot, at most 2^31.
+    PassCapacity c{std::uint64_t(1) << 30, "the ray ids' 32-bit indices"};
+    std::uint64_t kept = 0;
+    if (source) {
+        for (std::uint32_t k = 0; k < DACRT_BINDING_COUNT; ++k) kept += (*source->primary)[k].size();
+        if (source->triangleIds) kept += source->triangleIds->size();
+    }
+    constexpr std::uint64_t kSlotBytes = sizeof(Ray) + sizeof(Hit) + 2 * sizeof(std::uint32_t);  // rays, hits, ray ids
+    const std::uint64_t left = limits.memoryBytes > kept ? limits.memoryBytes - kept : 0;
+    if (limits.memoryBytes && left / 2 / kSlotBytes < c.slots)
+        c = {left / 2 / kSlotBytes, "half the " + limits.memoryLimit + " (" + std::to_string(limits.memoryBytes) +
+                                        " bytes) left by the primary pass's " + std::to_string(kept) + " bytes"};
+    return c;
+}
+
 // What a frame's (or a secondary pass's) stages hand each other.
 struct GpuTracer::Frame {
     const FrameGeometry& geometry;
@@ -255,10 +275,7 @@ TraceResult GpuTracer::trace(const FrameGeometry& geometry, const PlanHook& onPl
                          "' lacks subgroup arithmetic or shuffles in compute shaders, which the gpu backend needs");
     Frame frame{geometry, startResult()};
     frame.rays = geometry.rays->size();
-    if (resident_ && options_.skips.uploads && geometry.trianglesVersion != 0) {
-        frame.keepsTriangles = true;
-        frame.trianglesOnDevice = resident_->holds(geometry);
-    }
+    frame.keepsTriangles = resident_ && options_.skips.uploads && geometry.trianglesVersion != 0;
     divide(frame);
     frame.workgroupSize = chooseWorkgroupSize(*frame.work, tuning_, device, frame.result);
     planMemory(frame);
@@ -314,6 +331,9 @@ void GpuTracer::planMemory(Frame& frame) const {
     plan.add("host: triangle ids per ray group", frame.triIdCount * 4);
     gpu::addressLargeArrays(frame.buffers, limits_);
     gpu::addToMemoryPlan(frame.buffers, limits_, plan);
+    // Kept triangles in chunks this frame cannot reach (it binds what an earlier one addressed,
+    // or the reverse) are uploaded again.
+    frame.trianglesOnDevice = frame.keepsTriangles && resident_->holds(g, gpu::chunkBytesOf(frame.buffers));
     planBufferReuse(frame);
     plan.work.insert(plan.work.end(), frame.hostPlan.work.begin(), frame.hostPlan.work.end());
     gpu::addWorkItemLines(work, plan);
@@ -434,6 +454,7 @@ void GpuTracer::readBack(Frame& frame) const {
 
     const GpuCounters& counters = frame.counters;
     checkLoopLimit(counters, work.items.size(), context_.info());
+    result.counters.raysCulled += counters.raysCulled;  // a secondary pass's (the division counted a frame's)
     result.counters.rayBoxTests = counters.rayBoxTests;
     result.counters.rayTriangleTests = counters.rayTriangleTests;
     result.counters.leaves = counters.leaves;

@@ -3,6 +3,7 @@
 // rounds as compute dispatches (one workgroup per work item) recorded in one command buffer.
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include <dacrt/backend_tuning.hpp>
 
@@ -32,6 +33,17 @@ struct GpuPassSourceDeleter {
     void operator()(GpuPassSource* source) const;
 };
 using GpuPassSourcePtr = std::unique_ptr<GpuPassSource, GpuPassSourceDeleter>;
+
+// How many slots (primary rays x rays per hit) one secondary pass holds on the device, and
+// what holds no more: without buffer device addresses, the rays one binding holds; else the
+// ray ids' 32-bit indices, and half the device memory that `source`'s buffers (null: none)
+// leave, the other half for the pass's triangle ids, work items and stacks, which its plan
+// then checks exactly. A pass of more slots runs in batches of samples (library/frame_passes).
+struct PassCapacity {
+    std::uint64_t slots = 0;
+    std::string limit;  // "one binding of rays (maxStorageBufferRange, ...)", ...
+};
+PassCapacity secondaryPassCapacity(const GpuPassSource* source, const gpu::BufferLimits& limits);
 
 // Traces frames on the context's device with one set of options: each stage of a frame (the
 // division, the plan, the upload, the pipelines, the dispatch rounds, the readback) is a

@@ -13,19 +13,25 @@ namespace dacrt::gpu {
 
 class ResidentTriangles {
 public:
-    // Whether the buffers already hold g's triangles and bounds.
-    bool holds(const FrameGeometry& g) const;
-    // Makes them hold g's (allocating and uploading unless holds(g)), in chunks of chunkBytes
-    // where the frame addresses its arrays (0: one binding each).
-    void prepare(const Context& context, const FrameGeometry& g, std::uint64_t chunkBytes = 0);
+    // Whether the buffers already hold g's triangles and bounds in a form a frame whose
+    // addressed arrays are in chunks of chunkBytes (0: bound whole) reaches (Buffer::suitsChunks):
+    // then prepare uploads nothing.
+    bool holds(const FrameGeometry& g, std::uint64_t chunkBytes) const;
+    // Makes them hold g's so (allocating where the count or the chunks do not suit, and
+    // uploading), unless holds(g, chunkBytes).
+    void prepare(const Context& context, const FrameGeometry& g, std::uint64_t chunkBytes);
     Buffer& triangles() { return *triangles_; }
     Buffer& bounds() { return *bounds_; }
+    // How many times prepare uploaded them: what the plan's upload lines report.
+    std::uint64_t uploads() const { return uploads_; }
 
 private:
+    bool suits(std::uint64_t count, std::uint64_t chunkBytes) const;
+
     std::unique_ptr<Buffer> triangles_, bounds_;
     std::uint64_t version_ = 0;
     std::uint64_t count_ = 0;
-    std::uint64_t chunkBytes_ = 0;
+    std::uint64_t uploads_ = 0;
 };
 
 }  // namespace dacrt::gpu

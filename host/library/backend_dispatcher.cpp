@@ -20,6 +20,17 @@ bool usesVulkan(const std::vector<Backend>& backends) {
     return std::any_of(backends.begin(), backends.end(), runsOnVulkan);
 }
 
+// Whether a gpu pass goes the host's way although the primary hits are on the device: its rays
+// made on the host (the device's, bit for bit) for the pass cull, where the cull may drop
+// triangles. The pass makes at most raysPerHit rays per surface the primary rays hit.
+bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryHits, std::size_t triangles,
+                     const SkipSwitches& switches) {
+    std::uint64_t surfaces = 0;
+    for (const Hit& h : primaryHits) surfaces += h.prim != kMissPrim && h.prim != kNotTracedPrim;
+    const bool oneDirection = pass.kind == shared::kPassShadow && pass.light.type == shared::kLightDirectional;
+    return passCullMayDrop(surfaces * pass.raysPerHit, triangles, oneDirection, switches);
+}
+
 }  // namespace
 
 void checkBackendRequest(const BackendRequest& r) {
@@ -104,9 +115,12 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
     switch (request.trace.backend) {
         case Backend::Gpu:
             if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
-            // The last frame's buffers kept for its passes go back to the arena for this one.
-            if (request.keepForPasses) passSource_.reset();
-            arena_->startFrame();
+            // A closest-hit trace starts a frame (a pass culled on the host traces any hits): the
+            // last frame's buffers kept for its passes go back to the arena for this one.
+            if (geometry.query == HitQuery::Closest) {
+                arena_->startFrame();
+                if (request.keepForPasses) passSource_.reset();
+            }
             return GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get(),
                              arena_.get())
                 .trace(geometry, onPlan,
@@ -133,15 +147,13 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
                                                                const PlanHook& onPlan) {
     checkBackendRequest(request);
     ThreadPool& threadPool = pool(threadsOf(request.trace));
+    // On gpu the rays are made where the primary pass left its hits, unless the pass cull may
+    // drop triangles: the host makes them then, as for the other backends. A frame the skips
+    // left empty (no triangle: every primary ray misses) kept nothing on the device.
+    if (request.trace.backend == Backend::Gpu && passSource_ &&
+        !culledOnTheHost(pass, primaryHits, primary.triangles->size(), request.trace.skips))
+        return traceMadeOnDevice(primary, pass, request, onPlan);
     PassTrace out;
-    // On gpu the rays are made where the primary pass left its hits; a frame the skips left
-    // empty (no triangle: every primary ray misses) kept nothing there, and makes no ray.
-    if (request.trace.backend == Backend::Gpu && passSource_) {
-        out.result = GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), nullptr, arena_.get())
-                         .traceSecondary(*passSource_, primary, pass, onPlan);
-        for (const Hit& h : out.result.hits) out.rays += h.prim != kNotTracedPrim;
-        return out;
-    }
     // The slot arrays are allocated before the tracer plans: checked first, as its plan is.
     const std::uint64_t slots = secondarySlots(pass, primary.rays->size());
     MemoryPlan making;
@@ -167,6 +179,21 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     return out;
 }
 
+BackendDispatcher::PassTrace BackendDispatcher::traceMadeOnDevice(const FrameGeometry& primary,
+                                                                   const SecondaryPass& pass,
+                                                                   const BackendRequest& request, const PlanHook& onPlan) {
+    // The cull's lines, with its reason for dropping nothing.
+    MemoryPlan cullPlan;
+    planPassCull(primary, request.trace.skips, PassCull{}, cullPlan);
+    PassTrace out;
+    out.result = GpuTracer(*gpu_, pool(threadsOf(request.trace)), request.trace, request.gpuTuning, pipelines_.get(),
+                           nullptr, arena_.get())
+                     .traceSecondary(*passSource_, primary, pass, withWorkLines(onPlan, cullPlan.work, true));
+    out.result.memory.work.insert(out.result.memory.work.begin(), cullPlan.work.begin(), cullPlan.work.end());
+    for (const Hit& h : out.result.hits) out.rays += h.prim != kNotTracedPrim;
+    return out;
+}
+
 TraceResult BackendDispatcher::traceCulled(const FrameGeometry& g, const BackendRequest& request,
                                            const PlanHook& onPlan) {
     const auto start = Clock::now();
@@ -174,6 +201,11 @@ TraceResult BackendDispatcher::traceCulled(const FrameGeometry& g, const Backend
     MemoryPlan cullPlan;
     planPassCull(g, request.trace.skips, passCull_, cullPlan);
     return traceAfterSkips(g, passCull_.skips, cullPlan, msSince(start), request, onPlan, {});
+}
+
+PassCapacity BackendDispatcher::secondaryPassCapacity(const BackendRequest& request) const {
+    if (request.trace.backend != Backend::Gpu || !gpu_) return {~std::uint64_t(0), "none"};
+    return dacrt::secondaryPassCapacity(passSource_.get(), gpu::bufferLimits(gpu_->info(), request.gpuTuning));
 }
 
 std::uint32_t BackendDispatcher::validationErrors() const { return gpu_ ? gpu_->validationErrors() : 0; }

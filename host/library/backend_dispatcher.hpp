@@ -70,9 +70,10 @@ public:
 
     // A secondary pass of the frame the last trace() traced (with request.keepForPasses on
     // gpu): its rays made from the primary hits (on the device for gpu, where the primary pass
-    // left them; on the host for the others, and for gpu where it kept nothing) and traced for
-    // any hit by the same backend, over the triangles the pass cull keeps (pass_cull.hpp:
-    // those the pass's rays can reach; the peers trace every one). `primary` is the frame as
+    // left them; on the host for the others, and for gpu where it kept nothing or where the
+    // pass cull may drop triangles: passCullMayDrop) and traced for any hit by the same
+    // backend, over the triangles the pass cull keeps (pass_cull.hpp: those the pass's rays can
+    // reach; the peers and the gpu's device-made rays trace every one). `primary` is the frame as
     // given to trace(); the peers trace the structure it left. Returns one hit per slot
     // (hitsPerSlot) and the rays made.
     struct PassTrace {
@@ -81,6 +82,10 @@ public:
     };
     PassTrace traceSecondary(const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const SecondaryPass& pass,
                              const BackendRequest& request, const PlanHook& onPlan = {});
+
+    // gpu: how many slots one traceSecondary of the last frame holds on the device
+    // (secondaryPassCapacity); unlimited elsewhere.
+    PassCapacity secondaryPassCapacity(const BackendRequest& request) const;
 
     std::uint32_t validationErrors() const;
     // Under --validate: prints every validation message; true when there were errors (the
@@ -95,6 +100,10 @@ private:
     TraceResult traceAfterSkips(const FrameGeometry& geometry, const TriangleSkips& skips, const MemoryPlan& skipPlan,
                                 double skipMs, const BackendRequest& request, const PlanHook& onPlan,
                                 const ProgressHook& onProgress);
+    // A gpu pass whose rays the device makes from the hits the primary pass left there, over
+    // every triangle (the pass cull's lines say why none was dropped).
+    PassTrace traceMadeOnDevice(const FrameGeometry& primary, const SecondaryPass& pass, const BackendRequest& request,
+                                const PlanHook& onPlan);
     // A secondary pass's rays on dacrt's backends, over the triangles the pass cull keeps.
     TraceResult traceCulled(const FrameGeometry& pass, const BackendRequest& request, const PlanHook& onPlan);
 

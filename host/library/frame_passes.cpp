@@ -34,13 +34,15 @@ std::vector<SecondaryPass> secondaryPasses(const std::vector<Light>& lights, con
 
 namespace {
 
-// Samples of an occlusion pass per batch: all of them, but on a device whose storage buffers
-// cannot hold the pass's rays (lavapipe: 128 MiB, 2 million rays), as many as they can.
+// Samples of an occlusion pass per batch: all of them, but where the device cannot hold the
+// pass's slots at once (secondaryPassCapacity: one binding of rays on a device without buffer
+// device addresses, or its memory), as many as it can; `limit` names what holds no more.
 std::uint32_t samplesPerBatch(const SecondaryPass& pass, std::uint64_t primaryRays, const BackendDispatcher& backends,
-                              const BackendRequest& request) {
-    if (request.trace.backend != Backend::Gpu || !backends.gpuContext() || primaryRays == 0) return pass.raysPerHit;
-    const std::uint64_t fit = backends.gpuContext()->info().maxStorageBufferRange / sizeof(Ray) / primaryRays;
-    return std::uint32_t(std::clamp<std::uint64_t>(fit, 1, pass.raysPerHit));
+                              const BackendRequest& request, std::string& limit) {
+    if (primaryRays == 0) return pass.raysPerHit;
+    const PassCapacity capacity = backends.secondaryPassCapacity(request);
+    limit = capacity.limit;
+    return std::uint32_t(std::clamp<std::uint64_t>(capacity.slots / primaryRays, 1, pass.raysPerHit));
 }
 
 // A batch's result folded into the whole pass's: slots, rays, time and counters.
@@ -75,7 +77,8 @@ std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& p
     std::vector<TracedPass> traced;
     const std::uint64_t primaryRays = primary.rays->size();
     for (const SecondaryPass& pass : passes) {
-        const std::uint32_t batch = samplesPerBatch(pass, primaryRays, backends, request);
+        std::string limit;
+        const std::uint32_t batch = samplesPerBatch(pass, primaryRays, backends, request, limit);
         TracedPass whole{pass, {}, 0, 0.0};
         for (std::uint32_t first = 0; first < pass.raysPerHit; first += batch) {
             SecondaryPass part = pass;
@@ -93,7 +96,7 @@ std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& p
         }
         if (batch < pass.raysPerHit)
             whole.result.memory.addWork("occlusion batches", (pass.raysPerHit + batch - 1) / batch,
-                                        std::to_string(batch) + " samples per hit each: the device's storage buffers hold no more rays");
+                                        std::to_string(batch) + " samples per hit each: the slots that fit " + limit);
         traced.push_back(std::move(whole));
     }
     return traced;

@@ -1,7 +1,8 @@
 #pragma once
 // A camera frame with its secondary passes (Tracer::traceFrame): after the primary rays, a
 // shadow pass towards each light and an ambient-occlusion pass, their rays made from the
-// primary hits by the backend that traced them (gpu: on the device, where the hits lie).
+// primary hits by the backend that traced them (gpu: on the device, where the hits lie, but
+// on the host for a pass whose triangles the pass cull may thin, as on the other backends).
 #include <array>
 #include <cstdint>
 #include <functional>

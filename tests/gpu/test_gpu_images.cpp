@@ -429,6 +429,37 @@ TEST(GpuImages, TrianglesStayOnTheDeviceAcrossFramesUntilTheyChange) {
     EXPECT_TRUE(noValidationErrors(*context));
 }
 
+TEST(GpuImages, KeptTrianglesInChunksAFrameCannotReachAreUploadedAgainAndReportedSo) {
+    // Frames of one trianglesVersion that alternate between binding the triangles whole and
+    // addressing them in chunks: a frame reuses the kept buffers where it reaches them as they
+    // are (Buffer::suitsChunks), else uploads them again, and its plan says which it did.
+    DACRT_REQUIRE_GPU(context);
+    if (!context->info().bufferDeviceAddress) GTEST_SKIP() << "the device lacks buffer device addresses";
+    Frame frame(shapes(), 48, 32, CameraOptions{});
+    frame.geometry.trianglesVersion = frame.scene.trianglesVersion;
+    const std::uint64_t triangleBytes = frame.scene.triangles.size() * (sizeof(Triangle) + sizeof(Bounds));
+    ASSERT_GT(triangleBytes, 2 * 4096u);
+    const TraceResult reference = frame.trace(Backend::CpuSeq);
+    const GpuTuning bound{}, smallChunks{.bufferBytes = 4096, .chunkBytes = 4096}, oneChunk{.bufferBytes = 4096};
+    ThreadPool pool(2);
+    gpu::ResidentTriangles resident;
+    // Each frame's tuning, and whether it finds the triangles on the device.
+    const std::vector<std::pair<GpuTuning, bool>> frames = {{bound, false},     {bound, true},    {smallChunks, false},
+                                                            {smallChunks, true}, {oneChunk, false}, {bound, true}};
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        SCOPED_TRACE("frame " + std::to_string(i));
+        const std::uint64_t uploadsBefore = resident.uploads();
+        const TraceResult r = GpuTracer(*context, pool, gpuOptions(2), frames[i].first, nullptr, &resident).trace(frame.geometry);
+        const bool skipped = resident.uploads() == uploadsBefore;
+        EXPECT_EQ(skipped, frames[i].second);
+        const WorkLine* line = workLine(r.memory, "skipped: triangle and bounds upload (bytes)");
+        ASSERT_TRUE(line);
+        EXPECT_EQ(line->count, skipped ? triangleBytes : 0u);
+        EXPECT_TRUE(identicalHits(reference.hits, r.hits));
+    }
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
 TEST(GpuImages, OrthographicCameras) {
     // Rays of many origins sharing one direction (an orthographic camera): not sharing their
     // start, they are read per ray, and the near child comes from the direction's signs.

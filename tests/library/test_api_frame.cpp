@@ -1,7 +1,6 @@
 // The public API's camera frames (Tracer::traceFrame): the primary pass as trace() gives it,
 // then the shadow and occlusion passes from its hits, their plans, and the pass bounds.
 #include <algorithm>
-#include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -13,19 +12,7 @@
 namespace dacrt {
 namespace {
 
-// A point light in the middle of the scene, then ambient occlusion with three rays per hit.
-std::vector<FramePass> lightAndOcclusion(const TraceScene& scene) {
-    const SceneBounds b = scene.bounds();
-    FramePass shadow{.name = "shadow: centre", .kind = PassKind::Shadow};
-    float diagonal = 0.0f;
-    for (int a = 0; a < 3; ++a) {
-        shadow.light.position[a] = 0.5f * (b.lo[a] + b.hi[a]);
-        diagonal += (b.hi[a] - b.lo[a]) * (b.hi[a] - b.lo[a]);
-    }
-    FramePass occlusion{.name = "occlusion", .kind = PassKind::Occlusion, .raysPerHit = 3,
-                        .occlusionDistance = 0.1f * std::sqrt(diagonal), .sampleSeed = 1};
-    return {shadow, occlusion};
-}
+using test::lightAndOcclusion;
 
 std::size_t slotsWithRays(const std::vector<RayHit>& hits) {
     return std::size_t(std::count_if(hits.begin(), hits.end(), [](const RayHit& h) {

@@ -31,6 +31,102 @@ std::optional<Tracer> gpuTracer(std::string& why) {
     }
 }
 
+// The count of a plan's work line, or none.
+std::optional<std::uint64_t> workCount(const FramePlan& plan, const std::string& name) {
+    for (const FramePlan::Work& w : plan.work)
+        if (w.name == name) return w.count;
+    return std::nullopt;
+}
+
+// Slot by slot: a ray made in the same slots, and the same visibility (any hit: the triangle
+// found may differ).
+::testing::AssertionResult sameVisibility(const std::vector<RayHit>& a, const std::vector<RayHit>& b) {
+    if (a.size() != b.size()) return ::testing::AssertionFailure() << a.size() << " slots against " << b.size();
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if ((a[i].primitive == kNotTracedPrimitive) != (b[i].primitive == kNotTracedPrimitive) || a[i].hit() != b[i].hit())
+            return ::testing::AssertionFailure() << "slot " << i << ": primitive " << a[i].primitive << " against "
+                                                 << b[i].primitive;
+    return ::testing::AssertionSuccess();
+}
+
+// The room's passes at 32x24: a directional light's shadow, the centre's point light's, one
+// occlusion ray per hit (each fewer rays than an eighth of the 11,948 triangles: the pass
+// cull's grid pays), and sixteen (more: no grid).
+std::vector<FramePass> fewAndManyRays(const TraceScene& scene) {
+    FramePass sun{.name = "shadow: sun", .kind = PassKind::Shadow};
+    sun.light.kind = LightKind::Directional;
+    sun.light.direction = {0.36f, -0.8f, -0.48f};
+    const std::vector<FramePass> centre = test::lightAndOcclusion(scene, 1);
+    FramePass many = centre[1];
+    many.name = "occlusion: many rays";
+    many.raysPerHit = 16;
+    return {sun, centre[0], centre[1], many};
+}
+
+TEST(ApiGpu, FramePassesCullWhatCpuSeqCulls) {
+    // The gpu makes the rays of the passes the cull may thin on the host (the device's, bit for
+    // bit) and traces the triangles cpu-seq's cull keeps; the pass of many rays is made on the
+    // device over every triangle, as cpu-seq traces it. Every slot agrees, and so do the rays
+    // made, the cull's work lines and the rays culled.
+    std::string why;
+    std::optional<Tracer> gpu = gpuTracer(why);
+    if (!gpu) GTEST_SKIP() << "no Vulkan device: " << why;
+    const TraceScene scene = TraceScene::load(test::kRoomScene);
+    const RayBatch rays = RayBatch::fromCamera(scene, {}, 32, 24);
+    const std::vector<FramePass> passes = fewAndManyRays(scene);
+    const FrameOutput expected = Tracer(onBackend(Backend::CpuSeq)).traceFrame(scene, rays, passes);
+    const FrameOutput device = gpu->traceFrame(scene, rays, passes);
+    ASSERT_EQ(device.passes.size(), passes.size());
+    const std::string outside = "skipped: outside the pass's rays' bounds";
+    for (std::size_t k = 0; k < passes.size(); ++k) {
+        SCOPED_TRACE(passes[k].name);
+        const TraceOutput& got = device.passes[k].output;
+        const TraceOutput& want = expected.passes[k].output;
+        EXPECT_EQ(device.passes[k].rays, expected.passes[k].rays);
+        EXPECT_TRUE(sameVisibility(got.hits, want.hits));
+        EXPECT_GT(test::hitCount(want.hits), 0u);
+        for (const std::string& line : {outside, std::string("skipped: back-facing"), std::string("triangles traced")}) {
+            ASSERT_TRUE(workCount(got.plan, line)) << line;
+            EXPECT_EQ(workCount(got.plan, line), workCount(want.plan, line)) << line;
+        }
+        EXPECT_EQ(got.counters.raysCulled, want.counters.raysCulled);
+        const bool fewRays = k + 1 < passes.size();
+        EXPECT_EQ(*workCount(got.plan, outside) > 0, fewRays) << "the grid pays for few rays only";
+    }
+    EXPECT_EQ(gpu->validationErrors(), 0u);
+}
+
+TEST(ApiGpu, AnOcclusionPassIsOneBatchUnlessTheDeviceMemoryHoldsLess) {
+    // With buffer device addresses a pass's rays are not held to one binding: one batch. A
+    // memory cap that leaves room for a few samples' slots splits it into batches, which draw
+    // the whole pass's samples: the same slots.
+    std::string why;
+    std::optional<Tracer> gpu = gpuTracer(why);
+    if (!gpu) GTEST_SKIP() << "no Vulkan device: " << why;
+    if (!gpu->deviceProperties()->bufferDeviceAddress) GTEST_SKIP() << "the device lacks buffer device addresses";
+    const TraceScene scene = TraceScene::load(test::kRoomScene);
+    const RayBatch rays = RayBatch::fromCamera(scene, {}, 40, 30);
+    const std::vector<FramePass> passes = {fewAndManyRays(scene).back()};
+    const FrameOutput whole = gpu->traceFrame(scene, rays, passes);
+    ASSERT_EQ(whole.passes.size(), 1u);
+    EXPECT_FALSE(workCount(whole.passes[0].output.plan, "occlusion batches"));
+    // The primary pass's device buffers stay on the device; half of what the cap leaves holds
+    // the slots of 6 samples.
+    std::uint64_t primaryBytes = 0;
+    for (const FramePlan::Buffer& b : whole.primary.plan.memory) primaryBytes += b.name.starts_with("device: ") ? b.bytes : 0;
+    TracerOptions capped = gpu->options();
+    capped.gpu.memoryBytes = primaryBytes + 2 * 6 * rays.size() * (64 + 16 + 8);
+    gpu->setOptions(capped);
+    const FrameOutput batched = gpu->traceFrame(scene, rays, passes);
+    ASSERT_EQ(batched.passes.size(), 1u);
+    const std::optional<std::uint64_t> batches = workCount(batched.passes[0].output.plan, "occlusion batches");
+    ASSERT_TRUE(batches);
+    EXPECT_GT(*batches, 1u);
+    EXPECT_EQ(batched.passes[0].rays, whole.passes[0].rays);
+    EXPECT_TRUE(sameVisibility(batched.passes[0].output.hits, whole.passes[0].output.hits));
+    EXPECT_EQ(gpu->validationErrors(), 0u);
+}
+
 TEST(ApiGpu, SameHitsAsCpuSeq) {
     std::string why;
     std::optional<Tracer> gpu = gpuTracer(why);

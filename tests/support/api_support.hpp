@@ -2,6 +2,7 @@
 // The public API's tests (tests/library): random scenes and rays as arrays, and hits compared
 // bit for bit.
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -17,6 +18,21 @@ namespace dacrt::test {
 
 // The repository's room, as `dacrt render` renders it by default in the docs.
 inline const std::string kRoomScene = std::string(DACRT_TEST_SCENES) + "/../../scenes/room.glb";
+
+// A point light in the middle of the scene, then ambient occlusion with raysPerHit rays per
+// hit, a tenth of the scene box's diagonal long.
+inline std::vector<FramePass> lightAndOcclusion(const TraceScene& scene, std::uint32_t raysPerHit = 3) {
+    const SceneBounds b = scene.bounds();
+    FramePass shadow{.name = "shadow: centre", .kind = PassKind::Shadow};
+    float diagonal = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        shadow.light.position[a] = 0.5f * (b.lo[a] + b.hi[a]);
+        diagonal += (b.hi[a] - b.lo[a]) * (b.hi[a] - b.lo[a]);
+    }
+    FramePass occlusion{.name = "occlusion", .kind = PassKind::Occlusion, .raysPerHit = raysPerHit,
+                        .occlusionDistance = 0.1f * std::sqrt(diagonal), .sampleSeed = 1};
+    return {shadow, occlusion};
+}
 
 struct SceneArrays {
     std::vector<float> positions;
