@@ -327,6 +327,13 @@ void GpuTracer::planMemory(Frame& frame) const {
         .stackSlots = frame.stackSlots = stackSlots(work.items.size()),
     });
     MemoryPlan& plan = frame.result.memory;
+    // The frame's own arrays on the host, which the device's are uploaded from and the hits
+    // read back into (the cpu backends' plans count them too; on a CPU device such as lavapipe
+    // the device's copies are host memory as well).
+    plan.add("host: rays", g.rays->size() * sizeof(Ray));
+    plan.add("host: triangles", g.triangles->size() * sizeof(Triangle));
+    plan.add("host: triangle bounds", g.triangles->size() * sizeof(Bounds));  // one per triangle
+    plan.add("host: hits", g.rays->size() * sizeof(Hit));
     for (const auto& [name, bytes] : frame.hostPlan.buffers) plan.add("host: " + name, bytes);
     plan.add("host: triangle ids per ray group", frame.triIdCount * 4);
     gpu::addressLargeArrays(frame.buffers, limits_);
