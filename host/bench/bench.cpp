@@ -16,6 +16,7 @@
 #include "bench/bench_animation.hpp"
 #include "bench/bench_configs.hpp"
 #include "bench/bench_frame.hpp"
+#include "bench/bench_memory.hpp"
 #include "bench/bench_passes.hpp"
 #include "bench/bench_report.hpp"
 #include "bench/reference_cache.hpp"
@@ -152,9 +153,8 @@ struct Accumulator {
     InLoopEmbree embree;    // embree with its rays made in the loop: its structure and frame buffer
 };
 
-// The rows of the scene, each peer's structure built before the frames.
-std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
-                                   BenchRun& run) {
+// The rows of the scene.
+std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd, const std::vector<BenchConfig>& configs) {
     std::vector<Accumulator> acc(configs.size());
     for (std::size_t c = 0; c < configs.size(); ++c) {
         BenchRow& row = acc[c].row;
@@ -163,16 +163,16 @@ std::vector<Accumulator> startRows(const BenchScene& s, const BenchCommand& cmd,
         row.raysPerFrame = std::size_t(cmd.width) * std::size_t(cmd.height);
         row.cameras = int(s.cameras.size());
         row.config = configs[c];
-        prepareStructure(run, row.config, s.traced, acc[c].embree);
     }
     return acc;
 }
 
 // Every configuration's frames of one camera. Configurations are interleaved (repeat, then
 // configuration), so that a slow spell of this shared machine lands on every configuration
-// alike instead of on whichever one happened to run then.
+// alike instead of on whichever one happened to run then, unless their kept state must be held
+// one at a time (bench_memory.hpp).
 void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, const std::string& cacheDir,
-                   std::vector<Accumulator>& acc, BenchRun& run, Progress& progress) {
+                   std::vector<Accumulator>& acc, KeptStates& states, BenchRun& run, Progress& progress) {
     progress.stage(s.name + ": camera " + std::to_string(k + 1) + " of " + std::to_string(s.cameras.size()) + ", " +
                    std::to_string(acc.size()) + " configurations");
     progress.step(s.name + " float64 reference, camera " + std::to_string(k));
@@ -187,26 +187,25 @@ void measureCamera(const BenchScene& s, std::size_t k, const BenchCommand& cmd, 
     for (std::size_t i = 0; i < rays.size(); ++i) asHits[i] = Hit{float(reference[i].t), reference[i].prim, 0.0f, 0.0f};
     const std::vector<std::uint8_t> referenceShaded = shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &asHits});
     const std::size_t frames = s.cameras.size() * std::size_t(cmd.repeat);
-    for (int w = 0; w < cmd.warmup + cmd.repeat; ++w) {
-        for (Accumulator& a : acc) {
-            const BenchConfig& config = a.row.config;
-            progress.step(s.name + " " + config.series + " " + config.name + " camera " + std::to_string(k));
-            const FrameOutcome frame = traceStillFrame(config, s.traced, camera, cmd.width, cmd.height, run, a.rays, a.embree);
-            settleAfter(config.backend());
-            if (w < cmd.warmup) continue;
-            a.cameraMs.push_back(frame.ms);
-            for (const auto& [name, ms] : frame.parts) {
-                if (!a.partSums.count(name)) a.partOrder.push_back(name);
-                a.partSums[name] += ms / double(frames);
-            }
-            if (w != cmd.warmup) continue;  // every backend is deterministic: one frame's hits stand for all
-            const std::vector<Hit> hits = hitsOf(frame.output.hits);
-            const std::vector<std::uint8_t> shaded = shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &hits});
-            a.row.errors.add(
-                measureErrors(scene.triangles, s.bounds, rays, reference, hits, referenceShaded, shaded, pool));
-            a.row.regions = frame.output.counters.regions;
-            a.row.divisionAxis = frame.output.counters.divisionAxis;
+    for (const auto& [w, c] : frameOrder(cmd.warmup + cmd.repeat, acc.size(), states.oneAtATime())) {
+        Accumulator& a = acc[c];
+        const BenchConfig& config = a.row.config;
+        progress.step(s.name + " " + config.series + " " + config.name + " camera " + std::to_string(k));
+        states.hold(c, config, s.traced, run);
+        const FrameOutcome frame = traceStillFrame(config, s.traced, camera, cmd.width, cmd.height, run, a.rays, a.embree);
+        settleAfter(config.backend());
+        if (w < cmd.warmup) continue;
+        a.cameraMs.push_back(frame.ms);
+        for (const auto& [name, ms] : frame.parts) {
+            if (!a.partSums.count(name)) a.partOrder.push_back(name);
+            a.partSums[name] += ms / double(frames);
         }
+        if (w != cmd.warmup) continue;  // every backend is deterministic: one frame's hits stand for all
+        const std::vector<Hit> hits = hitsOf(frame.output.hits);
+        const std::vector<std::uint8_t> shaded = shadeImage(scene, HitImage{cmd.width, cmd.height, &rays, &hits});
+        a.row.errors.add(measureErrors(scene.triangles, s.bounds, rays, reference, hits, referenceShaded, shaded, pool));
+        a.row.regions = frame.output.counters.regions;
+        a.row.divisionAxis = frame.output.counters.divisionAxis;
     }
     for (Accumulator& a : acc) {
         // Per camera over the repeats, then the mean over the orbit: each camera is its own
@@ -231,10 +230,14 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
     std::vector<std::string> taken;
     for (const BenchRow& r : rows) taken.push_back(r.scene);
     const BenchScene s = loadBenchScene(path, cmd, taken);
-    std::vector<Accumulator> acc = startRows(s, cmd, configs, run);
+    std::vector<Accumulator> acc = startRows(s, cmd, configs);
+    std::vector<InLoopEmbree*> embree;
+    for (Accumulator& a : acc) embree.push_back(&a.embree);
+    KeptStates states(planSceneMemory(configs, s, cmd, run).oneAtATime, embree);
+    states.prepareAll(configs, s.traced, run);
     Progress progress("dacrt bench", s.cameras.size() * (1 + configs.size() * std::size_t(cmd.warmup + cmd.repeat)));
     const std::string cacheDir = cmd.cacheDir.empty() ? defaultCacheDir() : cmd.cacheDir;
-    for (std::size_t k = 0; k < s.cameras.size(); ++k) measureCamera(s, k, cmd, cacheDir, acc, run, progress);
+    for (std::size_t k = 0; k < s.cameras.size(); ++k) measureCamera(s, k, cmd, cacheDir, acc, states, run, progress);
     finishRows(acc, s.cameras.size(), rows);
 }
 

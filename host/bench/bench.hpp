@@ -55,6 +55,10 @@ struct BenchCommand {
     std::string device;        // gpu, rayquery: --device (index or part of the name; empty: the best)
     bool validate = false;     // gpu, rayquery: --validate
     GpuProfile gpuProfile = GpuProfile::Auto;  // gpu: --gpu-profile, every configuration's
+    // The most memory the run may hold, in MiB (--memory-limit; 0: 90% of this machine's):
+    // configurations whose kept state does not fit at once run one after another
+    // (bench/bench_memory.hpp).
+    std::uint64_t memoryLimitMiB = 0;
     // --suite passes: the lights (render's --light) and the occlusion rays per hit (--ao).
     PassOptions passes{.lights = {}, .occlusionSamples = 4, .occlusionDistance = 0.0};
     // --suite animation: frames first..last (--frames, render's syntax), frame n at n / fps

@@ -12,6 +12,7 @@
 #include "bench/animated_frame.hpp"
 #include "bench/animation_report.hpp"
 #include "bench/bench_frame.hpp"
+#include "bench/bench_memory.hpp"
 #include "bench/bench_report.hpp"
 #include "app/exit_codes.hpp"
 #include "app/progress.hpp"
@@ -67,6 +68,19 @@ const AnimatedWork& medianRun(const std::vector<AnimatedWork>& runs) {
     return runs[order[(order.size() - 1) / 2]];
 }
 
+// The suite keeps every configuration's structure from frame to frame (a refit follows the
+// frame before it), so a run whose kept state does not fit at once is refused before its first
+// frame (bench_memory.hpp) instead of holding one at a time.
+void checkAnimationMemory(const std::vector<BenchConfig>& configs, const TraceScene& scene, const Camera& camera,
+                          const BenchCommand& cmd, const std::string& name, BenchRun& run) {
+    std::vector<Ray> buffer;
+    const RayBatch rays = makeCameraRays(camera, cmd.width, cmd.height, run.pools.of(run.hardwareThreads), buffer);
+    const BenchMemoryPlan plan = planBenchMemory(configs, scene, rays, name, cmd.memoryLimitMiB, run);
+    if (plan.oneAtATime)
+        throw InputError("bench --suite animation: " + name + ": " + keptAtOnceText(plan) +
+                         ": bench fewer configurations (--backends) or a smaller scene");
+}
+
 void measureScene(const std::string& path, const BenchCommand& cmd, const std::vector<BenchConfig>& configs,
                   BenchRun& run, std::vector<AnimationScene>& scenes, std::vector<AnimationFrameRow>& rows) {
     const GltfDocument doc = GltfDocument::open(path);
@@ -99,6 +113,7 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
     // The scene every configuration traces, each frame's triangles written into it.
     TraceScene traced = adoptScene(std::move(first), firstBox);
 
+    checkAnimationMemory(configs, traced, makeCameras(sceneOf(traced), firstBox, view, aspect).front(), cmd, info.name, run);
     std::vector<AnimatedConfig> states;
     for (const BenchConfig& config : configs) states.push_back(startAnimatedConfig(config, traced, run));
     Progress progress("dacrt bench", frames.size() * configs.size() * std::size_t(cmd.warmup + cmd.repeat));

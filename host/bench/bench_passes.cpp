@@ -12,6 +12,7 @@
 
 #include "bench/bench_configs.hpp"
 #include "bench/bench_frame.hpp"
+#include "bench/bench_memory.hpp"
 #include "bench/bench_report.hpp"
 #include "app/exit_codes.hpp"
 #include "app/json_keys.hpp"
@@ -166,8 +167,11 @@ struct SceneRun {
     const BenchScene& s;
     std::vector<FramePass> passes;
     std::vector<ConfigRun> runs;
+    std::optional<KeptStates> states;  // bench_memory.hpp: every configuration's, or one at a time
 };
 
+// Configurations interleave within every repeat (as bench.cpp's), unless their kept state
+// must be held one at a time.
 void measureCamera(SceneRun& run, std::size_t k, const BenchCommand& cmd, BenchRun& bench, Progress& progress) {
     const BenchScene& s = run.s;
     progress.stage(s.name + ": camera " + std::to_string(k + 1) + " of " + std::to_string(s.cameras.size()) + ", " +
@@ -176,35 +180,34 @@ void measureCamera(SceneRun& run, std::size_t k, const BenchCommand& cmd, BenchR
     const double frames = double(s.cameras.size() * std::size_t(cmd.repeat));
     const std::size_t passCount = 1 + run.passes.size();
     std::vector<std::vector<RayHit>> reference;  // cpu-seq's answers, the first configuration's
-    for (int w = 0; w < cmd.warmup + cmd.repeat; ++w) {
-        for (std::size_t c = 0; c < run.runs.size(); ++c) {
-            ConfigRun& r = run.runs[c];
-            progress.step(s.name + " " + configLabel(r.config) + " camera " + std::to_string(k));
-            std::vector<PassFrame> frame = traceLitFrame(r.config, s, s.cameras[k], cmd, run.passes, bench, r.rays, r.embree);
-            settleAfter(r.config.backend());
-            if (w < cmd.warmup) continue;
-            double frameMs = 0.0;
-            for (std::size_t p = 0; p < passCount; ++p) {
-                r.totals[p].addFrame(frame[p].ms, frame[p].parts, frames);
-                frameMs += frame[p].ms;
-            }
-            std::vector<std::pair<std::string, double>> perPass;
-            for (std::size_t p = 0; p < passCount; ++p)
-                perPass.emplace_back(p == 0 ? std::string("primary") : run.passes[p - 1].name, frame[p].ms);
-            r.totals[passCount].addFrame(frameMs, perPass, frames);
-            if (w != cmd.warmup) continue;  // every backend is deterministic: one frame's answers stand for all
-            if (c == 0)
-                for (const PassFrame& f : frame) reference.push_back(f.hits);
-            const bool exact = !isPeer(r.config.backend());
-            PassTotals& whole = r.totals[passCount];
-            for (std::size_t p = 0; p < passCount; ++p) {
-                const std::uint64_t differ = mismatches(reference[p], frame[p].hits, p == 0, exact);
-                for (PassTotals* t : {&r.totals[p], &whole}) {
-                    t->raysSum += double(frame[p].rays);
-                    t->slotsSum += double(frame[p].hits.size());
-                    t->checked += frame[p].hits.size();
-                    t->mismatches += differ;
-                }
+    for (const auto& [w, c] : frameOrder(cmd.warmup + cmd.repeat, run.runs.size(), run.states->oneAtATime())) {
+        ConfigRun& r = run.runs[c];
+        progress.step(s.name + " " + configLabel(r.config) + " camera " + std::to_string(k));
+        run.states->hold(c, r.config, s.traced, bench);
+        std::vector<PassFrame> frame = traceLitFrame(r.config, s, s.cameras[k], cmd, run.passes, bench, r.rays, r.embree);
+        settleAfter(r.config.backend());
+        if (w < cmd.warmup) continue;
+        double frameMs = 0.0;
+        for (std::size_t p = 0; p < passCount; ++p) {
+            r.totals[p].addFrame(frame[p].ms, frame[p].parts, frames);
+            frameMs += frame[p].ms;
+        }
+        std::vector<std::pair<std::string, double>> perPass;
+        for (std::size_t p = 0; p < passCount; ++p)
+            perPass.emplace_back(p == 0 ? std::string("primary") : run.passes[p - 1].name, frame[p].ms);
+        r.totals[passCount].addFrame(frameMs, perPass, frames);
+        if (w != cmd.warmup) continue;  // every backend is deterministic: one frame's answers stand for all
+        if (c == 0)
+            for (const PassFrame& f : frame) reference.push_back(f.hits);
+        const bool exact = !isPeer(r.config.backend());
+        PassTotals& whole = r.totals[passCount];
+        for (std::size_t p = 0; p < passCount; ++p) {
+            const std::uint64_t differ = mismatches(reference[p], frame[p].hits, p == 0, exact);
+            for (PassTotals* t : {&r.totals[p], &whole}) {
+                t->raysSum += double(frame[p].rays);
+                t->slotsSum += double(frame[p].hits.size());
+                t->checked += frame[p].hits.size();
+                t->mismatches += differ;
             }
         }
     }
@@ -220,14 +223,17 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
     // camera, as render places them.
     bool headlight = false;
     const std::vector<Light> lights = frameLights(s.scene(), s.cameras.front(), s.box, cmd.passes.lights, headlight);
-    SceneRun run{s, framePasses(lights, cmd.passes, s.box, 0), {}};
+    SceneRun run{s, framePasses(lights, cmd.passes, s.box, 0), {}, {}};
     for (const BenchConfig& config : configs) {
         ConfigRun r;
         r.config = config;
-        prepareStructure(bench, r.config, s.traced, r.embree);
         r.totals.resize(run.passes.size() + 2);
         run.runs.push_back(std::move(r));
     }
+    std::vector<InLoopEmbree*> embree;
+    for (ConfigRun& r : run.runs) embree.push_back(&r.embree);
+    run.states.emplace(planSceneMemory(configs, s, cmd, bench).oneAtATime, embree);
+    run.states->prepareAll(configs, s.traced, bench);
     Progress progress("dacrt bench", s.cameras.size() * configs.size() * std::size_t(cmd.warmup + cmd.repeat));
     for (std::size_t k = 0; k < s.cameras.size(); ++k) measureCamera(run, k, cmd, bench, progress);
 

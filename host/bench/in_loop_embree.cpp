@@ -21,6 +21,13 @@ double InLoopEmbree::build(const TraceScene& scene, const BenchConfig& config) {
     return scene_->buildMs();
 }
 
+void InLoopEmbree::release() {
+    scene_.reset();
+    pixels_.reset();
+    hits_ = {};
+    slots_ = {};
+}
+
 PhaseTimes InLoopEmbree::nextFrame() {
     if (!scene_) throw InternalError("an in-loop embree frame before its structure was built");
     PhaseTimes phases;

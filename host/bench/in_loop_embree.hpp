@@ -40,6 +40,9 @@ public:
     // Returns its phases (trace) and the rays it made.
     PhaseTimes occludeSecondary(const FramePass& pass, ThreadPool& pool, std::uint64_t& rays);
 
+    // Frees the structure and the frame buffers: build makes them again.
+    void release();
+
     const std::vector<Hit>& hits() const { return hits_; }
     const std::vector<Hit>& slots() const { return slots_; }
 

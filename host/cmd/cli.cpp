@@ -423,6 +423,10 @@ Subcommand addBenchCommand(CLI::App& app) {
                     "the rows with their time parts (default OUT/bench.json); tools/bench/plot.py draws them");
     cmd->add_option("--cache", bench.cacheDir, "reference cache directory (default: $XDG_CACHE_HOME/dacrt)");
     cmd->add_flag("--no-cache", s->noCache, "always recompute the float64 reference");
+    cmd->add_option("--memory-limit", bench.memoryLimitMiB,
+                    "the most memory the run may hold, in MiB (default: 90% of this machine's); where every "
+                    "configuration's kept structures do not fit at once, the configurations run one after another")
+        ->check(CLI::Range(std::uint64_t(1), std::uint64_t(1) << 40));
     addDeviceOptions(cmd, bench.device, bench.validate);
     addEnumOption(cmd, "--gpu-profile", bench.gpuProfile,
                   "whose defaults the gpu rows take: auto (the device's kind), cpu (a CPU device's) or discrete "

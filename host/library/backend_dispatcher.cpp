@@ -56,6 +56,13 @@ BackendDispatcher::BackendDispatcher(const DeviceChoice& devices, const std::vec
 
 BackendDispatcher::~BackendDispatcher() = default;
 
+void BackendDispatcher::releaseKept() {
+    passSource_.reset();  // first: it holds buffers of the arena
+    peers_.clear();
+    if (resident_) resident_ = std::make_unique<gpu::ResidentTriangles>();
+    if (arena_) arena_ = std::make_unique<gpu::BufferArena>();
+}
+
 unsigned BackendDispatcher::threadsOf(const TraceOptions& options) {
     if (options.backend == Backend::CpuSeq) return 1;
     return options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
@@ -126,10 +133,10 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
                 .trace(geometry, onPlan,
                        request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
         case Backend::Embree: {
-            // Embree allocates its BVH itself: there is no plan to show or check.
+            // Embree allocates its BVH itself: its plan bounds it from the triangle count.
             EmbreeOptions embree = request.embree;
             embree.threads = threads;
-            return peers_.traceEmbree(geometry, embree, threadPool, frame);
+            return peers_.traceEmbree(geometry, embree, threadPool, onPlan, frame);
         }
         case Backend::RayQuery:
             if (!gpu_) throw InternalError("the rayquery backend was asked for a trace without a device being opened");

@@ -87,6 +87,10 @@ public:
     // (secondaryPassCapacity); unlimited elsewhere.
     PassCapacity secondaryPassCapacity(const BackendRequest& request) const;
 
+    // Frees the peers' structures, the gpu's resident triangles and kept buffers, and the last
+    // frame kept for its passes: the next trace makes them again (Tracer::releaseKept).
+    void releaseKept();
+
     std::uint32_t validationErrors() const;
     // Under --validate: prints every validation message; true when there were errors (the
     // command then fails with its validation exit code).

@@ -23,6 +23,11 @@ struct PeerScenes::Kept {
 PeerScenes::PeerScenes() = default;
 PeerScenes::~PeerScenes() = default;
 
+void PeerScenes::clear() {
+    kept_.clear();
+    sceneId_ = 0;
+}
+
 PeerScenes::Kept* PeerScenes::keptFor(const FrameGeometry& g, Backend backend, const EmbreeOptions& embree,
                                       RayQueryBuild build) {
     if (g.sceneId != sceneId_) {
@@ -50,8 +55,13 @@ PeerScenes::Kept& PeerScenes::keep(Backend backend, const EmbreeOptions& embree,
 }
 
 TraceResult PeerScenes::traceEmbree(const FrameGeometry& g, const EmbreeOptions& options, ThreadPool& pool,
-                                    PeerFrame frame) {
-    if (g.sceneId == 0) return dacrt::traceEmbree(g, options, pool);
+                                    const PlanHook& onPlan, PeerFrame frame) {
+    if (std::optional<TraceResult> planned = stoppedAtEmbreePlan(g, onPlan)) return *planned;
+    if (g.sceneId == 0) {
+        TraceResult result = dacrt::traceEmbree(g, options, pool);
+        result.memory = embreePlan(g);
+        return result;
+    }
     EmbreeOptions key = options;
     key.imageWidth = 0;  // chosen per trace: the frame names its own
     Kept* k = keptFor(g, Backend::Embree, key, {});
@@ -69,6 +79,7 @@ TraceResult PeerScenes::traceEmbree(const FrameGeometry& g, const EmbreeOptions&
     k->triangles = g.triangles->size();
     k->version = g.trianglesVersion;
     TraceResult result = k->embreeScene->trace(*g.rays, pool, g.query, g.imageWidth);
+    result.memory = embreePlan(g);
     result.phases.build = build;
     result.phases.refit = refit;
     return result;

@@ -36,8 +36,9 @@ public:
     // structure then updates it in place (a rebuild into the last one's memory, phase build, or
     // a refit, phase refit); a static one is built once per triangles' version and then only
     // traced.
+    // onPlan sees the frame's plan first (stoppedAtEmbreePlan).
     TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool,
-                            PeerFrame frame);
+                            const PlanHook& onPlan, PeerFrame frame);
 
     // Ray queries: a scene's first trace allocates (phase allocate) and builds; a dynamic or
     // refit structure is rebuilt or refitted by every trace, passes included (RayQueryScene
@@ -45,6 +46,9 @@ public:
     // onPlan sees the frame's plan first (stoppedAtPlan).
     TraceResult traceRayQuery(const FrameGeometry& geometry, RayQueryBuild build, gpu::Context& context,
                               gpu::PipelineCache& pipelines, const PlanHook& onPlan, PeerFrame frame);
+
+    // Frees every kept structure: the next trace of a scene builds again, as its first did.
+    void clear();
 
 private:
     struct Kept;

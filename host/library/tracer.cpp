@@ -142,8 +142,6 @@ FrameOutput Tracer::traceFrame(const TraceScene& scene, const RayBatch& cameraRa
 }
 
 FramePlan Tracer::plan(const TraceScene& scene, const RayBatch& rays) {
-    if (impl_->options.trace.backend == Backend::Embree)
-        throw InputError("embree allocates its BVH itself, so dacrt has no memory plan for it");
     if (rays.impl_->rays.empty()) return {};
     std::optional<MemoryPlan> planned;
     const PlanHook stopAtPlan = [&planned](const MemoryPlan& p) {
@@ -167,6 +165,8 @@ void Tracer::setOptions(const TracerOptions& options) {
     impl_->request = Impl::checkedRequest(options);
     impl_->options = options;
 }
+
+void Tracer::releaseKept() { impl_->dispatcher.releaseKept(); }
 
 const TracerOptions& Tracer::options() const { return impl_->options; }
 

@@ -1,6 +1,7 @@
 #include "peers/embree_tracer.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <mutex>
@@ -10,6 +11,7 @@
 #include <embree3/rtcore.h>
 
 #include "core/timing.hpp"
+#include "peers/embree_memory.hpp"
 #include "peers/embree_packets.hpp"
 
 namespace dacrt {
@@ -57,6 +59,24 @@ struct SharedDevice {
         std::lock_guard<std::mutex> lock(d.messageMutex);
         d.lastMessage = message ? message : "";
     }
+
+    // What the device's structures hold now, and the most since markPeak: Embree reports each
+    // allocation before it is made and each release after it, from any of its threads.
+    std::atomic<std::int64_t> bytes{0}, peakBytes{0};
+
+    static bool countBytes(void* self, ssize_t change, bool) {
+        SharedDevice& d = *static_cast<SharedDevice*>(self);
+        const std::int64_t now = d.bytes.fetch_add(change) + change;
+        std::int64_t peak = d.peakBytes.load();
+        while (now > peak && !d.peakBytes.compare_exchange_weak(peak, now)) {
+        }
+        return true;  // counted, never refused: the bench plans before it builds (peers/embree_memory.hpp)
+    }
+    std::int64_t markPeak() {
+        const std::int64_t now = bytes.load();
+        peakBytes.store(now);
+        return now;
+    }
 };
 
 SharedDevice& sharedDevice(unsigned threads) {
@@ -75,6 +95,7 @@ SharedDevice& sharedDevice(unsigned threads) {
         slot = new SharedDevice;
         slot->device = device;
         rtcSetDeviceErrorFunction(device, &SharedDevice::recordError, slot);
+        rtcSetDeviceMemoryMonitorFunction(device, &SharedDevice::countBytes, slot);
     }
     return *slot;
 }
@@ -164,6 +185,7 @@ EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOpt
     impl_->options = options;
 
     // Only what a new frame repeats is timed: the scene, its geometry and the BVH build.
+    const std::int64_t bytesBefore = impl_->shared->markPeak();
     const Clock::time_point start = Clock::now();
     impl_->scene = rtcNewScene(impl_->device);
     impl_->check("rtcNewScene");
@@ -212,6 +234,8 @@ EmbreeScene::EmbreeScene(const std::vector<Triangle>& triangles, const EmbreeOpt
     rtcCommitScene(impl_->scene);
     impl_->check("rtcCommitScene");
     buildMs_ = msSince(start);
+    memory_.held = std::uint64_t(std::max<std::int64_t>(0, impl_->shared->bytes.load() - bytesBefore));
+    memory_.buildPeak = std::uint64_t(std::max<std::int64_t>(0, impl_->shared->peakBytes.load() - bytesBefore));
 }
 
 EmbreeScene::~EmbreeScene() = default;
@@ -295,6 +319,23 @@ TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool, H
     }
     result.phases.trace = msSince(start);
     return result;
+}
+
+MemoryPlan embreePlan(const FrameGeometry& geometry) {
+    MemoryPlan plan;
+    plan.add("embree: structure and index buffer (a bound from the triangle count; Embree allocates them)",
+             embreeStructureBytesBound(geometry.triangles->size()));
+    plan.add("hits", geometry.rays->size() * sizeof(Hit));
+    plan.addWork("rays", geometry.rays->size(), "traced by Embree");
+    return plan;
+}
+
+std::optional<TraceResult> stoppedAtEmbreePlan(const FrameGeometry& geometry, const PlanHook& onPlan) {
+    if (!onPlan) return std::nullopt;
+    TraceResult planned;
+    planned.memory = embreePlan(geometry);
+    if (onPlan(planned.memory)) return std::nullopt;
+    return planned;
 }
 
 TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool) {

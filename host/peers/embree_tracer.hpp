@@ -14,6 +14,7 @@
 #include "cpu/options.hpp"  // EmbreeBuild's names
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
+#include "cpu/memory_plan.hpp"
 #include "cpu/trace_result.hpp"
 
 struct RTCSceneTy;  // Embree's scene (embree3/rtcore_scene.h: RTCScene is a pointer to it)
@@ -32,6 +33,14 @@ public:
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
     double buildMs() const { return buildMs_; }
+
+    // What Embree allocated for this structure, from the device's memory monitor: what it
+    // holds after its build, and the most it held during the build (temporaries included).
+    // Counted device-wide, so exact only where no other structure builds on the device at once.
+    struct Memory {
+        std::uint64_t held = 0, buildPeak = 0;
+    };
+    Memory memory() const { return memory_; }
 
     // After the triangles' vertices moved (same count): refit (Refit) or rebuild (otherwise).
     // Returns the milliseconds it took.
@@ -58,10 +67,19 @@ private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
     double buildMs_ = 0.0;
+    Memory memory_;
 };
 
 // A dynamic-scene frame: build, then trace the frame's rays for its query, in tiles where the
 // frame says its rays are an image. phases holds build and trace.
 TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool);
+
+// The frame's memory as Embree holds it: its structure and index buffer by their bound from
+// the triangle count (peers/embree_memory.hpp), and the hits; its work, the rays.
+MemoryPlan embreePlan(const FrameGeometry& geometry);
+
+// Where onPlan declines embreePlan (returns false), the plan as a trace with no hits (as every
+// backend's plan stops); none where it goes on or there is no onPlan.
+std::optional<TraceResult> stoppedAtEmbreePlan(const FrameGeometry& geometry, const PlanHook& onPlan);
 
 }  // namespace dacrt

@@ -80,8 +80,6 @@ void checkOutputNames(const RenderOptions& o) {
 void checkRenderOptions(const RenderOptions& o) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw InputError("--size: width and height must lie in 1..16384");
-    if (o.tracer.trace.backend == Backend::Embree && o.planOnly)
-        throw InputError("--plan: embree allocates its BVH itself, so dacrt has no memory plan for it");
     checkTracerOptions(o.tracer);
     checkPassOptions(o.passes);
     checkFrameOptions(o);

@@ -71,8 +71,8 @@ public:
     // The memory and work plan trace() would follow, without tracing: no ray meets a
     // triangle. The plan depends on more than the counts: the skips and the division into
     // sub-scenes decide it, so their passes over the scene and rays run (as for `dacrt render
-    // --plan`). Throws InputError for embree, which allocates its hierarchy itself and has no
-    // plan.
+    // --plan`). Embree allocates its structure itself: its plan bounds it from the triangle
+    // count (the most Embree 3.13.5 was measured to take, docs/benchmarks.md).
     FramePlan plan(const TraceScene& scene, const RayBatch& rays);
 
     // Later traces use these options, on the threads and device already open: a sweep over
@@ -80,6 +80,12 @@ public:
     // as the constructor does, on another device or validation choice than the open one, and
     // on gpu or rayquery for a tracer made without them (which opened no device).
     void setOptions(const TracerOptions& options);
+
+    // Frees what this tracer keeps between traces: the peers' structures, and the gpu's
+    // resident triangles and kept buffers. The next trace of a scene makes them again, as a
+    // scene's first trace does: for a caller that holds more than memory allows at once (a
+    // bench run whose configurations would each keep their own: docs/benchmarks.md).
+    void releaseKept();
 
     const TracerOptions& options() const;
     // gpu, rayquery: the Vulkan device opened, "name (driver)"; empty where none is open.

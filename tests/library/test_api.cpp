@@ -14,6 +14,7 @@
 #include "core/gltf_loader.hpp"
 #include "cpu/predicates.hpp"
 #include "library/backend_dispatcher.hpp"
+#include "peers/embree_memory.hpp"
 #include "support/api_support.hpp"
 #include "support/fixtures.hpp"
 
@@ -265,7 +266,14 @@ TEST(ApiTracer, PlanIsTheTracesWithoutTracing) {
         for (const FramePlan::Work& w : plan.work) raysLine |= w.name == "rays" && w.count == rays.size();
         EXPECT_TRUE(raysLine) << int(b);
     }
-    expectInputError([&] { Tracer(onBackend(Backend::Embree)).plan(scene, rays); }, "no memory plan");
+    // Embree's plan bounds the structure it allocates itself from the triangle count.
+    Tracer embree(onBackend(Backend::Embree));
+    const FramePlan plan = embree.plan(scene, rays);
+    ASSERT_EQ(plan.memory.size(), 2u);
+    EXPECT_NE(plan.memory[0].name.find("embree: structure"), std::string::npos);
+    EXPECT_EQ(plan.memory[0].bytes, embreeStructureBytesBound(scene.triangleCount()));
+    EXPECT_EQ(plan.memory[1].bytes, rays.size() * sizeof(Hit));
+    EXPECT_EQ(embree.trace(scene, rays).plan.totalBytes(), plan.totalBytes());
 }
 
 TEST(ApiTracer, ReportsTypedTimingsAndCounters) {

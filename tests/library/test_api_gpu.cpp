@@ -244,6 +244,15 @@ TEST(ApiGpu, BuffersKeptBetweenFramesOfEverySizeGiveCpuSeqHits) {
         const std::vector<RayHit> any = gpu->occluded(scene, rays).hits;
         for (std::size_t i = 0; i < any.size(); ++i) ASSERT_EQ(any[i].hit(), out.hits[i].hit()) << "frame " << f << " ray " << i;
     }
+    // Released (Tracer::releaseKept), the next frame finds nothing kept and the same hits.
+    const test::RayArrays r = test::randomRayArrays(99, 9000);
+    const RayBatch rays = RayBatch::fromArrays(r.origins, r.directions, {}, r.tmax);
+    const TraceOutput before = gpu->trace(scenes[0], rays);
+    EXPECT_GT(reusedBytes(gpu->trace(scenes[0], rays).plan), 0u);
+    gpu->releaseKept();
+    const TraceOutput after = gpu->trace(scenes[0], rays);
+    EXPECT_EQ(reusedBytes(after.plan), 0u);
+    EXPECT_TRUE(sameHits(after.hits, before.hits));
     EXPECT_EQ(gpu->validationErrors(), 0u);
 }
 

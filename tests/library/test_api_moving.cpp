@@ -104,6 +104,24 @@ TEST(ApiMovingScene, EmbreeKeepsAStructurePerOptionSetAndFreesThemForAnotherScen
     EXPECT_EQ(phaseNames(tracer.trace(scene, f.rays))[0], "build");  // freed by the other scene's trace
 }
 
+TEST(ApiMovingScene, ReleasedStructuresAreBuiltAgainByTheNextTrace) {
+    const MovingFrame f;
+    const TraceScene scene = f.original();
+    Tracer tracer(embreeWith(EmbreeBuild::Refit));
+    const TraceOutput first = tracer.trace(scene, f.rays);
+    EXPECT_EQ(phaseNames(tracer.trace(scene, f.rays))[0], "refit");
+    tracer.releaseKept();
+    const TraceOutput rebuilt = tracer.trace(scene, f.rays);
+    EXPECT_EQ(phaseNames(rebuilt)[0], "build");  // as the scene's first trace
+    EXPECT_TRUE(sameHits(rebuilt.hits, first.hits));
+    EXPECT_EQ(phaseNames(tracer.trace(scene, f.rays))[0], "refit");  // kept again
+    // On a backend that keeps nothing between traces it frees nothing and changes nothing.
+    Tracer cpu(onBackend(Backend::Cpu, 2));
+    const TraceOutput before = cpu.trace(scene, f.rays);
+    cpu.releaseKept();
+    EXPECT_TRUE(sameHits(cpu.trace(scene, f.rays).hits, before.hits));
+}
+
 TEST(ApiMovingScene, ATriangleMovedToNoAreaIsNeverHit) {
     // Triangle 0 in front of triangle 1; rays along -z through both.
     const std::vector<float> p = {-1, -1, -1, 1, -1, -1, 0, 1, -1, -2, -2, -2, 2, -2, -2, 0, 2, -2};

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <string>
 
+#include "peers/embree_memory.hpp"
 #include "peers/embree_tracer.hpp"
 #include "core/procedural.hpp"
 #include "support/frames.hpp"
@@ -238,6 +239,26 @@ TEST(EmbreeScene, ReportsBuildAndTraceTimes) {
     EXPECT_EQ(r.axis, -1);
     EXPECT_EQ(r.hits.size(), frame.rays.size());
     EXPECT_GT(hitCount(r.hits), frame.rays.size() / 20);
+}
+
+// The bench plans Embree's memory before Embree allocates it (peers/embree_memory.hpp): the
+// bound must hold what its memory monitor counts, held and at the build's peak, in every build
+// mode, on a small scene (where the fixed part weighs most) and on a mid-sized one.
+TEST(EmbreeScene, MemoryStaysWithinThePlannedBoundInEveryBuildMode) {
+    std::vector<Mesh> meshes = {icosphere({-0.8f, 0.0f, 0.0f}, 0.7f, 5), torus({0.9f, -0.2f, 0.3f}, 0.6f, 0.2f, 80, 32)};
+    const std::vector<Scene> scenes = {test::shapesScene(), sceneFromMeshes(meshes, "large")};
+    for (const Scene& s : scenes) {
+        for (EmbreeBuild build : {EmbreeBuild::Dynamic, EmbreeBuild::Refit, EmbreeBuild::Static}) {
+            EmbreeOptions options;
+            options.build = build;
+            const EmbreeScene scene(s.triangles, options);
+            const EmbreeScene::Memory m = scene.memory();
+            const std::uint64_t bound = embreeStructureBytesBound(s.triangles.size());
+            EXPECT_GT(m.held, 0u) << s.triangles.size() << " triangles, build " << int(build);
+            EXPECT_GE(m.buildPeak, m.held);
+            EXPECT_LE(m.buildPeak, bound) << s.triangles.size() << " triangles, build " << int(build);
+        }
+    }
 }
 
 TEST(EmbreeScene, OneAndTwoThreadsGiveIdenticalHits) {
