@@ -148,6 +148,7 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     const DacrtOptions dacrt = trace.dacrt.resolvedFor(trace.backend);
     j["options"] = {{"ray_limit", dacrt.rayLimit}, {"tri_limit", dacrt.triLimit},
                     {"max_depth", trace.dacrt.maxDepth}, {"split", toString(trace.dacrt.split)},
+                    {"split_cost", toString(trace.dacrt.splitCost)},
                     {"axis", toString(trace.axis)}, {"intersector", toString(trace.dacrt.intersector)},
                     {"triangle_filter", toString(trace.dacrt.triangleFilter)},
                     {"precision", toString(trace.dacrt.precision)},
