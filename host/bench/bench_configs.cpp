@@ -32,6 +32,8 @@ std::string optionText(const BenchConfig& c) {
       << " precision=" << toString(d.precision) << " split=" << toString(d.split) << " ray_limit=" << d.rayLimit
       << " tri_limit=" << d.triLimit << " axis=" << toString(c.options.trace.axis) << " regions=" << c.options.trace.regions
       << " threads=" << c.threads();
+    if (d.splitCost != SplitCost::Limits) s << " split_cost=" << toString(d.splitCost);
+    if (!d.packets) s << " packets=off";
     if (c.backend() == Backend::Gpu)
         s << " ray_groups=" << (c.options.gpu.rayGroups ? std::to_string(c.options.gpu.rayGroups) : "auto");
     if (c.backend() == Backend::Gpu && c.options.gpu.profile != GpuProfile::Auto)
@@ -55,59 +57,74 @@ BenchConfig baseConfig(Backend b, unsigned hardwareThreads) {
     return c;
 }
 
+namespace {
+
+// A non-default row of base's series: base changed by `change`, named `name`.
+template <typename Change>
+BenchConfig variantOf(const BenchConfig& base, const std::string& name, Change&& change) {
+    BenchConfig c = base;
+    c.name = name;
+    c.isDefault = false;
+    change(c);
+    return c;
+}
+
+// base as the series of one build mode of a peer ("embree refit"): the default is the dynamic one.
+template <typename Build, typename SetBuild>
+BenchConfig buildSeries(const BenchConfig& base, const std::string& peer, Build build, SetBuild setBuild) {
+    BenchConfig c = base;
+    c.series = peer + " " + toString(build);
+    setBuild(c, build);
+    c.isDefault = build == Build::Dynamic;
+    return c;
+}
+
+// As a Vulkan user builds for each case (the device's own ray tracing).
+std::vector<BenchConfig> rayQuerySweep(const BenchConfig& base) {
+    std::vector<BenchConfig> out;
+    for (RayQueryBuild build : {RayQueryBuild::Dynamic, RayQueryBuild::Refit, RayQueryBuild::Static})
+        out.push_back(buildSeries(base, "rayquery", build, [](BenchConfig& row, RayQueryBuild b) { row.options.rayQueryBuild = b; }));
+    return out;
+}
+
+// As Embree's users run each case: a series per build mode, its rays made in the tracing loop,
+// robust mode on (the default, exact on the models) and off; then the same with its rays made
+// and stored first and traced through the Tracer (what the rows were before issue 32), and
+// single rays against packets once (on stored rays: the in-loop tracer is the packets').
+std::vector<BenchConfig> embreeSweep(const BenchConfig& base) {
+    std::vector<BenchConfig> out;
+    for (EmbreeBuild build : {EmbreeBuild::Dynamic, EmbreeBuild::Refit, EmbreeBuild::Static}) {
+        BenchConfig c = buildSeries(base, "embree", build, [](BenchConfig& row, EmbreeBuild b) { row.options.embree.build = b; });
+        out.push_back(c);
+        c.isDefault = false;
+        BenchConfig stored = c;
+        stored.name = kStoredRays;
+        stored.raysInLoop = false;
+        c.name = "robust=off";
+        c.options.embree.robust = false;
+        out.push_back(c);
+        out.push_back(stored);
+    }
+    out.push_back(variantOf(base, "rtcIntersect1, " + std::string(kStoredRays), [](BenchConfig& c) {
+        c.options.embree.packets = false;
+        c.raysInLoop = false;
+    }));
+    out.back().series = "embree dynamic";
+    // Without the face rule's filter: what a user whose meshes show no back face runs.
+    out.push_back(variantOf(base, "face-filter=off", [](BenchConfig& c) { c.options.embree.faceFilter = false; }));
+    out.back().series = "embree dynamic";
+    return out;
+}
+
+}  // namespace
+
 std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions,
                                       std::uint32_t gpuDefaultRayGroups) {
-    std::vector<BenchConfig> out;
     const BenchConfig base = baseConfig(b, hardwareThreads);
-    auto variant = [&](const std::string& name, auto&& change) {
-        BenchConfig c = base;
-        c.name = name;
-        c.isDefault = false;
-        change(c);
-        out.push_back(c);
-    };
-    if (b == Backend::RayQuery) {
-        // As a Vulkan user builds for each case (the device's own ray tracing).
-        for (RayQueryBuild build : {RayQueryBuild::Dynamic, RayQueryBuild::Refit, RayQueryBuild::Static}) {
-            BenchConfig c = base;
-            c.series = "rayquery " + toString(build);
-            c.options.rayQueryBuild = build;
-            c.isDefault = build == RayQueryBuild::Dynamic;
-            out.push_back(c);
-        }
-        return out;
-    }
-    if (b == Backend::Embree) {
-        // As Embree's users run each case: a series per build mode, its rays made in the
-        // tracing loop, robust mode on (the default, exact on the models) and off; then the
-        // same with its rays made and stored first and traced through the Tracer (what the
-        // rows were before issue 32), and single rays against packets once (on stored rays:
-        // the in-loop tracer is the packets').
-        for (EmbreeBuild build : {EmbreeBuild::Dynamic, EmbreeBuild::Refit, EmbreeBuild::Static}) {
-            BenchConfig c = base;
-            c.series = "embree " + toString(build);
-            c.options.embree.build = build;
-            c.isDefault = build == EmbreeBuild::Dynamic;
-            out.push_back(c);
-            c.isDefault = false;
-            BenchConfig stored = c;
-            stored.name = kStoredRays;
-            stored.raysInLoop = false;
-            c.name = "robust=off";
-            c.options.embree.robust = false;
-            out.push_back(c);
-            out.push_back(stored);
-        }
-        variant("rtcIntersect1, " + std::string(kStoredRays), [](BenchConfig& c) {
-            c.options.embree.packets = false;
-            c.raysInLoop = false;
-        });
-        out.back().series = "embree dynamic";
-        // Without the face rule's filter: what a user whose meshes show no back face runs.
-        variant("face-filter=off", [](BenchConfig& c) { c.options.embree.faceFilter = false; });
-        out.back().series = "embree dynamic";
-        return out;
-    }
+    if (b == Backend::RayQuery) return rayQuerySweep(base);
+    if (b == Backend::Embree) return embreeSweep(base);
+    std::vector<BenchConfig> out;
+    auto variant = [&](const std::string& name, auto&& change) { out.push_back(variantOf(base, name, change)); };
     out.push_back(base);
     if (b == Backend::Brute) return out;
     const bool cpu = b == Backend::Cpu || b == Backend::CpuSeq;
@@ -118,6 +135,13 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         variant("precision=f64", [](BenchConfig& c) { c.options.trace.dacrt.precision = Precision::F64; });
         variant("split=centroid-mean", [](BenchConfig& c) { c.options.trace.dacrt.split = SplitMethod::CentroidMean; });
         variant("split=sampled-mean", [](BenchConfig& c) { c.options.trace.dacrt.split = SplitMethod::SampledMean; });
+        // Nabata et al. 2013's ray-sampling cost: with packets (it decides below their levels)
+        // and without (it decides from the top).
+        variant("split-cost=ray-sampling", [](BenchConfig& c) { c.options.trace.dacrt.splitCost = SplitCost::RaySampling; });
+        variant("split-cost=ray-sampling packets=off", [](BenchConfig& c) {
+            c.options.trace.dacrt.splitCost = SplitCost::RaySampling;
+            c.options.trace.dacrt.packets = false;
+        });
     }
     const DacrtOptions defaults = base.options.trace.dacrt.resolvedFor(b);
     if (cpu) {

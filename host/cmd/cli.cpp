@@ -93,6 +93,7 @@ std::vector<std::string> dacrtBackendNames() { return {"brute", "cpu-seq", "cpu"
 // The DACRT options (render's only: bench sweeps them); their help comes from the table.
 void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     addEnumOption(cmd, "--split", o.split, "");
+    addEnumOption(cmd, "--split-cost", o.splitCost, "");
     const std::string gpu = ", " + std::to_string(kGpuLeafLimit) + " on gpu";
     cmd->add_option("--ray-limit", o.rayLimit)
         ->check(CLI::Range(1u, 1u << 30))

@@ -19,7 +19,7 @@ constexpr bool kAdvanced = true;
 constexpr bool kDacrtOption = true;
 
 // The order is the help's, and the order in which a refusal names the options.
-constexpr std::array<BackendOption, 17> kBackendOptions{{
+constexpr std::array<BackendOption, 18> kBackendOptions{{
     {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
@@ -32,6 +32,11 @@ constexpr std::array<BackendOption, 17> kBackendOptions{{
      [](const RequestedOptions& r) { return r.trace.dacrt.triLimit != 0; }},
     {"--split", kCpuDacrt, "DACRT split", "gpu always splits at the spatial median", !kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.split != DacrtOptions{}.split; }},
+    {"--split-cost", kCpuDacrt,
+     "what makes a node a leaf: limits (--ray-limit, --tri-limit) or ray-sampling (Nabata et al. 2013: also where a "
+     "sample of its rays and triangles estimates a leaf cheaper than any split; it then splits where that estimate is lowest)",
+     "with packets, ray-sampling decides in the levels traced ray by ray", !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.splitCost != DacrtOptions{}.splitCost; }},
     {"--intersector", kCpuDacrt, "leaf ray/triangle test", "", !kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.intersector != DacrtOptions{}.intersector; }},
     {"--triangle-filter", kCpuDacrt, "triangle/box filter: bounds, sat (exact separating axes) or mora (inexact)", "",

@@ -27,6 +27,11 @@ struct EnumNames<SplitMethod> {
          {SplitMethod::SampledMean, "sampled-mean"}}};
 };
 template <>
+struct EnumNames<SplitCost> {
+    static constexpr std::array<std::pair<SplitCost, std::string_view>, 2> table{
+        {{SplitCost::Limits, "limits"}, {SplitCost::RaySampling, "ray-sampling"}}};
+};
+template <>
 struct EnumNames<DivisionAxis> {
     static constexpr std::array<std::pair<DivisionAxis, std::string_view>, 4> table{
         {{DivisionAxis::Best, "best"}, {DivisionAxis::X, "x"}, {DivisionAxis::Y, "y"}, {DivisionAxis::Z, "z"}}};

@@ -205,16 +205,19 @@ float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triB
 // one, then the rays moving down the low one, so that each ray meets its children in the
 // order it crosses them. itemBegin is read again for each visit: a ray recursion moves the
 // rays an earlier visit finished before it. False (nothing done) where the node must end here
-// instead: fewItems, too few triangles, too deep, stalled, or no split inside.
+// instead: fewItems, too few triangles, too deep, stalled, no split inside, or (sampleRays:
+// items are rays, under SplitCost::RaySampling) cheaper as a leaf by the sampled estimate.
 template <typename FilterItems, typename Descend>
 bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, std::uint32_t itemEnd,
                                std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
-                               std::uint32_t stalls, bool fewItems, FilterItems filterItems, Descend descend) {
+                               std::uint32_t stalls, bool fewItems, bool sampleRays, FilterItems filterItems,
+                               Descend descend) {
     const int axis = longestAxis(box);
-    const float split = splitPosition(box, axis, triBegin, triEnd);
+    float split = splitPosition(box, axis, triBegin, triEnd);
     if (fewItems || triEnd - triBegin < options_.triLimit || depth >= options_.maxDepth ||
         stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis]))
         return false;
+    if (sampleRays && !sampledSplit(box, axis, itemBegin, itemEnd, triBegin, triEnd, split)) return false;
     Box low = box, high = box;
     low.hi[axis] = split;
     high.lo[axis] = split;
@@ -241,12 +244,22 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     return true;
 }
 
+bool DacrtTraversal::sampledSplit(const Box& box, int axis, std::uint32_t rayBegin, std::uint32_t rayEnd,
+                                  std::uint32_t triBegin, std::uint32_t triEnd, float& split) {
+    const SampledNode sampled{rays_, hits_, rayIds_ + rayBegin, rayEnd - rayBegin,
+                              triangleBounds_, triIds_ + triBegin, triEnd - triBegin};
+    const SplitChoice choice = chooseSplitByRaySampling(sampled, box, axis, margin_, split);
+    counters_.rayBoxTests += choice.rayBoxTests;
+    if (choice.split) split = choice.position;
+    return choice.split;
+}
+
 void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
                           std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
     if (terminated >= rayEnd || triBegin >= triEnd) return;
     const bool split = splitNode(
         box, terminated, rayEnd, triBegin, triEnd, depth, stalls, rayEnd - terminated < options_.rayLimit,
-        [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving) {
+        options_.splitCost == SplitCost::RaySampling, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving) {
             return filterRaysMoving(cell, begin, end, axis, moving);
         },
         [&](const Box& child, std::uint32_t childRays, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
@@ -329,7 +342,7 @@ void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std:
     if (packetBegin >= packetEnd || triBegin >= triEnd) return;
     const bool split = splitNode(
         box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls, packetEnd - packetBegin < options_.packetFlush,
-        [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int) { return filterPackets(cell, begin, end); },
+        false, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int) { return filterPackets(cell, begin, end); },
         [&](const Box& child, std::uint32_t childPackets, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
             nodePackets(child, packetBegin, childPackets, triBegin, childTris, d, s);
         });

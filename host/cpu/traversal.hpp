@@ -9,6 +9,7 @@
 #include "cpu/memory_plan.hpp"
 #include "cpu/simd_kernels.hpp"
 #include "cpu/options.hpp"
+#include "cpu/ray_sampling.hpp"
 #include "cpu/trace_result.hpp"
 
 namespace dacrt {
@@ -101,8 +102,10 @@ public:
 private:
     template <typename FilterItems, typename Descend>
     bool splitNode(const Box& box, const std::uint32_t& itemBegin, std::uint32_t itemEnd, std::uint32_t triBegin,
-                   std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool fewItems,
+                   std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool fewItems, bool sampleRays,
                    FilterItems filterItems, Descend descend);
+    bool sampledSplit(const Box& box, int axis, std::uint32_t rayBegin, std::uint32_t rayEnd, std::uint32_t triBegin,
+                      std::uint32_t triEnd, float& split);
     void node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,

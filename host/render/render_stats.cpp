@@ -118,6 +118,27 @@ nlohmann::ordered_json lightsJson(const RenderedFrame& frame) {
     return lights;
 }
 
+// The trace's options as the frame ran them: the DACRT backends' resolved, or Embree's own.
+nlohmann::ordered_json optionsJson(const RenderOptions& o) {
+    const TraceOptions& trace = o.tracer.trace;
+    if (trace.backend == Backend::Embree)
+        return {{"robust", o.tracer.embree.robust}, {"build", toString(o.tracer.embree.build)},
+                {"packets", o.tracer.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
+    const DacrtOptions dacrt = trace.dacrt.resolvedFor(trace.backend);
+    return {{"ray_limit", dacrt.rayLimit}, {"tri_limit", dacrt.triLimit},
+            {"max_depth", trace.dacrt.maxDepth}, {"split", toString(trace.dacrt.split)},
+            {"split_cost", toString(trace.dacrt.splitCost)},
+            {"axis", toString(trace.axis)}, {"intersector", toString(trace.dacrt.intersector)},
+            {"triangle_filter", toString(trace.dacrt.triangleFilter)},
+            {"precision", toString(trace.dacrt.precision)},
+            {"cull", toString(o.cull)},
+            {"skip_backfaces", trace.skips.backFaces},
+            {"skip_frustum", trace.skips.frustum},
+            {"skip_uploads", trace.skips.uploads},
+            {"skip_subscenes", trace.skips.subScenes},
+            {"skip_passrays", trace.skips.passRays}};
+}
+
 }  // namespace
 
 nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFrame& frame) {
@@ -145,21 +166,7 @@ nlohmann::ordered_json renderStatsJson(const RenderOptions& o, const RenderedFra
     if (camera.projection == Projection::Perspective) j["camera"]["yfov_degrees"] = glm::degrees(camera.yfovRadians);
     else j["camera"]["ymag"] = camera.ymag;
     if (scene.camera && !scene.camera->name.empty()) j["camera"]["name"] = scene.camera->name;
-    const DacrtOptions dacrt = trace.dacrt.resolvedFor(trace.backend);
-    j["options"] = {{"ray_limit", dacrt.rayLimit}, {"tri_limit", dacrt.triLimit},
-                    {"max_depth", trace.dacrt.maxDepth}, {"split", toString(trace.dacrt.split)},
-                    {"axis", toString(trace.axis)}, {"intersector", toString(trace.dacrt.intersector)},
-                    {"triangle_filter", toString(trace.dacrt.triangleFilter)},
-                    {"precision", toString(trace.dacrt.precision)},
-                    {"cull", toString(o.cull)},
-                    {"skip_backfaces", trace.skips.backFaces},
-                    {"skip_frustum", trace.skips.frustum},
-                    {"skip_uploads", trace.skips.uploads},
-                    {"skip_subscenes", trace.skips.subScenes},
-                    {"skip_passrays", trace.skips.passRays}};
-    if (trace.backend == Backend::Embree)
-        j["options"] = {{"robust", o.tracer.embree.robust}, {"build", toString(o.tracer.embree.build)},
-                        {"packets", o.tracer.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
+    j["options"] = optionsJson(o);
     nlohmann::ordered_json t;
     for (const auto& [name, ms] : frame.timingsMs) t[name] = ms;
     const nlohmann::ordered_json phases = phasesJson(r.timings);

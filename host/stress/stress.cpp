@@ -89,6 +89,9 @@ std::vector<StressConfig> stressConfigs(const std::vector<Backend>& backends, bo
                 c.trace.dacrt.split = s;
                 out.push_back(c);
             }
+            StressConfig sampled = config(base + " --split-cost ray-sampling", false, b);
+            sampled.trace.dacrt.splitCost = SplitCost::RaySampling;
+            out.push_back(sampled);
         }
         // The smallest leaves: 1 on the CPU; 4 on the GPU, where 1 took 495 s instead of 5 s
         // for the small watertight family on lavapipe (a workgroup-wide step per tiny node).

@@ -12,6 +12,11 @@ constexpr bool runsOnVulkan(Backend b) { return b == Backend::Gpu || b == Backen
 // embree and rayquery are the peers: they build their own hierarchy and take no DACRT options.
 constexpr bool isPeer(Backend b) { return b == Backend::Embree || b == Backend::RayQuery; }
 enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
+// What makes a DACRT node a leaf. Limits: fewer rays or triangles than the leaf limits.
+// RaySampling (Nabata et al. 2013, cpu only): above the limits too, wherever a fixed sample of
+// the node's rays and triangles estimates a leaf cheaper than filtering them into children;
+// it also picks the split among the split method's position and the axis's quarter points.
+enum class SplitCost { Limits, RaySampling };
 enum class DivisionAxis { Best, X, Y, Z };
 // Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks
 // through shared edges; Moller-Trumbore is the classic faster test without that guarantee.
@@ -40,6 +45,7 @@ struct DacrtOptions {
     std::uint32_t triLimit = 0;    // a node with fewer triangles is a leaf; 0: the backend's default
     std::uint32_t maxDepth = 48;   // guards against coincident triangles that never separate
     SplitMethod split = SplitMethod::SpatialMedian;
+    SplitCost splitCost = SplitCost::Limits;
     Intersector intersector = Intersector::Watertight;
     TriangleFilter triangleFilter = TriangleFilter::Bounds;
     Precision precision = Precision::F32;

@@ -88,6 +88,7 @@ TEST(Bench, SweepWritesRowsAndCacheAndDefaultsAreExact) {
     }
     for (const char* expected : {"cpu-seq intersector=moller-trumbore", "cpu-seq triangle-filter=sat",
                                  "cpu-seq triangle-filter=mora", "cpu-seq precision=f64", "cpu-seq split=sampled-mean",
+                                 "cpu-seq split-cost=ray-sampling", "cpu split-cost=ray-sampling packets=off",
                                  "cpu regions=64", "cpu axis=z", "embree static default", "embree dynamic robust=off",
                                  "embree refit default", "embree refit robust=off", "embree refit stored rays",
                                  "embree dynamic rtcIntersect1, stored rays"})

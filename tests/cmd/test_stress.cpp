@@ -385,6 +385,7 @@ TEST(StressCommand, PrintsTheTableAndWritesJson) {
         "stress --size small --families split-plane --backends brute,cpu-seq,cpu --no-determinism --json " + json);
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_NE(r.output.find("cpu-seq --split centroid-mean"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("cpu --split-cost ray-sampling"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("every default configuration is clean"), std::string::npos) << r.output;
     std::ifstream f(json);
     const nlohmann::json j = nlohmann::json::parse(f);

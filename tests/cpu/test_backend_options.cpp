@@ -37,8 +37,10 @@ TEST(BackendOptions, ATracerRefusesTheDacrtOptionsItDoesNotTake) {
     TraceOptions gpu;
     gpu.backend = Backend::Gpu;
     gpu.dacrt.split = SplitMethod::CentroidMean;
+    gpu.dacrt.splitCost = SplitCost::RaySampling;
     gpu.dacrt.packets = false;
-    EXPECT_NE(refusal([&] { checkTraceOptions(gpu); }).find("--split and --packets are not options of --backend gpu"),
+    EXPECT_NE(refusal([&] { checkTraceOptions(gpu); })
+                  .find("--split, --split-cost and --packets are not options of --backend gpu"),
               std::string::npos);
     TraceOptions brute;
     brute.backend = Backend::Brute;

@@ -73,7 +73,8 @@ bool sameBits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std:
 
 // The optimised traversal's option sets that promise brute force's hits: the defaults (SIMD,
 // packets where the rays allow), without packets, packets down to the leaves, and the scalar
-// path (the exact separating-axis filter) with the smallest leaves.
+// path (the exact separating-axis filter) with the smallest leaves; each again with the
+// ray-sampling cost deciding leaves and splits (where the tiny leaves leave it every node).
 std::vector<std::pair<std::string, DacrtOptions>> exactOptionSets() {
     DacrtOptions noPackets, packetsToTheLeaves, scalarTinyLeaves;
     noPackets.packets = false;
@@ -81,10 +82,16 @@ std::vector<std::pair<std::string, DacrtOptions>> exactOptionSets() {
     scalarTinyLeaves.triangleFilter = TriangleFilter::Sat;
     scalarTinyLeaves.rayLimit = 1;
     scalarTinyLeaves.triLimit = 2;
-    return {{"defaults", {}},
-            {"no packets", noPackets},
-            {"packets to the leaves", packetsToTheLeaves},
-            {"scalar, tiny leaves", scalarTinyLeaves}};
+    std::vector<std::pair<std::string, DacrtOptions>> sets = {{"defaults", {}},
+                                                              {"no packets", noPackets},
+                                                              {"packets to the leaves", packetsToTheLeaves},
+                                                              {"scalar, tiny leaves", scalarTinyLeaves}};
+    for (std::size_t i = 0, n = sets.size(); i < n; ++i) {
+        DacrtOptions sampled = sets[i].second;
+        sampled.splitCost = SplitCost::RaySampling;
+        sets.emplace_back(sets[i].first + ", ray-sampling cost", sampled);
+    }
+    return sets;
 }
 
 void expectExact(const Case& c) {
@@ -129,6 +136,10 @@ void expectExact(const Case& c) {
         o.axis = DivisionAxis::Best;
         o.dacrt.packets = false;
         check(traceParallel(g, o, pool).hits, "cpu, 3 regions, no packets, " + std::to_string(threads) + " threads");
+        o.dacrt.splitCost = SplitCost::RaySampling;
+        check(traceParallel(g, o, pool).hits, "cpu, 3 regions, no packets, ray-sampling cost, " + std::to_string(threads) + " threads");
+        o.dacrt.packets = true;
+        check(traceParallel(g, o, pool).hits, "cpu, 3 regions, ray-sampling cost, " + std::to_string(threads) + " threads");
     }
 }
 

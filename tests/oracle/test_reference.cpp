@@ -193,8 +193,8 @@ TraceResult traceWith(const Frame& f, Backend b, DacrtOptions dacrt) {
     return traceCpu(f.geometry, o, pool);
 }
 
-// Conservative filters change which triangles a leaf sees, never the answer: hit for hit the
-// same as the default. The float64 leaf has no real error against the reference.
+// Conservative filters change which triangles a leaf sees, and the ray-sampling cost where the
+// leaves are, never the answer: hit for hit the same as the default. The float64 leaf has no real error against the reference.
 TEST(DacrtOptions, ConservativeOptionsMatchTheDefaultAndF64MatchesTheReference) {
     const Scene s = shapesWithFloorGrid();
     CameraOptions orbit;
@@ -208,6 +208,16 @@ TEST(DacrtOptions, ConservativeOptionsMatchTheDefaultAndF64MatchesTheReference) 
             const TraceResult withSat = traceWith(f, b, sat);
             EXPECT_TRUE(test::identicalHits(base.hits, withSat.hits)) << toString(b);
             EXPECT_LE(withSat.counters.rayTriangleTests, base.counters.rayTriangleTests);
+
+            // The ray-sampling cost moves leaves (the counters show it did), never a hit.
+            DacrtOptions byLimits, sampled;
+            sampled.splitCost = SplitCost::RaySampling;
+            for (const bool packets : {true, false}) {
+                sampled.packets = byLimits.packets = packets;
+                const TraceResult limits = traceWith(f, b, byLimits), withSampling = traceWith(f, b, sampled);
+                EXPECT_TRUE(test::identicalHits(limits.hits, withSampling.hits)) << toString(b) << " packets " << packets;
+                EXPECT_NE(withSampling.counters.leaves, limits.counters.leaves) << toString(b) << " packets " << packets;
+            }
 
             DacrtOptions f64;
             f64.precision = Precision::F64;
