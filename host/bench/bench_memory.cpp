@@ -20,7 +20,7 @@ bool startsWith(const std::string& s, const std::string& prefix) { return s.comp
 // (its plan bounds it), and what a Vulkan backend holds on its device (on lavapipe, this
 // machine's memory too); the rest is the frame's.
 bool keptBetweenFrames(const BenchConfig& c, const std::string& buffer) {
-    if (c.backend() == Backend::Embree) return startsWith(buffer, "embree:");
+    if (c.backend() == Backend::Embree) return startsWith(buffer, "embree structure");
     return runsOnVulkan(c.backend()) && !startsWith(buffer, "host:");
 }
 

@@ -323,8 +323,9 @@ TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool, H
 
 MemoryPlan embreePlan(const FrameGeometry& geometry) {
     MemoryPlan plan;
-    plan.add("embree: structure and index buffer (a bound from the triangle count; Embree allocates them)",
-             embreeStructureBytesBound(geometry.triangles->size()));
+    // Embree allocates its structure itself: the line is a bound from the triangle count.
+    plan.add("embree structure and index buffer (at most)", embreeStructureBytesBound(geometry.triangles->size()));
+    plan.add("triangles (Embree's vertex buffer, shared)", geometry.triangles->size() * sizeof(Triangle));
     plan.add("hits", geometry.rays->size() * sizeof(Hit));
     plan.addWork("rays", geometry.rays->size(), "traced by Embree");
     return plan;

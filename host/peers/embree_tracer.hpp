@@ -75,7 +75,8 @@ private:
 TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool);
 
 // The frame's memory as Embree holds it: its structure and index buffer by their bound from
-// the triangle count (peers/embree_memory.hpp), and the hits; its work, the rays.
+// the triangle count (peers/embree_memory.hpp), the triangles it reads in place, and the hits;
+// its work, the rays.
 MemoryPlan embreePlan(const FrameGeometry& geometry);
 
 // Where onPlan declines embreePlan (returns false), the plan as a trace with no hits (as every
