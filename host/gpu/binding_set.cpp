@@ -144,8 +144,9 @@ void addToMemoryPlan(const DacrtBufferPlan& buffers, const BufferLimits& limits,
                      " bytes (" + limits.chunkLimit + ")");
     }
     if (limits.memoryBytes && total > limits.memoryBytes)
-        throw InputError(overBy("the frame's device memory", total, limits.memoryLimit, limits.memoryBytes) +
-                         "; render fewer pixels or split the scene");
+        throw DeviceLimitExceeded(overBy("the frame's device memory", total, limits.memoryLimit, limits.memoryBytes) +
+                                      "; render fewer pixels",
+                                  "device memory (" + limits.memoryLimit + ", bytes)", total, limits.memoryBytes);
 }
 
 DacrtBindingSet::DacrtBindingSet(const Context& context, const DacrtBufferPlan& plan, const ResidentBuffers& resident,

@@ -14,6 +14,7 @@
 #include "cpu/memory_plan.hpp"
 #include "gpu/buffer.hpp"
 #include "gpu/compute_pipeline.hpp"
+#include "gpu/device_limit_exceeded.hpp"
 
 namespace dacrt::gpu {
 

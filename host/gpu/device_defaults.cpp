@@ -26,18 +26,22 @@ std::uint32_t widestWorkgroup(const DeviceInfo& device) {
     return std::min({device.maxComputeWorkGroupInvocations, device.maxComputeWorkGroupSizeX, subgroup * subgroup});
 }
 
+double stepWorkgroupNeed(const DeviceInfo& device, std::uint32_t largestRegionRays, std::uint32_t largestRegionTriangles) {
+    const std::uint32_t budget = loopBudgetOf(device);
+    if (!budget) return 0.0;
+    // The largest single step (a split of the biggest region, then its final partition) must
+    // fit one slice: about (2 (rays + triangles) + 2 rays) / (4 size) iterations, a partition
+    // step taking four ids per invocation (kIdsPerInvocation).
+    return (4.0 * largestRegionRays + 2.0 * largestRegionTriangles) / (4.0 * 0.8 * budget);
+}
+
 std::uint32_t defaultWorkgroupSize(const DeviceInfo& device, GpuProfile profile, std::uint32_t largestRegionRays,
                                    std::uint32_t largestRegionTriangles) {
     const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
     const std::uint32_t widest = widestWorkgroup(device);
     std::uint32_t size = takesCpuDefaults(device, profile) ? subgroup : std::max(64u, subgroup);
-    if (const std::uint32_t budget = loopBudgetOf(device)) {
-        // The largest single step (a split of the biggest region, then its final partition)
-        // must fit one slice: about (2 (rays + triangles) + 2 rays) / (4 size) iterations, a
-        // partition step taking four ids per invocation (kIdsPerInvocation).
-        const double needed = (4.0 * largestRegionRays + 2.0 * largestRegionTriangles) / (4.0 * 0.8 * budget);
-        while (size < widest && double(size) < needed) size *= 2;
-    }
+    const double needed = stepWorkgroupNeed(device, largestRegionRays, largestRegionTriangles);
+    while (size < widest && double(size) < needed) size *= 2;
     return std::min(size, widest);
 }
 

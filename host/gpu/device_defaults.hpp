@@ -26,6 +26,10 @@ std::uint32_t loopBudgetOf(const DeviceInfo& device);
 // as one subgroup has lanes (workgroupExclusiveSum sums the subgroup totals in one subgroup).
 std::uint32_t widestWorkgroup(const DeviceInfo& device);
 
+// The workgroup size (invocations) the largest single step of a frame whose largest region
+// holds these rays and triangles needs to fit one slice of the loop budget; 0 without one.
+double stepWorkgroupNeed(const DeviceInfo& device, std::uint32_t largestRegionRays, std::uint32_t largestRegionTriangles);
+
 // A CPU device such as lavapipe runs a workgroup on one thread, SIMD across invocations, so
 // one subgroup per workgroup (no shared-memory barrier at all), widened only as far as the
 // loop budget needs for the largest region; a GPU wants wider workgroups.

@@ -1,6 +1,7 @@
 #include "gpu/gpu_tracer.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -92,6 +93,18 @@ std::uint32_t chooseWorkgroupSize(const gpu::WorkPlan& work, const GpuTuning& tu
                                    : gpu::defaultWorkgroupSize(device, tuning.profile, work.largestSlotRays, work.largestSlotTriangles);
     const std::uint32_t subgroup = std::max(device.subgroupSize, 1u);
     const std::uint32_t widest = gpu::widestWorkgroup(device);
+    const double need = gpu::stepWorkgroupNeed(device, work.largestSlotRays, work.largestSlotTriangles);
+    if (!tuning.workgroupSize && need > widest) {
+        // Fewer triangles per frame shrink the step: the caller may trace them in batches.
+        const std::uint64_t needed = std::uint64_t(std::ceil(need));
+        throw gpu::DeviceLimitExceeded(
+            "the largest region's single step (" + std::to_string(work.largestSlotRays) + " rays, " +
+                std::to_string(work.largestSlotTriangles) + " triangles) needs a workgroup of about " +
+                std::to_string(needed) + " invocations to fit the loop budget of " +
+                std::to_string(gpu::loopBudgetOf(device)) + " iterations (" + device.driver + "), more than the widest, " +
+                std::to_string(widest) + "; use more regions (--regions)",
+            "loop budget of one step (workgroup invocations)", needed, widest);
+    }
     if (size % subgroup != 0 || size > widest)
         throw InputError("a workgroup size of " + std::to_string(size) + " does not suit this device: it must be a " +
                          "multiple of the subgroup size " + std::to_string(subgroup) + " and at most " +

@@ -10,6 +10,7 @@
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/pass_cull.hpp"
 #include "cpu/triangle_skips.hpp"
+#include "library/triangle_batches.hpp"
 
 namespace dacrt {
 
@@ -120,18 +121,25 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
     const unsigned threads = threadsOf(request.trace);
     ThreadPool& threadPool = pool(threads);
     switch (request.trace.backend) {
-        case Backend::Gpu:
+        case Backend::Gpu: {
             if (!gpu_) throw InternalError("the gpu backend was asked for a trace without a device being opened");
             // A closest-hit trace starts a frame (a pass culled on the host traces any hits): the
-            // last frame's buffers kept for its passes go back to the arena for this one.
-            if (geometry.query == HitQuery::Closest) {
-                arena_->startFrame();
-                if (request.keepForPasses) passSource_.reset();
-            }
-            return GpuTracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get(),
-                             arena_.get())
-                .trace(geometry, onPlan,
-                       request.keepForPasses && geometry.query == HitQuery::Closest ? &passSource_ : nullptr);
+            // last frame's buffers kept for its passes go back to the arena for this one. A frame
+            // beyond the device's memory runs in triangle batches, each a frame of the arena's,
+            // none kept for the passes (they then make their rays on the host).
+            const bool closest = geometry.query == HitQuery::Closest;
+            if (closest && request.keepForPasses) passSource_.reset();
+            bool whole = true;
+            const auto traceOne = [&](const FrameGeometry& g, const std::vector<WorkLine>& planLines) {
+                if (closest) arena_->startFrame();
+                GpuTracer tracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get(),
+                                 arena_.get());
+                const bool keep = whole && request.keepForPasses && closest;
+                whole = false;
+                return tracer.trace(g, withWorkLines(onPlan, planLines, false), keep ? &passSource_ : nullptr);
+            };
+            return traceInTriangleBatches(geometry, traceOne);
+        }
         case Backend::Embree: {
             // Embree allocates its BVH itself: its plan bounds it from the triangle count.
             EmbreeOptions embree = request.embree;

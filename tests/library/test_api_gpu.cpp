@@ -127,6 +127,62 @@ TEST(ApiGpu, AnOcclusionPassIsOneBatchUnlessTheDeviceMemoryHoldsLess) {
     EXPECT_EQ(gpu->validationErrors(), 0u);
 }
 
+// The device bytes of a plan (its "device: " lines).
+std::uint64_t deviceBytes(const FramePlan& plan) {
+    std::uint64_t bytes = 0;
+    for (const FramePlan::Buffer& b : plan.memory) bytes += b.name.starts_with("device: ") ? b.bytes : 0;
+    return bytes;
+}
+
+TEST(ApiGpu, AFrameBeyondTheDeviceMemoryRunsInTriangleBatchesWithCpuSeqHits) {
+    // A memory cap below what the frame's device buffers need, but above what its rays need
+    // alone: the triangles are traced in batches, and the merged hits are cpu-seq's, bit for
+    // bit (closest hits), slot for slot (a lit frame's passes).
+    std::string why;
+    std::optional<Tracer> gpu = gpuTracer(why);
+    if (!gpu) GTEST_SKIP() << "no Vulkan device: " << why;
+    Tracer cpuSeq(onBackend(Backend::CpuSeq));
+    const test::SceneArrays s = test::randomSceneArrays(41, 12000);
+    const test::RayArrays r = test::randomRayArrays(42, 3000);
+    const TraceScene scene = TraceScene::fromArrays(s.positions, s.indices, s.singleSided);
+    const RayBatch rays = RayBatch::fromArrays(r.origins, r.directions, {}, r.tmax);
+    const TraceOutput whole = gpu->trace(scene, rays);
+    EXPECT_FALSE(workCount(whole.plan, "triangle batches"));
+    const TracerOptions uncapped = gpu->options();
+    TracerOptions capped = uncapped;
+    capped.gpu.memoryBytes = deviceBytes(whole.plan) * 6 / 10;
+    gpu->setOptions(capped);
+    const TraceOutput batched = gpu->trace(scene, rays);
+    const std::optional<std::uint64_t> batches = workCount(batched.plan, "triangle batches");
+    ASSERT_TRUE(batches);
+    EXPECT_GE(*batches, 2u);
+    EXPECT_TRUE(sameHits(batched.hits, whole.hits));
+    EXPECT_TRUE(sameHits(batched.hits, cpuSeq.trace(scene, rays).hits));
+    EXPECT_TRUE(sameVisibility(gpu->occluded(scene, rays).hits, cpuSeq.occluded(scene, rays).hits));
+
+    // A lit frame of the room: the primary pass in batches; its passes made on the host.
+    const TraceScene room = TraceScene::load(test::kRoomScene);
+    const RayBatch camera = RayBatch::fromCamera(room, {}, 32, 24);
+    const std::vector<FramePass> passes = fewAndManyRays(room);
+    gpu->setOptions(uncapped);
+    const FrameOutput unbatched = gpu->traceFrame(room, camera, passes);
+    capped.gpu.memoryBytes = deviceBytes(unbatched.primary.plan) * 7 / 10;
+    gpu->setOptions(capped);
+    const FrameOutput lit = gpu->traceFrame(room, camera, passes);
+    const FrameOutput expected = cpuSeq.traceFrame(room, camera, passes);
+    EXPECT_TRUE(workCount(lit.primary.plan, "triangle batches"));
+    EXPECT_TRUE(sameHits(lit.primary.hits, expected.primary.hits));
+    ASSERT_EQ(lit.passes.size(), passes.size());
+    for (std::size_t k = 0; k < passes.size(); ++k)
+        EXPECT_TRUE(sameVisibility(lit.passes[k].output.hits, expected.passes[k].output.hits)) << passes[k].name;
+
+    // Where the rays alone exceed the cap, no batch of triangles fits: refused, the limit named.
+    capped.gpu.memoryBytes = 65536;
+    gpu->setOptions(capped);
+    test::expectInputError([&] { gpu->trace(scene, rays); }, "memory cap (GpuTuning::memoryBytes) of 65536 bytes");
+    EXPECT_EQ(gpu->validationErrors(), 0u);
+}
+
 TEST(ApiGpu, SameHitsAsCpuSeq) {
     std::string why;
     std::optional<Tracer> gpu = gpuTracer(why);
