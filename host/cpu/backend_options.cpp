@@ -19,7 +19,7 @@ constexpr bool kAdvanced = true;
 constexpr bool kDacrtOption = true;
 
 // The order is the help's, and the order in which a refusal names the options.
-constexpr std::array<BackendOption, 18> kBackendOptions{{
+constexpr std::array<BackendOption, 19> kBackendOptions{{
     {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
@@ -49,6 +49,11 @@ constexpr std::array<BackendOption, 18> kBackendOptions{{
      [](const RequestedOptions& r) { return r.trace.dacrt.packets != DacrtOptions{}.packets; }},
     {"--packet-flush", kCpuDacrt, "a node with fewer packets goes on ray by ray", "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.packetFlush != 0; }},
+    {"--ray-grouping", kCpuDacrt,
+     "the order a secondary pass's rays are traced in: slots (as made, pixel by pixel), octant (grouped by the signs "
+     "of their directions) or octant-calls (each octant's group traced on its own)",
+     "", kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.rayGrouping != DacrtOptions{}.rayGrouping; }},
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,
      [](const RequestedOptions& r) { return r.workgroupSize != 0; }},
     {"--ray-groups", kGpu, "work items per region, each a band of its rays with its own copy of the region's triangle ids",

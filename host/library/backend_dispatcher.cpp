@@ -1,6 +1,7 @@
 #include "library/backend_dispatcher.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <ostream>
 #include <thread>
 
@@ -59,6 +60,7 @@ BackendDispatcher::~BackendDispatcher() = default;
 void BackendDispatcher::releaseKept() {
     passSource_.reset();  // first: it holds buffers of the arena
     peers_.clear();
+    grouping_ = GroupingBuffers{};
     if (resident_) resident_ = std::make_unique<gpu::ResidentTriangles>();
     if (arena_) arena_ = std::make_unique<gpu::BufferArena>();
 }
@@ -166,24 +168,82 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     MemoryPlan making;
     making.add("secondary rays and their slots (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
     making.add("hits per slot", slots * sizeof(Hit));
+    const bool cpuDacrt = request.trace.backend == Backend::Cpu || request.trace.backend == Backend::CpuSeq;
+    const RayGrouping grouping = cpuDacrt ? request.trace.dacrt.rayGrouping : RayGrouping::Slots;
+    if (grouping != RayGrouping::Slots)  // kept for the next pass
+        making.add("rays and slots grouped by octant (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
+    if (grouping == RayGrouping::OctantCalls) making.add("one octant's rays (at most)", slots * sizeof(Ray));
     if (onPlan && !onPlan(making)) return out;
     const auto start = Clock::now();
-    const SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
+    SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
     const double makeMs = msSince(start);
     out.rays = rays.rays.size();
     if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
         out.result.hits = hitsPerSlot(rays, {});
     } else {
-        FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays.rays, primary.sceneBox);
-        g.trianglesVersion = primary.trianglesVersion;
-        g.sceneId = primary.sceneId;
-        out.result = isPeer(request.trace.backend) ? traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass)
-                                                   : traceCulled(g, request, onPlan);
+        OctantStarts octants{};
+        std::optional<double> groupMs;
+        if (grouping != RayGrouping::Slots) {
+            const auto groupStart = Clock::now();
+            octants = groupByOctant(rays, grouping_, threadPool);
+            groupMs = msSince(groupStart);
+        }
+        out.result = grouping == RayGrouping::OctantCalls ? traceOctants(primary, rays.rays, octants, request, onPlan)
+                                                          : tracePassRays(primary, rays.rays, request, onPlan);
         if (out.result.hits.empty()) return out;  // stopped at the plan
         out.result.hits = hitsPerSlot(rays, out.result.hits);
+        out.result.phases.groupRays = groupMs;
     }
     out.result.phases.makeRays = makeMs;
     return out;
+}
+
+namespace {
+
+// The frame a secondary pass's rays (or a group of them) are traced as.
+FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>& rays) {
+    FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays, primary.sceneBox);
+    g.trianglesVersion = primary.trianglesVersion;
+    g.sceneId = primary.sceneId;
+    return g;
+}
+
+}  // namespace
+
+TraceResult BackendDispatcher::tracePassRays(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                                             const BackendRequest& request, const PlanHook& onPlan) {
+    const FrameGeometry g = passGeometry(primary, rays);
+    return isPeer(request.trace.backend) ? traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass)
+                                         : traceCulled(g, request, onPlan);
+}
+
+TraceResult BackendDispatcher::traceOctants(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                                            const OctantStarts& octants, const BackendRequest& request,
+                                            const PlanHook& onPlan) {
+    // The pass cull once, over every ray: each group's own would survey its rays again.
+    const auto start = Clock::now();
+    const FrameGeometry all = passGeometry(primary, rays);
+    cullForPass(all, request.trace.skips, pool(threadsOf(request.trace)), passCull_);
+    MemoryPlan cullPlan;
+    planPassCull(all, request.trace.skips, passCull_, cullPlan);
+    double cullMs = msSince(start);
+    TraceResult whole;
+    for (unsigned o = 0; o < kOctants; ++o) {
+        if (octants[o] == octants[o + 1]) continue;
+        grouping_.group.assign(rays.begin() + std::ptrdiff_t(octants[o]), rays.begin() + std::ptrdiff_t(octants[o + 1]));
+        TraceResult part = traceAfterSkips(passGeometry(primary, grouping_.group), passCull_.skips, cullPlan, cullMs,
+                                           request, onPlan, {});
+        cullMs = 0.0;  // counted once, with the first group
+        if (part.hits.empty()) return {};  // stopped at the plan
+        if (whole.hits.empty()) {
+            whole = std::move(part);
+            continue;
+        }
+        whole.hits.insert(whole.hits.end(), part.hits.begin(), part.hits.end());
+        whole.counters.add(part.counters);
+        whole.phases.add(part.phases);
+    }
+    return whole;
 }
 
 BackendDispatcher::PassTrace BackendDispatcher::traceMadeOnDevice(const FrameGeometry& primary,

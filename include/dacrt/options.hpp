@@ -17,6 +17,11 @@ enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
 // the node's rays and triangles estimates a leaf cheaper than filtering them into children;
 // it also picks the split among the split method's position and the axis's quarter points.
 enum class SplitCost { Limits, RaySampling };
+// The order in which the cpu backends trace a secondary pass's rays (docs/cpu-reference.md):
+// Slots, as made, pixel by pixel; Octant, grouped by the signs of their directions and traced
+// as one set; OctantCalls, each octant's group traced on its own, its rays' signs all agreeing.
+// Every order gives the same visibility: it changes speed only.
+enum class RayGrouping { Slots, Octant, OctantCalls };
 enum class DivisionAxis { Best, X, Y, Z };
 // Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks
 // through shared edges; Moller-Trumbore is the classic faster test without that guarantee.
@@ -53,6 +58,7 @@ struct DacrtOptions {
     // the recursion, one by one below; the SIMD path of rays that share their start only.
     bool packets = true;
     std::uint32_t packetFlush = 0;  // a node with fewer packets goes on ray by ray; 0: the default
+    RayGrouping rayGrouping = RayGrouping::Slots;  // secondary passes on the cpu backends
 
     // These options with the leaf limits of `backend` filled in where they are 0.
     DacrtOptions resolvedFor(Backend backend) const {

@@ -50,6 +50,19 @@ TEST(ApiFrame, TracesTheCameraFrameThenItsPasses) {
         EXPECT_EQ(sequential.passes[k].rays, frame.passes[k].rays) << k;
         EXPECT_TRUE(test::sameHits(sequential.passes[k].output.hits, frame.passes[k].output.hits)) << k;
     }
+    // So is every order of the passes' rays on the cpu backends (--ray-grouping).
+    for (const RayGrouping grouping : {RayGrouping::Octant, RayGrouping::OctantCalls})
+        for (const Backend backend : {Backend::Cpu, Backend::CpuSeq}) {
+            TracerOptions o = test::onBackend(backend, 2);
+            o.trace.dacrt.rayGrouping = grouping;
+            const FrameOutput grouped = Tracer(o).traceFrame(scene, rays, passes);
+            ASSERT_EQ(grouped.passes.size(), 2u);
+            for (std::size_t k = 0; k < 2; ++k) {
+                EXPECT_EQ(grouped.passes[k].rays, frame.passes[k].rays) << k;
+                EXPECT_TRUE(test::sameVisibility(sequential.passes[k].output.hits, grouped.passes[k].output.hits))
+                    << k << ", grouping " << int(grouping) << ", backend " << int(backend);
+            }
+        }
 }
 
 TEST(ApiFrame, PlanCallbackSeesEachPassAndMayStop) {
