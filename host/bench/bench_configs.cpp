@@ -215,7 +215,7 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
     out.push_back(baseConfig(b, hardwareThreads));
     // The secondary rays' order (docs/benchmarks.md, "Rays grouped by octant").
     if (b == Backend::Cpu)
-        for (RayGrouping grouping : {RayGrouping::Octant, RayGrouping::OctantCalls}) {
+        for (RayGrouping grouping : {RayGrouping::Octant, RayGrouping::OctantCalls, RayGrouping::Batches}) {
             BenchConfig c = out.front();
             c.name = "ray-grouping=" + toString(grouping);
             c.isDefault = false;

@@ -18,6 +18,8 @@ constexpr BackendSet kEmbree{Backend::Embree};
 constexpr bool kAdvanced = true;
 constexpr bool kDacrtOption = true;
 
+static_assert(kPassBatchRays == 65536, "--ray-grouping's help names the batch size");
+
 // The order is the help's, and the order in which a refusal names the options.
 constexpr std::array<BackendOption, 19> kBackendOptions{{
     {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 64 on a GPU",
@@ -50,8 +52,9 @@ constexpr std::array<BackendOption, 19> kBackendOptions{{
     {"--packet-flush", kCpuDacrt, "a node with fewer packets goes on ray by ray", "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.packetFlush != 0; }},
     {"--ray-grouping", kCpuDacrt,
-     "the order a secondary pass's rays are traced in: slots (as made, pixel by pixel), octant (grouped by the signs "
-     "of their directions) or octant-calls (each octant's group traced on its own)",
+     "how a secondary pass's rays are traced: slots (as made, pixel by pixel), octant (grouped by the signs of their "
+     "directions), octant-calls (each octant's group traced on its own) or batches (as made, in traces of at most "
+     "65536 rays each)",
      "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.rayGrouping != DacrtOptions{}.rayGrouping; }},
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,

@@ -33,8 +33,10 @@ struct EnumNames<SplitCost> {
 };
 template <>
 struct EnumNames<RayGrouping> {
-    static constexpr std::array<std::pair<RayGrouping, std::string_view>, 3> table{
-        {{RayGrouping::Slots, "slots"}, {RayGrouping::Octant, "octant"}, {RayGrouping::OctantCalls, "octant-calls"}}};
+    static constexpr std::array<std::pair<RayGrouping, std::string_view>, 4> table{{{RayGrouping::Slots, "slots"},
+                                                                                    {RayGrouping::Octant, "octant"},
+                                                                                    {RayGrouping::OctantCalls, "octant-calls"},
+                                                                                    {RayGrouping::Batches, "batches"}}};
 };
 template <>
 struct EnumNames<DivisionAxis> {

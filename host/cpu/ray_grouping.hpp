@@ -34,4 +34,9 @@ struct GroupingBuffers {
 using OctantStarts = std::array<std::size_t, kOctants + 1>;
 OctantStarts groupByOctant(SecondaryRays& rays, GroupingBuffers& buffers, ThreadPool& pool);
 
+
+// Where each of the equal batches of `rays` rays begins, then `rays`: one batch where they
+// number at most `most`.
+std::vector<std::size_t> rayBatches(std::size_t rays, std::size_t most);
+
 }  // namespace dacrt

@@ -170,9 +170,11 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     making.add("hits per slot", slots * sizeof(Hit));
     const bool cpuDacrt = request.trace.backend == Backend::Cpu || request.trace.backend == Backend::CpuSeq;
     const RayGrouping grouping = cpuDacrt ? request.trace.dacrt.rayGrouping : RayGrouping::Slots;
-    if (grouping != RayGrouping::Slots)  // kept for the next pass
+    const bool byOctant = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
+    if (byOctant)  // kept for the next pass
         making.add("rays and slots grouped by octant (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
-    if (grouping == RayGrouping::OctantCalls) making.add("one octant's rays (at most)", slots * sizeof(Ray));
+    if (grouping == RayGrouping::OctantCalls || grouping == RayGrouping::Batches)
+        making.add("one group's rays (at most)", slots * sizeof(Ray));
     if (onPlan && !onPlan(making)) return out;
     const auto start = Clock::now();
     SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
@@ -181,15 +183,18 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
         out.result.hits = hitsPerSlot(rays, {});
     } else {
-        OctantStarts octants{};
+        std::vector<std::size_t> groups = {0, rays.rays.size()};  // one trace of every ray
         std::optional<double> groupMs;
-        if (grouping != RayGrouping::Slots) {
+        if (byOctant) {
             const auto groupStart = Clock::now();
-            octants = groupByOctant(rays, grouping_, threadPool);
+            const OctantStarts octants = groupByOctant(rays, grouping_, threadPool);
             groupMs = msSince(groupStart);
+            if (grouping == RayGrouping::OctantCalls) groups.assign(octants.begin(), octants.end());
+        } else if (grouping == RayGrouping::Batches) {
+            groups = rayBatches(rays.rays.size(), kPassBatchRays);
         }
-        out.result = grouping == RayGrouping::OctantCalls ? traceOctants(primary, rays.rays, octants, request, onPlan)
-                                                          : tracePassRays(primary, rays.rays, request, onPlan);
+        out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, request, onPlan)
+                                       : tracePassRays(primary, rays.rays, request, onPlan);
         if (out.result.hits.empty()) return out;  // stopped at the plan
         out.result.hits = hitsPerSlot(rays, out.result.hits);
         out.result.phases.groupRays = groupMs;
@@ -208,6 +213,34 @@ FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>&
     return g;
 }
 
+// One group's trace appended to the pass's: its hits after the earlier groups', its counters
+// summed, the transfer rounds of the same name together (the division and plan stay the first
+// group's).
+void addGroup(TraceResult& whole, TraceResult&& part) {
+    if (whole.hits.empty()) {
+        whole = std::move(part);
+        return;
+    }
+    whole.hits.insert(whole.hits.end(), part.hits.begin(), part.hits.end());
+    Counters& c = whole.counters;
+    const Counters& o = part.counters;
+    c.add(o);
+    c.raysCulled += o.raysCulled;
+    c.finishedStep1 += o.finishedStep1;
+    c.transferWorkItems += o.transferWorkItems;
+    c.transferWorkItemsSkipped += o.transferWorkItemsSkipped;
+    for (std::size_t r = 0; r < o.roundNames.size(); ++r) {
+        const auto same = std::find(c.roundNames.begin(), c.roundNames.end(), o.roundNames[r]);
+        if (same == c.roundNames.end()) {
+            c.roundNames.push_back(o.roundNames[r]);
+            c.finishedPerRound.push_back(o.finishedPerRound[r]);
+        } else {
+            c.finishedPerRound[std::size_t(same - c.roundNames.begin())] += o.finishedPerRound[r];
+        }
+    }
+    whole.phases.add(part.phases);
+}
+
 }  // namespace
 
 TraceResult BackendDispatcher::tracePassRays(const FrameGeometry& primary, const std::vector<Ray>& rays,
@@ -217,9 +250,9 @@ TraceResult BackendDispatcher::tracePassRays(const FrameGeometry& primary, const
                                          : traceCulled(g, request, onPlan);
 }
 
-TraceResult BackendDispatcher::traceOctants(const FrameGeometry& primary, const std::vector<Ray>& rays,
-                                            const OctantStarts& octants, const BackendRequest& request,
-                                            const PlanHook& onPlan) {
+TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                                           const std::vector<std::size_t>& groups, const BackendRequest& request,
+                                           const PlanHook& onPlan) {
     // The pass cull once, over every ray: each group's own would survey its rays again.
     const auto start = Clock::now();
     const FrameGeometry all = passGeometry(primary, rays);
@@ -228,20 +261,14 @@ TraceResult BackendDispatcher::traceOctants(const FrameGeometry& primary, const 
     planPassCull(all, request.trace.skips, passCull_, cullPlan);
     double cullMs = msSince(start);
     TraceResult whole;
-    for (unsigned o = 0; o < kOctants; ++o) {
-        if (octants[o] == octants[o + 1]) continue;
-        grouping_.group.assign(rays.begin() + std::ptrdiff_t(octants[o]), rays.begin() + std::ptrdiff_t(octants[o + 1]));
+    for (std::size_t k = 0; k + 1 < groups.size(); ++k) {
+        if (groups[k] == groups[k + 1]) continue;
+        grouping_.group.assign(rays.begin() + std::ptrdiff_t(groups[k]), rays.begin() + std::ptrdiff_t(groups[k + 1]));
         TraceResult part = traceAfterSkips(passGeometry(primary, grouping_.group), passCull_.skips, cullPlan, cullMs,
                                            request, onPlan, {});
         cullMs = 0.0;  // counted once, with the first group
         if (part.hits.empty()) return {};  // stopped at the plan
-        if (whole.hits.empty()) {
-            whole = std::move(part);
-            continue;
-        }
-        whole.hits.insert(whole.hits.end(), part.hits.begin(), part.hits.end());
-        whole.counters.add(part.counters);
-        whole.phases.add(part.phases);
+        addGroup(whole, std::move(part));
     }
     return whole;
 }

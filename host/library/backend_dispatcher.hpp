@@ -112,12 +112,12 @@ private:
     // A secondary pass's rays (host-made) traced as one frame on the request's backend.
     TraceResult tracePassRays(const FrameGeometry& primary, const std::vector<Ray>& rays, const BackendRequest& request,
                               const PlanHook& onPlan);
-    // RayGrouping::OctantCalls: each octant's rays (grouped by groupByOctant, starting at
-    // `octants`) traced as a frame of its own, the hits in the rays' order, the counters and
-    // phases summed (the plan and the division are the first group's).
-    TraceResult traceOctants(const FrameGeometry& primary, const std::vector<Ray>& rays,
-                             const OctantStarts& octants, const BackendRequest& request,
-                             const PlanHook& onPlan);
+    // RayGrouping::OctantCalls and Batches: each group of the rays (group k: from groups[k] to
+    // groups[k + 1]) traced as a frame of its own after one pass cull over them all, the hits
+    // in the rays' order, the counters and phases summed (the plan and division: the first's).
+    TraceResult traceGroups(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                            const std::vector<std::size_t>& groups, const BackendRequest& request,
+                            const PlanHook& onPlan);
     // A secondary pass's rays on dacrt's backends, over the triangles the pass cull keeps.
     TraceResult traceCulled(const FrameGeometry& pass, const BackendRequest& request, const PlanHook& onPlan);
 

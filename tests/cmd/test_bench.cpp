@@ -255,6 +255,7 @@ TEST(Bench, PassesSuiteTimesEachPassAndDacrtMatchesCpuSeqExactly) {
     const auto bySeries = passRowsBySeries(j);
     const std::set<std::string> expected = {"cpu-seq",        "cpu",
                                             "cpu ray-grouping=octant", "cpu ray-grouping=octant-calls",
+                                            "cpu ray-grouping=batches",
                                             "embree dynamic", "embree dynamic stored rays",
                                             "embree refit",   "embree refit stored rays",
                                             "embree static",  "embree static stored rays"};

@@ -339,3 +339,13 @@ TEST(SecondaryRays, GroupingByOctantIsAStablePermutationThatHitsPerSlotUndoes) {
             EXPECT_EQ(scattered[s].prim, madeAt[s] < made.rays.size() ? std::uint32_t(s) : kNotTracedPrim) << s;
     }
 }
+
+TEST(SecondaryRays, BatchesAreEqualRunsOfAtMostTheLimit) {
+    EXPECT_EQ(rayBatches(10, 4), (std::vector<std::size_t>{0, 3, 6, 10}));
+    EXPECT_EQ(rayBatches(8, 4), (std::vector<std::size_t>{0, 4, 8}));
+    EXPECT_EQ(rayBatches(3, 4), (std::vector<std::size_t>{0, 3}));
+    EXPECT_EQ(rayBatches(0, 4), (std::vector<std::size_t>{0, 0}));
+    const std::vector<std::size_t> room = rayBatches(1228800, kPassBatchRays);
+    EXPECT_EQ(room.size(), 20u);  // 19 batches of 64,673 or 64,674 rays
+    for (std::size_t b = 0; b + 1 < room.size(); ++b) EXPECT_LE(room[b + 1] - room[b], kPassBatchRays);
+}

@@ -25,7 +25,8 @@ void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
         request.trace.backend = Backend::Brute;
         const BackendDispatcher::PassTrace reference = dispatcher.traceSecondary(primary, set.primary.hits, pass, request);
         ASSERT_GT(reference.rays, 500u);
-        for (RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls})
+        for (RayGrouping grouping :
+             {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls, RayGrouping::Batches})
             for (auto [backend, regions] : {std::pair{Backend::CpuSeq, 0u}, {Backend::Cpu, 0u}, {Backend::Cpu, 3u}}) {
                 request.trace.backend = backend;
                 request.trace.threads = backend == Backend::CpuSeq ? 0 : 2;
@@ -35,7 +36,8 @@ void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
                 EXPECT_EQ(t.rays, reference.rays);
                 EXPECT_TRUE(identicalVisibility(reference.result.hits, t.result.hits))
                     << toString(backend) << ", " << regions << " regions, grouping " << toString(grouping);
-                EXPECT_EQ(t.result.phases.groupRays.has_value(), grouping != RayGrouping::Slots);
+                const bool sorts = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
+                EXPECT_EQ(t.result.phases.groupRays.has_value(), sorts);
             }
     }
 }
