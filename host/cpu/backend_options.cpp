@@ -18,7 +18,7 @@ constexpr BackendSet kEmbree{Backend::Embree};
 constexpr bool kAdvanced = true;
 constexpr bool kDacrtOption = true;
 
-static_assert(kPassBatchRays == 65536, "--ray-grouping's help names the batch size");
+static_assert(kPassBatchRays == 65536 && kPassBatchRaysPerTriangle == 8, "--ray-grouping's help names the batch size");
 
 // The order is the help's, and the order in which a refusal names the options.
 constexpr std::array<BackendOption, 19> kBackendOptions{{
@@ -54,7 +54,7 @@ constexpr std::array<BackendOption, 19> kBackendOptions{{
     {"--ray-grouping", kCpuDacrt,
      "how a secondary pass's rays are traced: slots (as made, pixel by pixel), octant (grouped by the signs of their "
      "directions), octant-calls (each octant's group traced on its own) or batches (as made, in traces of at most "
-     "65536 rays each)",
+     "65536 rays each, or 8 per triangle of the scene where that is more)",
      "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.rayGrouping != DacrtOptions{}.rayGrouping; }},
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,

@@ -191,7 +191,8 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
             groupMs = msSince(groupStart);
             if (grouping == RayGrouping::OctantCalls) groups.assign(octants.begin(), octants.end());
         } else if (grouping == RayGrouping::Batches) {
-            groups = rayBatches(rays.rays.size(), kPassBatchRays);
+            const std::size_t perTriangle = std::size_t(kPassBatchRaysPerTriangle) * primary.triangles->size();
+            groups = rayBatches(rays.rays.size(), std::max<std::size_t>(kPassBatchRays, perTriangle));
         }
         out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, request, onPlan)
                                        : tracePassRays(primary, rays.rays, request, onPlan);

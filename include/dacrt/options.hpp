@@ -45,10 +45,13 @@ constexpr std::uint32_t kCpuSimdRayLimit = 16;
 constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 constexpr std::uint32_t kPacketFlushDefault = 16;
-// RayGrouping::Batches: the most rays one DACRT of a secondary pass takes. A pass of more is
+// RayGrouping::Batches: the most rays one DACRT of a secondary pass takes, this many or
+// kPassBatchRaysPerTriangle per triangle of the scene where that is more. A pass of more is
 // cut into equal runs of slots, each traced on its own: a trace's rays, ids and scratch then
-// stay nearer the caches (measured: docs/benchmarks.md, "Secondary rays grouped").
+// stay nearer the caches, while every trace filters the triangles again (measured:
+// docs/benchmarks.md, "Secondary rays grouped").
 constexpr std::uint32_t kPassBatchRays = 65536;
+constexpr std::uint32_t kPassBatchRaysPerTriangle = 8;
 
 struct DacrtOptions {
     std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default

@@ -70,9 +70,9 @@ TEST(ApiFrame, TracesTheCameraFrameThenItsPasses) {
     }
     expectEveryGroupingGivesTheseVisibilities(scene, rays, passes, sequential);
     // A frame whose occlusion pass (4 rays a pixel) is cut into batches.
-    const RayBatch larger = RayBatch::fromCamera(scene, {}, 160, 120);
+    const RayBatch larger = RayBatch::fromCamera(scene, {}, 200, 150);
     const std::vector<FramePass> fourSamples = lightAndOcclusion(scene, 4);
-    ASSERT_GT(4 * larger.size(), kPassBatchRays);
+    ASSERT_GT(4 * larger.size(), std::max<std::size_t>(kPassBatchRays, kPassBatchRaysPerTriangle * scene.triangleCount()));
     expectEveryGroupingGivesTheseVisibilities(
         scene, larger, fourSamples, Tracer(test::onBackend(Backend::CpuSeq)).traceFrame(scene, larger, fourSamples));
 }
