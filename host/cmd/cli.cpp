@@ -110,6 +110,7 @@ void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     addEnumOption(cmd, "--intersector", o.intersector, "");
     addEnumOption(cmd, "--triangle-filter", o.triangleFilter, "");
     addEnumOption(cmd, "--precision", o.precision, "");
+    addEnumOption(cmd, "--ray-grouping", o.rayGrouping, "");
 }
 
 // The help and heading of render's backend-specific options, from the table that also refuses

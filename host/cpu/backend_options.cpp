@@ -18,8 +18,10 @@ constexpr BackendSet kEmbree{Backend::Embree};
 constexpr bool kAdvanced = true;
 constexpr bool kDacrtOption = true;
 
+static_assert(kPassBatchRays == 65536 && kPassBatchRaysPerTriangle == 8, "--ray-grouping's help names the batch size");
+
 // The order is the help's, and the order in which a refusal names the options.
-constexpr std::array<BackendOption, 18> kBackendOptions{{
+constexpr std::array<BackendOption, 19> kBackendOptions{{
     {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
@@ -49,6 +51,12 @@ constexpr std::array<BackendOption, 18> kBackendOptions{{
      [](const RequestedOptions& r) { return r.trace.dacrt.packets != DacrtOptions{}.packets; }},
     {"--packet-flush", kCpuDacrt, "a node with fewer packets goes on ray by ray", "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.packetFlush != 0; }},
+    {"--ray-grouping", kCpuDacrt,
+     "how a secondary pass's rays are traced: slots (as made, pixel by pixel), octant (grouped by the signs of their "
+     "directions), octant-calls (each octant's group traced on its own) or batches (as made, in traces of at most "
+     "65536 rays each, or 8 per triangle of the scene where that is more)",
+     "", kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.rayGrouping != DacrtOptions{}.rayGrouping; }},
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,
      [](const RequestedOptions& r) { return r.workgroupSize != 0; }},
     {"--ray-groups", kGpu, "work items per region, each a band of its rays with its own copy of the region's triangle ids",

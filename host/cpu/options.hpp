@@ -32,6 +32,13 @@ struct EnumNames<SplitCost> {
         {{SplitCost::Limits, "limits"}, {SplitCost::RaySampling, "ray-sampling"}}};
 };
 template <>
+struct EnumNames<RayGrouping> {
+    static constexpr std::array<std::pair<RayGrouping, std::string_view>, 4> table{{{RayGrouping::Slots, "slots"},
+                                                                                    {RayGrouping::Octant, "octant"},
+                                                                                    {RayGrouping::OctantCalls, "octant-calls"},
+                                                                                    {RayGrouping::Batches, "batches"}}};
+};
+template <>
 struct EnumNames<DivisionAxis> {
     static constexpr std::array<std::pair<DivisionAxis, std::string_view>, 4> table{
         {{DivisionAxis::Best, "best"}, {DivisionAxis::X, "x"}, {DivisionAxis::Y, "y"}, {DivisionAxis::Z, "z"}}};

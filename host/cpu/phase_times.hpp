@@ -12,6 +12,7 @@ namespace dacrt {
 struct PhaseTimes {
     std::optional<double> bounds;           // the triangles' bounds and the scene's box (dacrt's backends, each frame)
     std::optional<double> makeRays;         // secondary rays made on the host from the primary hits
+    std::optional<double> groupRays;        // cpu backends: a secondary pass's rays grouped (--ray-grouping)
     std::optional<double> skips;            // the triangle skips (dacrt's backends)
     std::optional<double> allocate;         // ray queries: the structure's buffers
     std::optional<double> divide;           // the parallel scheme's division (cpu, gpu)
@@ -58,9 +59,10 @@ struct PhaseTimes {
     }
 
 private:
-    static constexpr std::array<std::pair<const char*, Field>, 14> kPhases{{
+    static constexpr std::array<std::pair<const char*, Field>, 15> kPhases{{
         {"bounds", &PhaseTimes::bounds},
         {"make rays", &PhaseTimes::makeRays},
+        {"group rays", &PhaseTimes::groupRays},
         {"skips", &PhaseTimes::skips},
         {"allocate", &PhaseTimes::allocate},
         {"divide", &PhaseTimes::divide},

@@ -1,6 +1,7 @@
 #include "library/backend_dispatcher.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <ostream>
 #include <thread>
 
@@ -60,6 +61,7 @@ BackendDispatcher::~BackendDispatcher() = default;
 void BackendDispatcher::releaseKept() {
     passSource_.reset();  // first: it holds buffers of the arena
     peers_.clear();
+    grouping_ = GroupingBuffers{};
     if (resident_) resident_ = std::make_unique<gpu::ResidentTriangles>();
     if (arena_) arena_ = std::make_unique<gpu::BufferArena>();
 }
@@ -174,24 +176,110 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     MemoryPlan making;
     making.add("secondary rays and their slots (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
     making.add("hits per slot", slots * sizeof(Hit));
+    const bool cpuDacrt = request.trace.backend == Backend::Cpu || request.trace.backend == Backend::CpuSeq;
+    const RayGrouping grouping = cpuDacrt ? request.trace.dacrt.rayGrouping : RayGrouping::Slots;
+    const bool byOctant = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
+    if (byOctant)  // kept for the next pass
+        making.add("rays and slots grouped by octant (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
+    if (grouping == RayGrouping::OctantCalls || grouping == RayGrouping::Batches)
+        making.add("one group's rays (at most)", slots * sizeof(Ray));
     if (onPlan && !onPlan(making)) return out;
     const auto start = Clock::now();
-    const SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
+    SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
     const double makeMs = msSince(start);
     out.rays = rays.rays.size();
     if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
         out.result.hits = hitsPerSlot(rays, {});
     } else {
-        FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays.rays, primary.sceneBox);
-        g.trianglesVersion = primary.trianglesVersion;
-        g.sceneId = primary.sceneId;
-        out.result = isPeer(request.trace.backend) ? traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass)
-                                                   : traceCulled(g, request, onPlan);
+        std::vector<std::size_t> groups = {0, rays.rays.size()};  // one trace of every ray
+        std::optional<double> groupMs;
+        if (byOctant) {
+            const auto groupStart = Clock::now();
+            const OctantStarts octants = groupByOctant(rays, grouping_, threadPool);
+            groupMs = msSince(groupStart);
+            if (grouping == RayGrouping::OctantCalls) groups.assign(octants.begin(), octants.end());
+        } else if (grouping == RayGrouping::Batches) {
+            const std::size_t perTriangle = std::size_t(kPassBatchRaysPerTriangle) * primary.triangles->size();
+            groups = rayBatches(rays.rays.size(), std::max<std::size_t>(kPassBatchRays, perTriangle));
+        }
+        out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, request, onPlan)
+                                       : tracePassRays(primary, rays.rays, request, onPlan);
         if (out.result.hits.empty()) return out;  // stopped at the plan
         out.result.hits = hitsPerSlot(rays, out.result.hits);
+        out.result.phases.groupRays = groupMs;
     }
     out.result.phases.makeRays = makeMs;
     return out;
+}
+
+namespace {
+
+// The frame a secondary pass's rays (or a group of them) are traced as.
+FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>& rays) {
+    FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays, primary.sceneBox);
+    g.trianglesVersion = primary.trianglesVersion;
+    g.sceneId = primary.sceneId;
+    return g;
+}
+
+// One group's trace appended to the pass's: its hits after the earlier groups', its counters
+// summed, the transfer rounds of the same name together (the division and plan stay the first
+// group's).
+void addGroup(TraceResult& whole, TraceResult&& part) {
+    if (whole.hits.empty()) {
+        whole = std::move(part);
+        return;
+    }
+    whole.hits.insert(whole.hits.end(), part.hits.begin(), part.hits.end());
+    Counters& c = whole.counters;
+    const Counters& o = part.counters;
+    c.add(o);
+    c.raysCulled += o.raysCulled;
+    c.finishedStep1 += o.finishedStep1;
+    c.transferWorkItems += o.transferWorkItems;
+    c.transferWorkItemsSkipped += o.transferWorkItemsSkipped;
+    for (std::size_t r = 0; r < o.roundNames.size(); ++r) {
+        const auto same = std::find(c.roundNames.begin(), c.roundNames.end(), o.roundNames[r]);
+        if (same == c.roundNames.end()) {
+            c.roundNames.push_back(o.roundNames[r]);
+            c.finishedPerRound.push_back(o.finishedPerRound[r]);
+        } else {
+            c.finishedPerRound[std::size_t(same - c.roundNames.begin())] += o.finishedPerRound[r];
+        }
+    }
+    whole.phases.add(part.phases);
+}
+
+}  // namespace
+
+TraceResult BackendDispatcher::tracePassRays(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                                             const BackendRequest& request, const PlanHook& onPlan) {
+    const FrameGeometry g = passGeometry(primary, rays);
+    return isPeer(request.trace.backend) ? traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass)
+                                         : traceCulled(g, request, onPlan);
+}
+
+TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                                           const std::vector<std::size_t>& groups, const BackendRequest& request,
+                                           const PlanHook& onPlan) {
+    // The pass cull once, over every ray: each group's own would survey its rays again.
+    const auto start = Clock::now();
+    const FrameGeometry all = passGeometry(primary, rays);
+    cullForPass(all, request.trace.skips, pool(threadsOf(request.trace)), passCull_);
+    MemoryPlan cullPlan;
+    planPassCull(all, request.trace.skips, passCull_, cullPlan);
+    double cullMs = msSince(start);
+    TraceResult whole;
+    for (std::size_t k = 0; k + 1 < groups.size(); ++k) {
+        if (groups[k] == groups[k + 1]) continue;
+        grouping_.group.assign(rays.begin() + std::ptrdiff_t(groups[k]), rays.begin() + std::ptrdiff_t(groups[k + 1]));
+        TraceResult part = traceAfterSkips(passGeometry(primary, grouping_.group), passCull_.skips, cullPlan, cullMs,
+                                           request, onPlan, {});
+        cullMs = 0.0;  // counted once, with the first group
+        if (part.hits.empty()) return {};  // stopped at the plan
+        addGroup(whole, std::move(part));
+    }
+    return whole;
 }
 
 BackendDispatcher::PassTrace BackendDispatcher::traceMadeOnDevice(const FrameGeometry& primary,

@@ -16,6 +16,7 @@
 #include "cpu/memory_plan.hpp"
 #include "cpu/options.hpp"
 #include "cpu/pass_cull.hpp"
+#include "cpu/ray_grouping.hpp"
 #include "cpu/secondary_rays.hpp"
 #include "cpu/trace_result.hpp"
 #include "gpu/context.hpp"
@@ -108,6 +109,15 @@ private:
     // every triangle (the pass cull's lines say why none was dropped).
     PassTrace traceMadeOnDevice(const FrameGeometry& primary, const SecondaryPass& pass, const BackendRequest& request,
                                 const PlanHook& onPlan);
+    // A secondary pass's rays (host-made) traced as one frame on the request's backend.
+    TraceResult tracePassRays(const FrameGeometry& primary, const std::vector<Ray>& rays, const BackendRequest& request,
+                              const PlanHook& onPlan);
+    // RayGrouping::OctantCalls and Batches: each group of the rays (group k: from groups[k] to
+    // groups[k + 1]) traced as a frame of its own after one pass cull over them all, the hits
+    // in the rays' order, the counters and phases summed (the plan and division: the first's).
+    TraceResult traceGroups(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                            const std::vector<std::size_t>& groups, const BackendRequest& request,
+                            const PlanHook& onPlan);
     // A secondary pass's rays on dacrt's backends, over the triangles the pass cull keeps.
     TraceResult traceCulled(const FrameGeometry& pass, const BackendRequest& request, const PlanHook& onPlan);
 
@@ -117,6 +127,7 @@ private:
     std::unique_ptr<gpu::PipelineCache> pipelines_;
     std::unique_ptr<gpu::ResidentTriangles> resident_;  // gpu: the triangles kept on the device
     std::unique_ptr<gpu::BufferArena> arena_;           // gpu: every other buffer, kept for the next frame
+    GroupingBuffers grouping_;                          // cpu: a pass's rays grouped (--ray-grouping)
     GpuPassSourcePtr passSource_;                       // gpu: the last frame kept for its secondary passes
     PeerScenes peers_;                                  // embree, rayquery: their structures
     PassCull passCull_;                                 // the last pass's cull, its buffers reused

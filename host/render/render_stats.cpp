@@ -131,6 +131,7 @@ nlohmann::ordered_json optionsJson(const RenderOptions& o) {
             {"axis", toString(trace.axis)}, {"intersector", toString(trace.dacrt.intersector)},
             {"triangle_filter", toString(trace.dacrt.triangleFilter)},
             {"precision", toString(trace.dacrt.precision)},
+            {"ray_grouping", toString(trace.dacrt.rayGrouping)},
             {"cull", toString(o.cull)},
             {"skip_backfaces", trace.skips.backFaces},
             {"skip_frustum", trace.skips.frustum},

@@ -17,6 +17,12 @@ enum class SplitMethod { SpatialMedian, CentroidMean, SampledMean };
 // the node's rays and triangles estimates a leaf cheaper than filtering them into children;
 // it also picks the split among the split method's position and the axis's quarter points.
 enum class SplitCost { Limits, RaySampling };
+// How the cpu backends trace a secondary pass's rays (docs/cpu-reference.md): Slots, as made,
+// pixel by pixel, in one DACRT; Octant, grouped by the signs of their directions, in one;
+// OctantCalls, each octant's group in a DACRT of its own, its rays' signs all agreeing;
+// Batches, as made, in DACRTs of at most kPassBatchRays rays each. Every grouping gives the
+// same visibility: it changes speed only.
+enum class RayGrouping { Slots, Octant, OctantCalls, Batches };
 enum class DivisionAxis { Best, X, Y, Z };
 // Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks
 // through shared edges; Moller-Trumbore is the classic faster test without that guarantee.
@@ -39,6 +45,13 @@ constexpr std::uint32_t kCpuSimdRayLimit = 16;
 constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 constexpr std::uint32_t kPacketFlushDefault = 16;
+// RayGrouping::Batches: the most rays one DACRT of a secondary pass takes, this many or
+// kPassBatchRaysPerTriangle per triangle of the scene where that is more. A pass of more is
+// cut into equal runs of slots, each traced on its own: a trace's rays, ids and scratch then
+// stay nearer the caches, while every trace filters the triangles again (measured:
+// docs/benchmarks.md, "Secondary rays grouped").
+constexpr std::uint32_t kPassBatchRays = 65536;
+constexpr std::uint32_t kPassBatchRaysPerTriangle = 8;
 
 struct DacrtOptions {
     std::uint32_t rayLimit = 0;    // a node with fewer live rays is a leaf; 0: the backend's default
@@ -53,6 +66,7 @@ struct DacrtOptions {
     // the recursion, one by one below; the SIMD path of rays that share their start only.
     bool packets = true;
     std::uint32_t packetFlush = 0;  // a node with fewer packets goes on ray by ray; 0: the default
+    RayGrouping rayGrouping = RayGrouping::Slots;  // secondary passes on the cpu backends
 
     // These options with the leaf limits of `backend` filled in where they are 0.
     DacrtOptions resolvedFor(Backend backend) const {

@@ -9,6 +9,7 @@
 
 #include "core/procedural.hpp"
 #include "core/random.hpp"
+#include "cpu/ray_grouping.hpp"
 #include "cpu/secondary_rays.hpp"
 #include "support/frames.hpp"
 
@@ -286,4 +287,65 @@ TEST(SecondaryRays, ABatchOfSamplesMakesTheRaysTheWholePassWould) {
         }
     }
     EXPECT_EQ(compared, all.rays.size());
+}
+
+TEST(SecondaryRays, GroupingByOctantIsAStablePermutationThatHitsPerSlotUndoes) {
+    CameraOptions o;
+    o.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(shapesScene(), 48, 36, o);
+    const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
+    const PassFrame pass(frame, primary.hits, occlusionPass(4, 0.8f));
+    const SecondaryRays& made = pass.rays;
+    ASSERT_GT(made.rays.size(), 3000u);
+    ThreadPool pool(2);
+    GroupingBuffers buffers;
+    for (int run = 0; run < 2; ++run) {  // the second run reuses the buffers the first kept
+        SecondaryRays grouped = made;
+        const OctantStarts starts = groupByOctant(grouped, buffers, pool);
+        ASSERT_EQ(grouped.slotCount, made.slotCount);
+        ASSERT_EQ(grouped.rays.size(), made.rays.size());
+        ASSERT_EQ(grouped.slots.size(), made.slots.size());
+        EXPECT_EQ(starts.front(), 0u);
+        EXPECT_EQ(starts.back(), made.rays.size());
+        // Where each slot's ray was made.
+        std::vector<std::size_t> madeAt(made.slotCount, made.rays.size());
+        for (std::size_t i = 0; i < made.slots.size(); ++i) madeAt[made.slots[i]] = i;
+        std::vector<bool> seen(made.slotCount, false);
+        unsigned octantsUsed = 0;
+        for (unsigned octant = 0; octant < kOctants; ++octant) {
+            octantsUsed += starts[octant] < starts[octant + 1];
+            for (std::size_t i = starts[octant]; i < starts[octant + 1]; ++i) {
+                const std::uint32_t slot = grouped.slots[i];
+                ASSERT_LT(madeAt[slot], made.rays.size()) << "slot " << slot << " had no ray";
+                ASSERT_FALSE(seen[slot]) << "slot " << slot << " twice";
+                seen[slot] = true;
+                EXPECT_EQ(std::memcmp(&grouped.rays[i], &made.rays[madeAt[slot]], sizeof(Ray)), 0) << i;
+                EXPECT_EQ(directionOctant(grouped.rays[i]), octant) << i;
+                if (i > starts[octant]) {
+                    EXPECT_LT(grouped.slots[i - 1], slot) << "order within octant " << octant;
+                }
+            }
+        }
+        EXPECT_EQ(octantsUsed, kOctants);  // a hemisphere around every normal: every sign mix
+        // A hit naming its slot lands in that slot, as the slot order's own would.
+        auto slotHits = [](const SecondaryRays& r) {
+            std::vector<Hit> hits(r.slots.size());
+            for (std::size_t i = 0; i < hits.size(); ++i) hits[i] = Hit{float(r.slots[i]), r.slots[i], 0.0f, 0.0f};
+            return hits;
+        };
+        const std::vector<Hit> scattered = hitsPerSlot(grouped, slotHits(grouped));
+        EXPECT_TRUE(identicalHits(hitsPerSlot(made, slotHits(made)), scattered));
+        for (std::size_t s = 0; s < scattered.size(); ++s)
+            EXPECT_EQ(scattered[s].prim, madeAt[s] < made.rays.size() ? std::uint32_t(s) : kNotTracedPrim) << s;
+    }
+}
+
+TEST(SecondaryRays, BatchesAreEqualRunsOfAtMostTheLimit) {
+    EXPECT_EQ(rayBatches(10, 4), (std::vector<std::size_t>{0, 3, 6, 10}));
+    EXPECT_EQ(rayBatches(8, 4), (std::vector<std::size_t>{0, 4, 8}));
+    EXPECT_EQ(rayBatches(3, 4), (std::vector<std::size_t>{0, 3}));
+    EXPECT_EQ(rayBatches(0, 4), (std::vector<std::size_t>{0, 0}));
+    const std::vector<std::size_t> room = rayBatches(1228800, kPassBatchRays);
+    EXPECT_EQ(room.size(), 20u);  // 19 batches of 64,673 or 64,674 rays
+    for (std::size_t b = 0; b + 1 < room.size(); ++b) EXPECT_LE(room[b + 1] - room[b], kPassBatchRays);
 }

@@ -20,6 +20,24 @@ std::size_t slotsWithRays(const std::vector<RayHit>& hits) {
     }));
 }
 
+// Every grouping of the passes' rays on the cpu backends (--ray-grouping) gives the passes of
+// `expected` (cpu-seq's, slot order) their visibility slot by slot.
+void expectEveryGroupingGivesTheseVisibilities(const TraceScene& scene, const RayBatch& rays,
+                                               const std::vector<FramePass>& passes, const FrameOutput& expected) {
+    for (const RayGrouping grouping : {RayGrouping::Octant, RayGrouping::OctantCalls, RayGrouping::Batches})
+        for (const Backend backend : {Backend::Cpu, Backend::CpuSeq}) {
+            TracerOptions o = test::onBackend(backend, 2);
+            o.trace.dacrt.rayGrouping = grouping;
+            const FrameOutput grouped = Tracer(o).traceFrame(scene, rays, passes);
+            ASSERT_EQ(grouped.passes.size(), expected.passes.size());
+            for (std::size_t k = 0; k < expected.passes.size(); ++k) {
+                EXPECT_EQ(grouped.passes[k].rays, expected.passes[k].rays) << k;
+                EXPECT_TRUE(test::sameVisibility(expected.passes[k].output.hits, grouped.passes[k].output.hits))
+                    << k << ", grouping " << int(grouping) << ", backend " << int(backend);
+            }
+        }
+}
+
 TEST(ApiFrame, TracesTheCameraFrameThenItsPasses) {
     const TraceScene scene = TraceScene::load(test::kRoomScene);
     const RayBatch rays = RayBatch::fromCamera(scene, {}, 80, 60);
@@ -50,6 +68,13 @@ TEST(ApiFrame, TracesTheCameraFrameThenItsPasses) {
         EXPECT_EQ(sequential.passes[k].rays, frame.passes[k].rays) << k;
         EXPECT_TRUE(test::sameHits(sequential.passes[k].output.hits, frame.passes[k].output.hits)) << k;
     }
+    expectEveryGroupingGivesTheseVisibilities(scene, rays, passes, sequential);
+    // A frame whose occlusion pass (4 rays a pixel) is cut into batches.
+    const RayBatch larger = RayBatch::fromCamera(scene, {}, 200, 150);
+    const std::vector<FramePass> fourSamples = lightAndOcclusion(scene, 4);
+    ASSERT_GT(4 * larger.size(), std::max<std::size_t>(kPassBatchRays, kPassBatchRaysPerTriangle * scene.triangleCount()));
+    expectEveryGroupingGivesTheseVisibilities(
+        scene, larger, fourSamples, Tracer(test::onBackend(Backend::CpuSeq)).traceFrame(scene, larger, fourSamples));
 }
 
 TEST(ApiFrame, PlanCallbackSeesEachPassAndMayStop) {

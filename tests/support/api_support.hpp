@@ -104,6 +104,17 @@ inline ::testing::AssertionResult sameHits(const std::vector<RayHit>& a, const s
     return ::testing::AssertionSuccess();
 }
 
+// The same visibility slot by slot: a hit (any primitive) or none, and a ray or none.
+inline ::testing::AssertionResult sameVisibility(const std::vector<RayHit>& a, const std::vector<RayHit>& b) {
+    if (a.size() != b.size()) return ::testing::AssertionFailure() << a.size() << " slots against " << b.size();
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (a[i].hit() != b[i].hit() ||
+            (a[i].primitive == kNotTracedPrimitive) != (b[i].primitive == kNotTracedPrimitive))
+            return ::testing::AssertionFailure() << "slot " << i << ": primitive " << a[i].primitive << " against "
+                                                 << b[i].primitive;
+    return ::testing::AssertionSuccess();
+}
+
 // Expects `call` to throw InputError whose message contains `part`.
 inline void expectInputError(const std::function<void()>& call, const std::string& part) {
     try {

@@ -1,0 +1,51 @@
+// A secondary pass's rays grouped by octant on the cpu backends (DacrtOptions::rayGrouping):
+// through the dispatcher, as every frame's passes go, each grouping gives brute force's
+// visibility slot by slot.
+#include <gtest/gtest.h>
+
+#include "cpu/options.hpp"
+#include "library/backend_dispatcher.hpp"
+#include "support/frames.hpp"
+
+namespace dacrt {
+namespace {
+
+using namespace test;
+
+// Each pass of the set on brute force, then on cpu-seq and cpu (one region per thread, and
+// three) under every grouping, through one dispatcher, as a frame's passes are traced.
+void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
+    const FrameGeometry primary =
+        frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays, sceneBounds(set.frame.scene.triangles));
+    BackendDispatcher dispatcher({}, {Backend::Cpu});
+    for (const auto& [name, pass] : set.passes) {
+        SCOPED_TRACE(set.name + ", " + name);
+        BackendRequest request;
+        request.trace.threads = 2;
+        request.trace.backend = Backend::Brute;
+        const BackendDispatcher::PassTrace reference = dispatcher.traceSecondary(primary, set.primary.hits, pass, request);
+        ASSERT_GT(reference.rays, 500u);
+        for (RayGrouping grouping :
+             {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls, RayGrouping::Batches})
+            for (auto [backend, regions] : {std::pair{Backend::CpuSeq, 0u}, {Backend::Cpu, 0u}, {Backend::Cpu, 3u}}) {
+                request.trace.backend = backend;
+                request.trace.threads = backend == Backend::CpuSeq ? 0 : 2;
+                request.trace.regions = regions;
+                request.trace.dacrt.rayGrouping = grouping;
+                const BackendDispatcher::PassTrace t = dispatcher.traceSecondary(primary, set.primary.hits, pass, request);
+                EXPECT_EQ(t.rays, reference.rays);
+                EXPECT_TRUE(identicalVisibility(reference.result.hits, t.result.hits))
+                    << toString(backend) << ", " << regions << " regions, grouping " << toString(grouping);
+                const bool sorts = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
+                EXPECT_EQ(t.result.phases.groupRays.has_value(), sorts);
+            }
+    }
+}
+
+TEST(PassGrouping, EveryGroupingGivesBruteForcesVisibility) {
+    expectEveryGroupingAgrees(shapesSecondaryPasses());
+    expectEveryGroupingAgrees(shapesUnderACeilingPasses());
+}
+
+}  // namespace
+}  // namespace dacrt
