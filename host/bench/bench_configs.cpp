@@ -34,7 +34,7 @@ std::string optionText(const BenchConfig& c) {
       << " threads=" << c.threads();
     if (d.splitCost != SplitCost::Limits) s << " split_cost=" << toString(d.splitCost);
     if (!d.packets) s << " packets=off";
-    if (d.rayGrouping != RayGrouping::Slots) s << " ray_grouping=" << toString(d.rayGrouping);
+    if (d.rayGrouping != DacrtOptions{}.rayGrouping) s << " ray_grouping=" << toString(d.rayGrouping);
     if (c.backend() == Backend::Gpu)
         s << " ray_groups=" << (c.options.gpu.rayGroups ? std::to_string(c.options.gpu.rayGroups) : "auto");
     if (c.backend() == Backend::Gpu && c.options.gpu.profile != GpuProfile::Auto)
@@ -215,7 +215,7 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
     out.push_back(baseConfig(b, hardwareThreads));
     // The secondary rays' order (docs/benchmarks.md, "Rays grouped by octant").
     if (b == Backend::Cpu)
-        for (RayGrouping grouping : {RayGrouping::Octant, RayGrouping::OctantCalls, RayGrouping::Batches}) {
+        for (RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls}) {
             BenchConfig c = out.front();
             c.name = "ray-grouping=" + toString(grouping);
             c.isDefault = false;

@@ -52,9 +52,9 @@ constexpr std::array<BackendOption, 19> kBackendOptions{{
     {"--packet-flush", kCpuDacrt, "a node with fewer packets goes on ray by ray", "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.packetFlush != 0; }},
     {"--ray-grouping", kCpuDacrt,
-     "how a secondary pass's rays are traced: slots (as made, pixel by pixel), octant (grouped by the signs of their "
-     "directions), octant-calls (each octant's group traced on its own) or batches (as made, in traces of at most "
-     "65536 rays each, or 8 per triangle of the scene where that is more)",
+     "how a secondary pass's rays are traced: batches (as made, pixel by pixel, in traces of at most 65536 rays each, "
+     "or 8 per triangle of the scene where that is more), slots (as made, in one trace), octant (grouped by the signs "
+     "of their directions) or octant-calls (each octant's group traced on its own)",
      "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.rayGrouping != DacrtOptions{}.rayGrouping; }},
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,

@@ -66,7 +66,9 @@ struct DacrtOptions {
     // the recursion, one by one below; the SIMD path of rays that share their start only.
     bool packets = true;
     std::uint32_t packetFlush = 0;  // a node with fewer packets goes on ray by ray; 0: the default
-    RayGrouping rayGrouping = RayGrouping::Slots;  // secondary passes on the cpu backends
+    // Secondary passes on the cpu backends: batches by default (the room's lit frame 0.74x of
+    // slots, the Bunny's and the Dragon's passes one batch: docs/benchmarks.md).
+    RayGrouping rayGrouping = RayGrouping::Batches;
 
     // These options with the leaf limits of `backend` filled in where they are 0.
     DacrtOptions resolvedFor(Backend backend) const {

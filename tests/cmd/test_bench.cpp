@@ -254,8 +254,8 @@ TEST(Bench, PassesSuiteTimesEachPassAndDacrtMatchesCpuSeqExactly) {
     EXPECT_EQ(lines(out.dir / "b.csv"), j["rows"].size() + 1);
     const auto bySeries = passRowsBySeries(j);
     const std::set<std::string> expected = {"cpu-seq",        "cpu",
-                                            "cpu ray-grouping=octant", "cpu ray-grouping=octant-calls",
-                                            "cpu ray-grouping=batches",
+                                            "cpu ray-grouping=slots", "cpu ray-grouping=octant",
+                                            "cpu ray-grouping=octant-calls",
                                             "embree dynamic", "embree dynamic stored rays",
                                             "embree refit",   "embree refit stored rays",
                                             "embree static",  "embree static stored rays"};

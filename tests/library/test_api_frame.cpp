@@ -24,7 +24,7 @@ std::size_t slotsWithRays(const std::vector<RayHit>& hits) {
 // `expected` (cpu-seq's, slot order) their visibility slot by slot.
 void expectEveryGroupingGivesTheseVisibilities(const TraceScene& scene, const RayBatch& rays,
                                                const std::vector<FramePass>& passes, const FrameOutput& expected) {
-    for (const RayGrouping grouping : {RayGrouping::Octant, RayGrouping::OctantCalls, RayGrouping::Batches})
+    for (const RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls})
         for (const Backend backend : {Backend::Cpu, Backend::CpuSeq}) {
             TracerOptions o = test::onBackend(backend, 2);
             o.trace.dacrt.rayGrouping = grouping;
