@@ -73,9 +73,7 @@ const AnimatedWork& medianRun(const std::vector<AnimatedWork>& runs) {
 // frame (bench_memory.hpp) instead of holding one at a time.
 void checkAnimationMemory(const std::vector<BenchConfig>& configs, const TraceScene& scene, const Camera& camera,
                           const BenchCommand& cmd, const std::string& name, BenchRun& run) {
-    std::vector<Ray> buffer;
-    const RayBatch rays = makeCameraRays(camera, cmd.width, cmd.height, run.pools.of(run.hardwareThreads), buffer);
-    const BenchMemoryPlan plan = planBenchMemory(configs, scene, rays, name, cmd.memoryLimitMiB, run);
+    const BenchMemoryPlan plan = planBenchMemory(configs, scene, camera, name, cmd, run);
     if (plan.oneAtATime)
         throw InputError("bench --suite animation: " + name + ": " + keptAtOnceText(plan) +
                          ": bench fewer configurations (--backends) or a smaller scene");

@@ -7,6 +7,7 @@
 #include "core/process_memory.hpp"
 #include "core/system_memory.hpp"
 #include "bench/bench_configs.hpp"
+#include "peers/embree_memory.hpp"
 
 namespace dacrt {
 namespace {
@@ -14,14 +15,12 @@ namespace {
 // The share of the machine's memory a run may hold: the rest is the system's and its caches'.
 constexpr std::uint64_t kBudgetPercentOfMachine = 90;
 
-bool startsWith(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
-
 // Which of a plan's buffers a configuration keeps from frame to frame: Embree's structure
 // (its plan bounds it), and what a Vulkan backend holds on its device (on lavapipe, this
 // machine's memory too); the rest is the frame's.
 bool keptBetweenFrames(const BenchConfig& c, const std::string& buffer) {
-    if (c.backend() == Backend::Embree) return startsWith(buffer, "embree structure");
-    return runsOnVulkan(c.backend()) && !startsWith(buffer, "host:");
+    if (c.backend() == Backend::Embree) return buffer == kEmbreeStructurePlanLine;
+    return runsOnVulkan(c.backend()) && !buffer.starts_with("host:");
 }
 
 ConfigMemory configMemory(const BenchConfig& c, const TraceScene& scene, const RayBatch& rays, BenchRun& run) {
@@ -70,9 +69,12 @@ void chooseHolding(BenchMemoryPlan& plan, const std::vector<std::string>& labels
     plan.oneAtATime = true;
 }
 
-BenchMemoryPlan planBenchMemory(const std::vector<BenchConfig>& configs, const TraceScene& scene,
-                                const RayBatch& frameRays, const std::string& sceneName, std::uint64_t limitMiB,
-                                BenchRun& run) {
+BenchMemoryPlan planBenchMemory(const std::vector<BenchConfig>& configs, const TraceScene& scene, const Camera& camera,
+                                const std::string& sceneName, const BenchCommand& cmd, BenchRun& run) {
+    std::vector<Ray> buffer;
+    const RayBatch frameRays =
+        makeCameraRays(camera, cmd.width, cmd.height, run.pools.of(run.hardwareThreads), buffer);
+    const std::uint64_t limitMiB = cmd.memoryLimitMiB;
     BenchMemoryPlan plan;
     const std::optional<ResidentMemory> resident = residentMemory();
     plan.held = resident ? resident->current : 0;
@@ -102,10 +104,7 @@ std::string oneAtATimeNotice(const BenchMemoryPlan& plan, const std::string& sce
 
 BenchMemoryPlan planSceneMemory(const std::vector<BenchConfig>& configs, const BenchScene& scene,
                                 const BenchCommand& cmd, BenchRun& run) {
-    std::vector<Ray> buffer;
-    const RayBatch rays =
-        makeCameraRays(scene.cameras.front(), cmd.width, cmd.height, run.pools.of(run.hardwareThreads), buffer);
-    const BenchMemoryPlan plan = planBenchMemory(configs, scene.traced, rays, scene.name, cmd.memoryLimitMiB, run);
+    const BenchMemoryPlan plan = planBenchMemory(configs, scene.traced, scene.cameras.front(), scene.name, cmd, run);
     if (plan.oneAtATime) std::cerr << oneAtATimeNotice(plan, scene.name) << "\n";
     return plan;
 }

@@ -38,15 +38,14 @@ struct BenchMemoryPlan {
     std::uint64_t largestAlone() const;
 };
 
-// The memory each configuration keeps and each frame needs, for frames of `frameRays` rays
-// over `scene`, by its plan (Tracer::plan: what Embree's structure takes by its bound, what a
-// Vulkan backend holds on its device, are kept), against a budget of limitMiB (0: 90% of this
-// machine's memory).
+// The memory each configuration keeps and each frame needs, for frames of the camera's rays at
+// the command's size over `scene`, by its plan (Tracer::plan: what Embree's structure takes by
+// its bound, what a Vulkan backend holds on its device, are kept), against a budget of the
+// command's --memory-limit (0: 90% of this machine's memory).
 // Throws InputError, before any frame, where one configuration alone exceeds the budget;
 // `sceneName` names the scene in it.
-BenchMemoryPlan planBenchMemory(const std::vector<BenchConfig>& configs, const TraceScene& scene,
-                                const RayBatch& frameRays, const std::string& sceneName, std::uint64_t limitMiB,
-                                BenchRun& run);
+BenchMemoryPlan planBenchMemory(const std::vector<BenchConfig>& configs, const TraceScene& scene, const Camera& camera,
+                                const std::string& sceneName, const BenchCommand& cmd, BenchRun& run);
 
 // Where the configurations' kept state goes, from the plan's figures: every one at once where
 // it all fits the budget, else one at a time (oneAtATime set); throws InputError naming the

@@ -56,12 +56,17 @@ PeerScenes::Kept& PeerScenes::keep(Backend backend, const EmbreeOptions& embree,
 
 TraceResult PeerScenes::traceEmbree(const FrameGeometry& g, const EmbreeOptions& options, ThreadPool& pool,
                                     const PlanHook& onPlan, PeerFrame frame) {
-    if (std::optional<TraceResult> planned = stoppedAtEmbreePlan(g, onPlan)) return *planned;
-    if (g.sceneId == 0) {
-        TraceResult result = dacrt::traceEmbree(g, options, pool);
-        result.memory = embreePlan(g);
-        return result;
-    }
+    TraceResult result;
+    result.memory = embreePlan(g);
+    if (onPlan && !onPlan(result.memory)) return result;  // stopped at the plan: no hits
+    const MemoryPlan plan = std::move(result.memory);
+    result = g.sceneId == 0 ? dacrt::traceEmbree(g, options, pool) : traceKeptEmbree(g, options, pool, frame);
+    result.memory = plan;
+    return result;
+}
+
+TraceResult PeerScenes::traceKeptEmbree(const FrameGeometry& g, const EmbreeOptions& options, ThreadPool& pool,
+                                        PeerFrame frame) {
     EmbreeOptions key = options;
     key.imageWidth = 0;  // chosen per trace: the frame names its own
     Kept* k = keptFor(g, Backend::Embree, key, {});
@@ -79,7 +84,6 @@ TraceResult PeerScenes::traceEmbree(const FrameGeometry& g, const EmbreeOptions&
     k->triangles = g.triangles->size();
     k->version = g.trianglesVersion;
     TraceResult result = k->embreeScene->trace(*g.rays, pool, g.query, g.imageWidth);
-    result.memory = embreePlan(g);
     result.phases.build = build;
     result.phases.refit = refit;
     return result;

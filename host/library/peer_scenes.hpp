@@ -36,7 +36,7 @@ public:
     // structure then updates it in place (a rebuild into the last one's memory, phase build, or
     // a refit, phase refit); a static one is built once per triangles' version and then only
     // traced.
-    // onPlan sees the frame's plan first (stoppedAtEmbreePlan).
+    // onPlan sees the frame's plan first (embreePlan), which the result carries.
     TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool,
                             const PlanHook& onPlan, PeerFrame frame);
 
@@ -52,6 +52,9 @@ public:
 
 private:
     struct Kept;
+    // traceEmbree over the structure kept for the geometry's scene.
+    TraceResult traceKeptEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool,
+                                PeerFrame frame);
     // The structure kept for these options over the geometry's scene, or null: the kept ones
     // of another scene are freed first.
     Kept* keptFor(const FrameGeometry& geometry, Backend backend, const EmbreeOptions& embree, RayQueryBuild build);

@@ -16,6 +16,9 @@ constexpr std::uint64_t kEmbreeStructureBytesPerTriangle = 128;
 constexpr std::uint64_t kEmbreeIndexBytesPerTriangle = 12;
 constexpr std::uint64_t kEmbreeStructureFixedBytes = std::uint64_t(2) << 20;
 
+// The plan's line for it (embreePlan), which the bench counts as kept from frame to frame.
+inline constexpr const char* kEmbreeStructurePlanLine = "embree structure and index buffer (at most)";
+
 inline std::uint64_t embreeStructureBytesBound(std::uint64_t triangles) {
     return kEmbreeStructureFixedBytes + triangles * (kEmbreeStructureBytesPerTriangle + kEmbreeIndexBytesPerTriangle);
 }

@@ -324,19 +324,11 @@ TraceResult EmbreeScene::trace(const std::vector<Ray>& rays, ThreadPool& pool, H
 MemoryPlan embreePlan(const FrameGeometry& geometry) {
     MemoryPlan plan;
     // Embree allocates its structure itself: the line is a bound from the triangle count.
-    plan.add("embree structure and index buffer (at most)", embreeStructureBytesBound(geometry.triangles->size()));
+    plan.add(kEmbreeStructurePlanLine, embreeStructureBytesBound(geometry.triangles->size()));
     plan.add("triangles (Embree's vertex buffer, shared)", geometry.triangles->size() * sizeof(Triangle));
     plan.add("hits", geometry.rays->size() * sizeof(Hit));
     plan.addWork("rays", geometry.rays->size(), "traced by Embree");
     return plan;
-}
-
-std::optional<TraceResult> stoppedAtEmbreePlan(const FrameGeometry& geometry, const PlanHook& onPlan) {
-    if (!onPlan) return std::nullopt;
-    TraceResult planned;
-    planned.memory = embreePlan(geometry);
-    if (onPlan(planned.memory)) return std::nullopt;
-    return planned;
 }
 
 TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& options, ThreadPool& pool) {

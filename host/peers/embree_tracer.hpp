@@ -79,8 +79,4 @@ TraceResult traceEmbree(const FrameGeometry& geometry, const EmbreeOptions& opti
 // its work, the rays.
 MemoryPlan embreePlan(const FrameGeometry& geometry);
 
-// Where onPlan declines embreePlan (returns false), the plan as a trace with no hits (as every
-// backend's plan stops); none where it goes on or there is no onPlan.
-std::optional<TraceResult> stoppedAtEmbreePlan(const FrameGeometry& geometry, const PlanHook& onPlan);
-
 }  // namespace dacrt
