@@ -573,6 +573,11 @@ TEST(Bench, BadInputGetsAClearError) {
     EXPECT_NE(r.output.find("nonexistent.glb"), std::string::npos) << r.output;
     r = test::runDacrt("bench " + roomScene() + " --backends warp-drive");
     EXPECT_EQ(r.code, 2);
+    for (const char* limit : {"0", "lots"}) {
+        r = test::runDacrt("bench " + roomScene() + " --backends cpu-seq --memory-limit " + limit);
+        EXPECT_EQ(r.code, 2) << limit;
+        EXPECT_NE(r.output.find("--memory-limit"), std::string::npos) << r.output;
+    }
     r = test::runDacrt("bench " + roomScene() + " --suite table51 --backends embree");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.output.find("table51"), std::string::npos) << r.output;
