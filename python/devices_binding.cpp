@@ -15,7 +15,7 @@ py::dict vulkanDeviceOf(const VulkanDevice& d) {
                     "max_memory_allocation_size"_a = d.maxMemoryAllocationSize,
                     "device_local_bytes"_a = d.deviceLocalBytes, "buffer_device_address"_a = d.bufferDeviceAddress,
                     "ray_query"_a = d.rayQuery,
-                    "ray_query_missing"_a = d.rayQueryMissing);
+                    "ray_query_missing"_a = d.rayQueryMissing, "subgroup_clock"_a = d.subgroupClock);
 }
 
 py::dict devices() {

@@ -12,6 +12,9 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_shuffle : require
 #extension GL_EXT_control_flow_attributes : require
+#ifdef DACRT_STAGE_CLOCKS
+#extension GL_ARB_shader_clock : require
+#endif
 
 #define IN(T) in T
 #include "layout.h"
@@ -136,6 +139,7 @@ bool startAtRoot(ItemContext c, inout Slice s) {
 
 // A work item an earlier slice left off: its node from `states`, its stack from `stacks`.
 void resumeSaved(ItemContext c, TraversalState state, inout Slice s) {
+    uint start = stageClock();
     s.lo = state.lo;
     s.hi = state.hi;
     s.nodeRayEnd = state.nodeRayEnd;
@@ -152,6 +156,7 @@ void resumeSaved(ItemContext c, TraversalState state, inout Slice s) {
     for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) sStack[i] = stacks[from + i];
     s.spent = s.stackSize / kWorkgroupSize + 1u;
     workgroupSync();
+    addStageTicks(DACRT_STAGE_STACK_AND_SLICES, start);
 }
 
 // Tests the leaf's rays from leafNext (or the first live one) against its triangles, as many
@@ -237,6 +242,7 @@ uint splitNode(ItemContext c, inout Slice s, int axis, float split, uint rayCoun
 // The far child on top of the stack becomes the node, its rays and triangles filtered again.
 uint popFarChild(ItemContext c, inout Slice s) {
     if (s.stackSize == 0) return kStepTreeDone;
+    uint start = stageClock();
     workgroupSync();
     StackEntry far = sStack[s.stackSize - 1u];
     uint cost = partitionCost(far.rayEnd - s.terminated) + partitionCost(far.triEnd - far.triBegin) + kStepOverhead;
@@ -245,6 +251,7 @@ uint popFarChild(ItemContext c, inout Slice s) {
     s.progressed = true;
     --s.stackSize;
     workgroupSync();  // the slot may be written again before everyone has read it
+    addStageTicks(DACRT_STAGE_STACK_AND_SLICES, start);
     s.lo = far.lo;
     s.hi = far.hi;
     s.nodeRayEnd = far.rayRule == kKeepCrossing  // as in splitNode: the common rule as a constant
@@ -279,6 +286,7 @@ uint stepTraversal(ItemContext c, inout Slice s) {
 // holds fewer stacks than there are work items; past its last slot nothing is written, and
 // the host fails the frame (stackSlotsTaken).
 void saveSlice(ItemContext c, Slice s) {
+    uint start = stageClock();
     if (!s.progressed && c.lane == 0) atomicAdd(counters.tooLarge, 1u);
     if (s.stackSlot == 0u) {
         if (c.lane == 0) sStackSlot = atomicAdd(counters.stackSlotsTaken, 1u) + 1u;
@@ -308,6 +316,7 @@ void saveSlice(ItemContext c, Slice s) {
         regions[c.item.rayRegion].terminated = s.terminated;
         if (cutShort) atomicAdd(counters.loopLimitHits, 1u);
     }
+    addStageTicks(DACRT_STAGE_STACK_AND_SLICES, start);
 }
 
 // The tree is done: rays no later work item can change are finished here (see RetireRule on
@@ -329,15 +338,16 @@ void retireRays(ItemContext c, Slice s) {
     }
 }
 
-void main() {
-    loadFrameParameters();
-    ItemContext c;
-    c.lane = gl_LocalInvocationIndex;
-    c.index = push.firstWorkItem + gl_WorkGroupID.x;
-    c.item = workItems[c.index];
+// One launch of the workgroup's work item: nothing if it is finished or must wait, else a
+// slice of its traversal.
+void runWorkItem(inout ItemContext c) {
     TraversalState state = states[c.index];
     if (state.phase == kPhaseFinished) return;
-    if (!predecessorsFinished(c)) return;
+    uint waitStart = stageClock();
+    if (!predecessorsFinished(c)) {
+        addStageTicks(DACRT_STAGE_WAITING, waitStart);
+        return;
+    }
     if (c.lane == 0) atomicAdd(counters.slices, 1u);
     Slice s;
     s.terminated = regions[c.item.rayRegion].terminated;
@@ -370,4 +380,17 @@ void main() {
         saveSlice(c, s);
     else
         retireRays(c, s);
+}
+
+void main() {
+    uint launchStart = stageClock();
+    clearStageTicks();
+    loadFrameParameters();
+    ItemContext c;
+    c.lane = gl_LocalInvocationIndex;
+    c.index = push.firstWorkItem + gl_WorkGroupID.x;
+    c.item = workItems[c.index];
+    runWorkItem(c);
+    endLaunchTicks(launchStart);
+    publishStageTicks(c.lane);
 }

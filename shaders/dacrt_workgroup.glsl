@@ -4,6 +4,8 @@
 #ifndef DACRT_WORKGROUP_GLSL
 #define DACRT_WORKGROUP_GLSL
 
+#include "stage_clocks.glsl"
+
 // Makes buffer and shared writes of every invocation visible to the whole workgroup. A
 // workgroup of one subgroup needs only a subgroup barrier.
 void workgroupSync() {
@@ -191,11 +193,17 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
 }
 
 uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
-    return partitionIds(begin, end, rule, lo, hi);
+    uint start = stageClock();
+    uint kept = partitionIds(begin, end, rule, lo, hi);
+    addStageTicks(DACRT_STAGE_RAY_PARTITIONS, start);
+    return kept;
 }
 
 uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
-    return partitionIds(begin, end, kKeepOverlapping, lo, hi);
+    uint start = stageClock();
+    uint kept = partitionIds(begin, end, kKeepOverlapping, lo, hi);
+    addStageTicks(DACRT_STAGE_TRIANGLE_PARTITIONS, start);
+    return kept;
 }
 
 // Invocations that share one ray in a leaf with rayCount rays: a power of two, so that one
@@ -219,6 +227,7 @@ Ray leafRay(uint id) {
 // one invocation at a time, but shuffles in registers). With fewer rays than lanes each ray
 // gets `lanes` lanes that split the tile; a butterfly then gives all of them the best hit.
 void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
+    uint start = stageClock();
     uint lane = gl_SubgroupInvocationID;
     uint rayCount = rayEnd - rayBegin;
     uint lanes = leafLanesPerRay(rayCount);
@@ -268,6 +277,7 @@ void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
         if (rayActive && slot == 0u) HITS(id) = best;
     }
     workgroupSync();
+    addStageTicks(DACRT_STAGE_LEAF_TESTS, start);
 }
 
 // After a leaf's tests: the rays whose best hit ends them inside the leaf box move to the

@@ -173,6 +173,18 @@ struct SecondaryPush {
     uint pad3;
 };
 
+// The stages a work item's clock ticks are told apart by (shaders/stage_clocks.glsl): every
+// ray filter (the leaves' and the final retire included), every triangle filter, the leaves'
+// tests, the stack and the slices (a pop's wait, saving and resuming), a launch that finds a
+// predecessor still running, and every launch from start to end, which holds all the others.
+#define DACRT_STAGE_RAY_PARTITIONS 0
+#define DACRT_STAGE_TRIANGLE_PARTITIONS 1
+#define DACRT_STAGE_LEAF_TESTS 2
+#define DACRT_STAGE_STACK_AND_SLICES 3
+#define DACRT_STAGE_WAITING 4
+#define DACRT_STAGE_LAUNCHES 5
+#define DACRT_STAGE_COUNT 6
+
 // Counters the kernel adds to with atomics (32-bit: a frame stays far below 2^32 tests).
 struct GpuCounters {
     uint workItemsRun;
@@ -190,6 +202,9 @@ struct GpuCounters {
     uint terminatedStep1;  // rays finished by Step 1 work items (hit or retired), as the cpu backend counts them
     uint stackSlotsTaken;  // work items that saved a stack (more than DacrtPush::stackSlots: the frame fails)
     uint raysCulled;       // secondary.comp: rays made that miss the division's widened box (no region)
+    // The kernel's stage clocks (the DACRT_STAGE_CLOCKS build, --stage-clocks): clock ticks
+    // each stage took over the frame's work items, as 64-bit sums of (low, high) words.
+    uint stageTicks[2 * DACRT_STAGE_COUNT];
 };
 
 // Push constants of workgroup_test.comp, which runs one building block of the DACRT kernel
@@ -288,9 +303,10 @@ static_assert(offsetof(SecondaryPush, firstInvocation) == 88);
 static_assert(offsetof(DacrtPush, rayOrigin) == 0 && offsetof(DacrtPush, margin) == 12);
 static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, axis) == 20);
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
-static_assert(sizeof(GpuCounters) == 60 && offsetof(GpuCounters, raysRetired) == 20);
+static_assert(offsetof(GpuCounters, raysRetired) == 20);
 static_assert(offsetof(GpuCounters, terminatedStep1) == 48 && offsetof(GpuCounters, stackSlotsTaken) == 52);
-static_assert(offsetof(GpuCounters, raysCulled) == 56);
+static_assert(offsetof(GpuCounters, raysCulled) == 56 && offsetof(GpuCounters, stageTicks) == 60);
+static_assert(sizeof(GpuCounters) == 60 + 8 * DACRT_STAGE_COUNT);
 static_assert(offsetof(GpuCounters, itemsFinished) == 32 && offsetof(GpuCounters, tooLarge) == 44);
 static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, loopLimitHits) == 28);
 static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);

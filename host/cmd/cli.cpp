@@ -272,6 +272,7 @@ Subcommand addRenderCommand(CLI::App& app) {
     cmd->add_option("--workgroup-size", render.tracer.gpu.workgroupSize)->check(CLI::Range(1u, 1024u));
     cmd->add_option("--ray-groups", render.tracer.gpu.rayGroups)->check(CLI::Range(1u, 64u));
     addEnumOption(cmd, "--gpu-profile", render.tracer.gpu.profile, "");
+    cmd->add_flag("--stage-clocks", render.tracer.gpu.stageClocks);
     addFrameOptions(cmd, *s);
     describeBackendOptions(cmd);
     return {cmd, [s, cmd] {

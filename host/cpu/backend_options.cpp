@@ -21,7 +21,7 @@ constexpr bool kDacrtOption = true;
 static_assert(kPassBatchRays == 65536 && kPassBatchRaysPerTriangle == 8, "--ray-grouping's help names the batch size");
 
 // The order is the help's, and the order in which a refusal names the options.
-constexpr std::array<BackendOption, 19> kBackendOptions{{
+constexpr std::array<BackendOption, 20> kBackendOptions{{
     {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
@@ -66,6 +66,11 @@ constexpr std::array<BackendOption, 19> kBackendOptions{{
      "whose defaults the regions, ray groups and workgroup size take where not given: auto (the device's kind), cpu "
      "(a CPU device's, as lavapipe's) or discrete (a discrete GPU's, at least 2048 work items in Step 1, on any device)",
      "default: auto", kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.gpuProfile != GpuProfile::Auto; }},
+    {"--stage-clocks", kGpu,
+     "run the kernel with clocks around its stages and report each stage's ticks in --stats (gpu.stage_ticks): "
+     "the same hits, a little slower",
+     "needs the device's subgroup clock (dacrt devices)", kAdvanced, !kDacrtOption,
+     [](const RequestedOptions& r) { return r.stageClocks; }},
     {"--no-skip", {Backend::Brute, Backend::CpuSeq, Backend::Cpu, Backend::Gpu},
      "skips to turn off (each changes speed only): backfaces (single-sided triangles facing away from the camera, or "
      "from a directional light's shadow rays), "

@@ -38,6 +38,7 @@ struct RequestedOptions {
     bool embreeRobust = true;
     bool embreePackets = true;
     GpuProfile gpuProfile = GpuProfile::Auto;
+    bool stageClocks = false;
 };
 
 // One backend-specific option of `dacrt render`.

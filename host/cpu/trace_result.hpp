@@ -62,6 +62,8 @@ struct GpuReport {
     std::vector<GpuWorkPass> workPasses;  // gpu: Step 1, then each transfer round
     std::uint64_t workCost = 0;           // gpu: every work item's cost, summed
     std::uint64_t longestChainCost = 0;   // gpu: the costliest chain of work items that wait for each other
+    // gpu with stage clocks: each stage's clock ticks (DACRT_STAGE_* order); empty without.
+    std::vector<std::uint64_t> stageTicks;
 };
 
 struct TraceResult {

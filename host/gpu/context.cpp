@@ -155,6 +155,16 @@ bool computeFullSubgroups(VkPhysicalDevice d) {
     return control.computeFullSubgroups == VK_TRUE;
 }
 
+// Whether the device has VK_KHR_shader_clock with the shaderSubgroupClock feature (the
+// kernel's stage clocks, GpuTuning::stageClocks).
+bool subgroupClock(VkPhysicalDevice d, const std::vector<VkExtensionProperties>& extensions) {
+    if (!hasExtension(extensions, VK_KHR_SHADER_CLOCK_EXTENSION_NAME)) return false;
+    VkPhysicalDeviceShaderClockFeaturesKHR clock{};
+    clock.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_CLOCK_FEATURES_KHR;
+    queryFeatures(d, &clock);
+    return clock.shaderSubgroupClock == VK_TRUE;
+}
+
 DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     VkPhysicalDeviceDriverProperties driver{};
     driver.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES;
@@ -201,6 +211,7 @@ DeviceInfo describeDevice(VkPhysicalDevice d, std::uint32_t index) {
     info.rayQuery = missing.empty();
     for (std::size_t i = 0; i < missing.size(); ++i) info.rayQueryMissing += (i ? ", " : "") + missing[i];
     if (sizeControl) info.fullSubgroups = computeFullSubgroups(d);
+    info.subgroupClock = subgroupClock(d, extensions);
     return info;
 }
 
@@ -233,6 +244,7 @@ std::string DeviceInfo::describe() const {
       << "   subgroup size: " << subgroupSize << (subgroupOperations ? " (arithmetic and shuffles in compute)" : " (no compute arithmetic or shuffles)")
       << "\n   full subgroups on request: " << (fullSubgroups ? "yes" : "no")
       << "\n   timestamps: " << (timestamps ? "yes" : "no")
+      << "\n   shader clocks (--stage-clocks): " << (subgroupClock ? "yes" : "no")
       << "\n   ray query (rayquery backend): " << (rayQuery ? "yes" : "no, lacks " + rayQueryMissing) << "\n";
     return s.str();
 }
@@ -360,6 +372,15 @@ void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const De
         accel.pNext = &rayQuery;
         chain = &accel;
         for (const char* e : kRayQueryExtensions) enabled.push_back(e);
+    }
+    // The subgroup clock where the device has it: the kernel's stage clocks (--stage-clocks).
+    VkPhysicalDeviceShaderClockFeaturesKHR clock{};
+    clock.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_CLOCK_FEATURES_KHR;
+    if (info.subgroupClock) {
+        clock.shaderSubgroupClock = VK_TRUE;
+        clock.pNext = chain;
+        chain = &clock;
+        enabled.push_back(VK_KHR_SHADER_CLOCK_EXTENSION_NAME);
     }
     // Device addresses where the device has them: the acceleration structures' inputs, and the
     // gpu kernels' arrays beyond maxStorageBufferRange.

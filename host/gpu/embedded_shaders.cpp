@@ -2,6 +2,7 @@
 
 #include "dacrt.spv.h"
 #include "dacrt_addressed.spv.h"
+#include "dacrt_clocks.spv.h"
 #include "rayquery.spv.h"
 #include "secondary.spv.h"
 #include "secondary_addressed.spv.h"
@@ -17,6 +18,10 @@ std::span<const std::uint32_t> secondarySpirv() {
 
 std::span<const std::uint32_t> dacrtKernelAddressedSpirv() {
     return {dacrt_addressed_spv, sizeof(dacrt_addressed_spv) / sizeof(dacrt_addressed_spv[0])};
+}
+
+std::span<const std::uint32_t> dacrtKernelClocksSpirv() {
+    return {dacrt_clocks_spv, sizeof(dacrt_clocks_spv) / sizeof(dacrt_clocks_spv[0])};
 }
 
 std::span<const std::uint32_t> secondaryAddressedSpirv() {

@@ -10,6 +10,8 @@ std::span<const std::uint32_t> secondarySpirv();      // shaders/secondary.comp
 // The same two kernels with DACRT_ADDRESSED: the large arrays by device address, in chunks.
 std::span<const std::uint32_t> dacrtKernelAddressedSpirv();
 std::span<const std::uint32_t> secondaryAddressedSpirv();
+// The kernel with its stage clocks (DACRT_STAGE_CLOCKS): needs the shaderSubgroupClock feature.
+std::span<const std::uint32_t> dacrtKernelClocksSpirv();
 std::span<const std::uint32_t> workgroupTestSpirv();  // shaders/workgroup_test.comp
 std::span<const std::uint32_t> rayQuerySpirv();       // shaders/rayquery.comp
 

@@ -13,6 +13,7 @@
 #include "gpu/binding_set.hpp"
 #include "gpu/device_defaults.hpp"
 #include "gpu/dispatch_recorder.hpp"
+#include "gpu/stage_clocks.hpp"
 #include "gpu/work_plan.hpp"
 #include "gpu/work_spread.hpp"
 
@@ -350,6 +351,7 @@ void GpuTracer::planMemory(Frame& frame) const {
     for (const auto& [name, bytes] : frame.hostPlan.buffers) plan.add("host: " + name, bytes);
     plan.add("host: triangle ids per ray group", frame.triIdCount * 4);
     gpu::addressLargeArrays(frame.buffers, limits_);
+    checkStageClocks(frame.buffers);
     gpu::addToMemoryPlan(frame.buffers, limits_, plan);
     // Kept triangles in chunks this frame cannot reach (it binds what an earlier one addressed,
     // or the reverse) are uploaded again.
@@ -369,6 +371,19 @@ void GpuTracer::planMemory(Frame& frame) const {
                                       : g.trianglesVersion ? "skip off (--no-skip uploads)" : "the triangles' version is unknown");
     plan.addWork("bytes read back", std::uint64_t(g.rays->size()) * sizeof(Hit) + work.slots.size() * sizeof(Region) +
                  work.items.size() * sizeof(TraversalState), "hits, regions and work item states (their costs)");
+}
+
+// Stage clocks read the device's subgroup clock, and only the kernel that binds every array has them.
+void GpuTracer::checkStageClocks(const gpu::DacrtBufferPlan& buffers) const {
+    if (!tuning_.stageClocks) return;
+    const gpu::DeviceInfo& device = context_.info();
+    if (!device.subgroupClock)
+        throw InputError("--stage-clocks needs VK_KHR_shader_clock's shaderSubgroupClock, which device '" + device.name +
+                         "' (" + device.driver + ") lacks");
+    if (gpu::chunkBytesOf(buffers) != 0)
+        throw InputError("--stage-clocks times the kernel that binds every array, and this frame's arrays exceed one "
+                         "binding (" + limits_.bindingLimit + " of " + std::to_string(limits_.bindingBytes) +
+                         " bytes); render fewer pixels to time its stages");
 }
 
 // The frame's buffers that an earlier frame left in the arena: reused, not allocated.
@@ -432,6 +447,7 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .anyHit = anyHit,
         .addressed = frame.set->addressed(),
         .chunkBytes = frame.set->kernelChunkBytes(),
+        .stageClocks = tuning_.stageClocks,
     });
     // Compilation only (a first use; later frames find the pipeline in the cache), so that
     // render and bench can take it out of the frame.
@@ -493,6 +509,7 @@ void GpuTracer::readBack(Frame& frame) const {
     costs.reserve(states.size());
     for (const TraversalState& state : states) costs.push_back(state.cost);
     gpu::reportWorkSpread(work, costs, report);
+    if (tuning_.stageClocks) report.stageTicks = gpu::stageTicksOf(counters);
 }
 
 TraceResult GpuTracer::traceSecondary(GpuPassSource& source, const FrameGeometry& geometry, const SecondaryPass& pass,

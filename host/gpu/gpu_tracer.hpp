@@ -79,6 +79,7 @@ private:
     void divide(Frame& frame);
     void planMemory(Frame& frame) const;
     void planBufferReuse(Frame& frame) const;
+    void checkStageClocks(const gpu::DacrtBufferPlan& buffers) const;
     void upload(Frame& frame) const;
     void dispatch(Frame& frame) const;
     void readBack(Frame& frame) const;

@@ -1,5 +1,6 @@
 #include "gpu/pipeline_cache.hpp"
 
+#include "core/errors.hpp"
 #include "core/shader_layout.hpp"
 #include "gpu/binding_set.hpp"
 #include "gpu/dispatch_recorder.hpp"
@@ -52,12 +53,14 @@ void prime(Context& context, ComputePipeline& pipeline, bool addressed) {
 
 ComputePipeline& PipelineCache::kernel(const KernelSpecialization& specialization) {
     const std::vector<std::uint32_t> values = specialization.values();
-    const bool addressed = specialization.addressed;
-    std::unique_ptr<ComputePipeline>& slot = pipelines_[{addressed, values}];
+    const bool addressed = specialization.addressed, clocks = specialization.stageClocks;
+    std::unique_ptr<ComputePipeline>& slot = pipelines_[{addressed, clocks, values}];
     if (!slot) {
-        slot = std::make_unique<ComputePipeline>(context_, addressed ? dacrtKernelAddressedSpirv() : dacrtKernelSpirv(),
-                                                 DACRT_BINDING_COUNT, sizeof(DacrtPush), values,
-                                                 addressed ? "dacrt (addressed)" : "dacrt");
+        if (addressed && clocks) throw InternalError("the addressed kernel has no stage clocks (the tracer refuses the pair)");
+        const std::span<const std::uint32_t> spirv =
+            addressed ? dacrtKernelAddressedSpirv() : (clocks ? dacrtKernelClocksSpirv() : dacrtKernelSpirv());
+        slot = std::make_unique<ComputePipeline>(context_, spirv, DACRT_BINDING_COUNT, sizeof(DacrtPush), values,
+                                                 addressed ? "dacrt (addressed)" : (clocks ? "dacrt (stage clocks)" : "dacrt"));
         prime(context_, *slot, addressed);
     }
     return *slot;

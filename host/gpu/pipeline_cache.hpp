@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -24,6 +25,8 @@ struct KernelSpecialization {
     // chunks of chunkBytes (0: every array one chunk): DacrtBindingSet::addressed, kernelChunkBytes.
     bool addressed = false;
     std::uint32_t chunkBytes = 0;
+    // The kernel with its stage clocks (DACRT_STAGE_CLOCKS, GpuTuning::stageClocks).
+    bool stageClocks = false;
     std::vector<std::uint32_t> values() const;  // in constant_id order
 };
 
@@ -48,7 +51,8 @@ private:
     std::unique_ptr<ComputePipeline> rayQuery_;
     std::map<std::pair<bool, std::uint32_t>, std::unique_ptr<ComputePipeline>> secondary_;  // by addressed, chunkBytes
     bool rayQueryPrimed_ = false;
-    std::map<std::pair<bool, std::vector<std::uint32_t>>, std::unique_ptr<ComputePipeline>> pipelines_;
+    // By addressed, stage clocks and specialization values.
+    std::map<std::tuple<bool, bool, std::vector<std::uint32_t>>, std::unique_ptr<ComputePipeline>> pipelines_;
 };
 
 }  // namespace dacrt::gpu

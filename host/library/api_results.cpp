@@ -3,6 +3,7 @@
 #include <dacrt/plan_text.hpp>
 
 #include "cpu/phase_times.hpp"
+#include "gpu/stage_clocks.hpp"
 
 namespace dacrt {
 
@@ -64,12 +65,15 @@ DeviceReport deviceReportOf(const GpuReport& g) {
     for (const auto& [name, ms] : g.dispatchMs) dispatchTimes.push_back({name, ms});
     std::vector<DeviceReport::WorkPass> workPasses;
     for (const GpuWorkPass& p : g.workPasses) workPasses.push_back({p.name, p.items, p.maxCost, p.meanCost});
+    std::vector<DeviceReport::StageTicks> stageTicks;
+    for (std::size_t k = 0; k < g.stageTicks.size(); ++k) stageTicks.push_back({gpu::stageName(k), g.stageTicks[k]});
     return DeviceReport{.device = g.device, .driver = g.driver, .workgroupSize = g.workgroupSize,
                         .subgroupSize = g.subgroupSize, .rayGroups = g.rayGroups,
                         .dispatchTimes = std::move(dispatchTimes), .dispatches = g.dispatches,
                         .workItemsRun = g.workItemsRun, .workItemsEmpty = g.workItemsEmpty, .workItemSlices = g.slices,
                         .raysFinished = g.raysFinished, .validationErrors = g.validationErrors,
-                        .workPasses = std::move(workPasses), .workCost = g.workCost, .longestChainCost = g.longestChainCost};
+                        .workPasses = std::move(workPasses), .workCost = g.workCost, .longestChainCost = g.longestChainCost,
+                        .stageTicks = std::move(stageTicks)};
 }
 
 }  // namespace

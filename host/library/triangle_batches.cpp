@@ -31,6 +31,8 @@ void mergeGpuReports(GpuReport& into, const GpuReport& batch) {
     into.workPasses.insert(into.workPasses.end(), batch.workPasses.begin(), batch.workPasses.end());
     into.workCost += batch.workCost;
     into.longestChainCost += batch.longestChainCost;  // the batches run one after another
+    into.stageTicks.resize(std::max(into.stageTicks.size(), batch.stageTicks.size()), 0);
+    for (std::size_t k = 0; k < batch.stageTicks.size(); ++k) into.stageTicks[k] += batch.stageTicks[k];
 }
 
 // What a batch exceeded (the frame, for the first batches).

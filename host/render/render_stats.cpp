@@ -52,6 +52,16 @@ nlohmann::ordered_json workItemsJson(const DeviceReport& g) {
             {"parallelism", g.parallelism()}};
 }
 
+// The kernel's stage clocks (--stage-clocks): ticks and each stage's share of the launches'.
+nlohmann::ordered_json stageTicksJson(const DeviceReport& g) {
+    std::uint64_t launches = 0;
+    for (const DeviceReport::StageTicks& s : g.stageTicks) if (s.name == "launches") launches = s.ticks;
+    nlohmann::ordered_json j;
+    for (const DeviceReport::StageTicks& s : g.stageTicks)
+        j[jsonKey(s.name)] = {{"ticks", s.ticks}, {"share", launches ? double(s.ticks) / double(launches) : 0.0}};
+    return j;
+}
+
 nlohmann::ordered_json gpuJson(const DeviceReport& g) {
     nlohmann::ordered_json dispatches = nlohmann::ordered_json::array();
     for (const DeviceReport::Dispatch& d : g.dispatchTimes) dispatches.push_back({{"name", d.name}, {"gpu_ms", d.gpuMs}});
@@ -68,6 +78,7 @@ nlohmann::ordered_json gpuJson(const DeviceReport& g) {
             {"rays_finished", g.raysFinished},
             {"validation_errors", g.validationErrors}};
     if (!g.workPasses.empty()) j["work_items"] = workItemsJson(g);  // gpu (rayquery has no work items)
+    if (!g.stageTicks.empty()) j["stage_ticks"] = stageTicksJson(g);
     return j;
 }
 

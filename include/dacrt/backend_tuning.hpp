@@ -25,6 +25,11 @@ struct GpuTuning {
     std::uint64_t bufferBytes = 0;
     std::uint64_t chunkBytes = 0;
     std::uint64_t memoryBytes = 0;
+    // Runs the kernel built with its stage clocks (docs/gpu.md, "Where the kernel's time
+    // goes"): DeviceReport::stageTicks then tells the kernel's time apart by stage. Needs the
+    // device's subgroup clock (VulkanDeviceProperties::subgroupClock); frames whose arrays are
+    // reached by device address are refused with it.
+    bool stageClocks = false;
 };
 
 // How the BVH follows the frames, as Embree's users configure each case.

@@ -38,6 +38,16 @@ struct DeviceReport {
     std::uint64_t longestChainCost = 0;  // the costliest chain of work items that wait for each other
     // The parallelism the schedule offers: the work over its longest chain.
     double parallelism() const { return longestChainCost ? double(workCost) / double(longestChainCost) : 0.0; }
+
+    // With GpuTuning::stageClocks: the kernel's time by stage, in the device's subgroup clock
+    // ticks summed over the first invocation of every launch (docs/gpu.md, "Where the kernel's
+    // time goes"). "launches" holds the others; what it has beyond their sum is the rest of
+    // the kernel (the traversal's own steps, empty and finished work items). Empty without.
+    struct StageTicks {
+        std::string name;  // ray partitions, triangle partitions, leaf tests, stack and slices, waiting, launches
+        std::uint64_t ticks = 0;
+    };
+    std::vector<StageTicks> stageTicks;
 };
 
 }  // namespace dacrt

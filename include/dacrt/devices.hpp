@@ -42,6 +42,9 @@ struct VulkanDeviceProperties {
     // features, on Vulkan 1.2 or later: what the rayquery backend needs. Otherwise, what lacks.
     bool rayQuery = false;
     std::string rayQueryMissing;
+    // VK_KHR_shader_clock's shaderSubgroupClock: what the gpu kernel's stage clocks read
+    // (GpuTuning::stageClocks, --stage-clocks).
+    bool subgroupClock = false;
 };
 
 struct VulkanDevice : VulkanDeviceProperties {

@@ -171,6 +171,8 @@ INSTANTIATE_TEST_SUITE_P(
                    "--ray-groups is not an option of --backend cpu"},
         BadCommand{"GpuProfileOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu --gpu-profile discrete",
                    "--gpu-profile is not an option of --backend cpu"},
+        BadCommand{"StageClocksOnCpu", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend cpu --stage-clocks",
+                   "--stage-clocks is not an option of --backend cpu"},
         BadCommand{"UnknownGpuProfile", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --backend gpu --gpu-profile huge",
                    "--gpu-profile"},
         BadCommand{"UnknownSkip", "render " + dacrt::test::fixture("quad_u8_camera.gltf") + " --no-skip everything", "--no-skip"},

@@ -246,6 +246,60 @@ TEST(ApiGpu, ReportsItsDeviceAndTheGpuDefaultsThere) {
     }
 }
 
+// The ticks of one stage of a report, or none.
+std::optional<std::uint64_t> stageTicks(const DeviceReport& report, const std::string& stage) {
+    for (const DeviceReport::StageTicks& s : report.stageTicks)
+        if (s.name == stage) return s.ticks;
+    return std::nullopt;
+}
+
+TEST(ApiGpu, StageClocksTellTheKernelsStagesApartAndKeepCpuSeqHits) {
+    std::string why;
+    std::optional<Tracer> gpu = gpuTracer(why);
+    if (!gpu) GTEST_SKIP() << "no Vulkan device: " << why;
+    if (!gpu->deviceProperties()->subgroupClock) GTEST_SKIP() << "the device has no subgroup clock";
+    const test::SceneArrays s = test::randomSceneArrays(71, 3000);
+    const TraceScene scene = TraceScene::fromArrays(s.positions, s.indices, s.singleSided);
+    const RayBatch camera = RayBatch::fromCamera(scene, {}, 96, 64);
+    const TraceOutput plain = gpu->trace(scene, camera);
+    ASSERT_TRUE(plain.gpu);
+    EXPECT_TRUE(plain.gpu->stageTicks.empty());
+
+    const TracerOptions unclocked = gpu->options();
+    TracerOptions clocked = unclocked;
+    clocked.gpu.stageClocks = true;
+    gpu->setOptions(clocked);
+    const TraceOutput timed = gpu->trace(scene, camera);
+    EXPECT_TRUE(sameHits(timed.hits, plain.hits));
+    Tracer cpuSeq(onBackend(Backend::CpuSeq));
+    EXPECT_TRUE(sameHits(timed.hits, cpuSeq.trace(scene, camera).hits));
+    ASSERT_TRUE(timed.gpu);
+    ASSERT_EQ(timed.gpu->stageTicks.size(), 6u);
+    const std::uint64_t launches = stageTicks(*timed.gpu, "launches").value_or(0);
+    std::uint64_t stages = 0;
+    for (const char* stage : {"ray partitions", "triangle partitions", "leaf tests"}) {
+        const std::optional<std::uint64_t> ticks = stageTicks(*timed.gpu, stage);
+        ASSERT_TRUE(ticks) << stage;
+        EXPECT_GT(*ticks, 0u) << stage;  // every frame with a hit filters and tests
+        stages += *ticks;
+    }
+    stages += stageTicks(*timed.gpu, "stack and slices").value_or(0) + stageTicks(*timed.gpu, "waiting").value_or(0);
+    // A launch brackets its stages, which never overlap.
+    EXPECT_GE(launches, stages);
+    // Any-hit traces run the clocked kernel too.
+    const TraceOutput any = gpu->occluded(scene, camera);
+    ASSERT_TRUE(any.gpu);
+    EXPECT_GT(stageTicks(*any.gpu, "leaf tests").value_or(0), 0u);
+
+    // Frames whose arrays are reached by address run a kernel without clocks: refused.
+    if (gpu->deviceProperties()->bufferDeviceAddress) {
+        clocked.gpu.bufferBytes = 65536;
+        gpu->setOptions(clocked);
+        test::expectInputError([&] { gpu->trace(scene, camera); }, "--stage-clocks times the kernel that binds every array");
+    }
+    EXPECT_EQ(gpu->validationErrors(), 0u);
+}
+
 TEST(ApiGpu, MovedVerticesAreUploadedAgain) {
     std::string why;
     std::optional<Tracer> gpu = gpuTracer(why);
