@@ -36,7 +36,8 @@ constexpr std::array<BackendOption, 20> kBackendOptions{{
      [](const RequestedOptions& r) { return r.trace.dacrt.split != DacrtOptions{}.split; }},
     {"--split-cost", kCpuDacrt,
      "what makes a node a leaf: limits (--ray-limit, --tri-limit) or ray-sampling (Nabata et al. 2013: also where a "
-     "sample of its rays and triangles estimates a leaf cheaper than any split; it then splits where that estimate is lowest)",
+     "sample of its rays and triangles estimates a leaf cheaper than any split; it then splits where, and on the axis where, "
+     "that estimate is lowest)",
      "with packets, ray-sampling decides in the levels traced ray by ray", !kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.splitCost != DacrtOptions{}.splitCost; }},
     {"--intersector", kCpuDacrt, "leaf ray/triangle test", "", !kAdvanced, kDacrtOption,

@@ -198,7 +198,8 @@ float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triB
 }
 
 // The split both recursions share (node over rays, nodePackets over packets): the longest
-// axis at the split position, then the children front to back, each with its items and
+// axis at the split position (or, under SplitCost::RaySampling, the axis and position the
+// sampled estimate finds cheapest), then the children front to back, each with its items and
 // triangles filtered from the node's. With a common order (ChildOrder::NearSide) or
 // for any hit (where order changes no result) every item visits the near child, then the far
 // one; with ChildOrder::PerRay the rays moving up visit the low child, then all rays the high
@@ -212,7 +213,7 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
                                std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
                                std::uint32_t stalls, bool fewItems, bool sampleRays, FilterItems filterItems,
                                Descend descend) {
-    const int axis = longestAxis(box);
+    int axis = longestAxis(box);
     float split = splitPosition(box, axis, triBegin, triEnd);
     if (fewItems || triEnd - triBegin < options_.triLimit || depth >= options_.maxDepth ||
         stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis]))
@@ -244,13 +245,17 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     return true;
 }
 
-bool DacrtTraversal::sampledSplit(const Box& box, int axis, std::uint32_t rayBegin, std::uint32_t rayEnd,
+bool DacrtTraversal::sampledSplit(const Box& box, int& axis, std::uint32_t rayBegin, std::uint32_t rayEnd,
                                   std::uint32_t triBegin, std::uint32_t triEnd, float& split) {
-    const SampledNode sampled{rays_, hits_, rayIds_ + rayBegin, rayEnd - rayBegin,
-                              triangleBounds_, triIds_ + triBegin, triEnd - triBegin};
+    const SampledNode sampled{rays_,           hits_,           rayIds_ + rayBegin,       rayEnd - rayBegin,
+                              triangleBounds_, triIds_ + triBegin, triEnd - triBegin, options_.rayLimit,
+                              options_.triLimit};
     const SplitChoice choice = chooseSplitByRaySampling(sampled, box, axis, margin_, split);
     counters_.rayBoxTests += choice.rayBoxTests;
-    if (choice.split) split = choice.position;
+    if (choice.split) {
+        axis = choice.axis;
+        split = choice.position;
+    }
     return choice.split;
 }
 

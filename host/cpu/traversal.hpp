@@ -104,7 +104,7 @@ private:
     bool splitNode(const Box& box, const std::uint32_t& itemBegin, std::uint32_t itemEnd, std::uint32_t triBegin,
                    std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool fewItems, bool sampleRays,
                    FilterItems filterItems, Descend descend);
-    bool sampledSplit(const Box& box, int axis, std::uint32_t rayBegin, std::uint32_t rayEnd, std::uint32_t triBegin,
+    bool sampledSplit(const Box& box, int& axis, std::uint32_t rayBegin, std::uint32_t rayEnd, std::uint32_t triBegin,
                       std::uint32_t triEnd, float& split);
     void node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
