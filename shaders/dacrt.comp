@@ -265,14 +265,28 @@ uint popFarChild(ItemContext c, inout Slice s) {
     return kStepContinue;
 }
 
+// A leaf tests every one of its rays against every one of its triangles, a split only
+// partitions them. A node of a few rays over thousands of triangles (a band's rays thinning out
+// high in the tree, or a cluster of triangles in a corner of a big box that three splits in a row
+// have not separated) made a leaf cost up to 60 times a split: on the Dragon at 1920x1080 under
+// the discrete profile such leaves were the costliest work items of Step 1 (docs/gpu.md, "The
+// gpu profiles"). With kLeafOverSplit, a node whose leaf would cost more than that many splits
+// splits on while its box can (the maximum depth still bounds it): another tree, the same hits.
+bool leafCostsMoreThanSplits(uint rayCount, uint triCount) {
+    return kLeafOverSplit != 0u &&
+           leafTestCost(rayCount, triCount) > kLeafOverSplit * (partitionCost(rayCount) + partitionCost(triCount) + kStepOverhead);
+}
+
 // One step of the depth-first traversal: a leaf (or a slice of one), a split, or a pop.
 uint stepTraversal(ItemContext c, inout Slice s) {
     if (!(s.terminated < s.nodeRayEnd && s.triBegin < s.triEnd)) return popFarChild(c, s);
     uint rayCount = s.nodeRayEnd - s.terminated, triCount = s.triEnd - s.triBegin;
     int axis = longestAxis(s.lo, s.hi);
     float split = 0.5 * (s.lo[axis] + s.hi[axis]);
-    bool canSplit = s.depth < kMaxDepth && split > s.lo[axis] && split < s.hi[axis] && s.stalls < DACRT_MAX_STALLED_SPLITS;
-    bool isLeaf = rayCount < kRayLimit || triCount < kTriLimit || !canSplit || s.leafNext != 0u;
+    bool costly = leafCostsMoreThanSplits(rayCount, triCount);
+    bool canSplit = s.depth < kMaxDepth && split > s.lo[axis] && split < s.hi[axis] &&
+                    (s.stalls < DACRT_MAX_STALLED_SPLITS || costly);
+    bool isLeaf = (rayCount < kRayLimit && !costly) || triCount < kTriLimit || !canSplit || s.leafNext != 0u;
     // Under a loop budget a leaf too large for half a slice splits further instead while
     // splitting still separates something: another tree, the same hits (every tree gives
     // brute force's answer). A leaf that must stay one runs in slices.

@@ -13,6 +13,9 @@ layout(constant_id = DACRT_SPEC_LOOP_BUDGET) const uint kLoopBudget = 0;
 layout(constant_id = DACRT_SPEC_SHARED_START) const bool kSharedStart = false;
 // Shadow and occlusion rays: a ray ends at its first hit in its segment, wherever it lies.
 layout(constant_id = DACRT_SPEC_ANY_HIT) const bool kAnyHit = false;
+// Nonzero: a node whose leaf would cost more than this many splits splits on (dacrt.comp,
+// leafCostsMoreThanSplits). 0: the leaf limits and stalled splits alone decide.
+layout(constant_id = DACRT_SPEC_LEAF_OVER_SPLIT) const uint kLeafOverSplit = 0;
 
 #ifdef DACRT_ADDRESSED
 // Arrays larger than one binding may be (maxStorageBufferRange) are reached by device address,

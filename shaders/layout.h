@@ -276,7 +276,8 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_SHARED_START 5   // 1: every ray has origin rayOrigin and tmin rayTmin (DacrtPush)
 #define DACRT_SPEC_ANY_HIT 6        // 1: a ray ends at its first hit in its segment (shadow, occlusion)
 #define DACRT_SPEC_CHUNK_BYTES 7    // the addressed kernels: bytes of every chunk but an array's last
-#define DACRT_SPEC_COUNT 8
+#define DACRT_SPEC_LEAF_OVER_SPLIT 8  // 0, or how many splits' cost a leaf may reach (kLeafOverSplit)
+#define DACRT_SPEC_COUNT 9
 
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 32);

@@ -51,7 +51,7 @@ struct GpuReport {
     std::string driver;
     std::uint32_t workgroupSize = 0;
     std::uint32_t subgroupSize = 0;
-    std::uint32_t rayGroups = 0;       // work items per region and round (groupRegions)
+    std::uint32_t rayGroups = 0;       // ray groups per region asked for (groupRegions; the discrete profile shares them out by cost)
     std::vector<std::pair<std::string, double>> dispatchMs;  // GPU timestamps, per dispatch
     std::uint32_t dispatches = 0;
     std::uint32_t workItemsRun = 0;

@@ -57,6 +57,12 @@ std::uint32_t defaultRayGroups(const DeviceInfo& device, GpuProfile profile, uns
     return std::clamp((kDiscreteStep1WorkItems + regions - 1u) / regions, 1u, kMostDefaultRayGroups);
 }
 
+std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile) {
+    return takesCpuDefaults(device, profile) ? 0u : kDiscreteLeafOverSplit;
+}
+
+bool balancesRayGroups(const DeviceInfo& device, GpuProfile profile) { return !takesCpuDefaults(device, profile); }
+
 unsigned defaultGpuRegions(const DeviceInfo& device, GpuProfile profile) {
     // A CPU device runs one workgroup per thread: one region per core, as for the cpu backend,
     // measured best on lavapipe (docs/benchmarks.md: 2 regions beat 16 by 35% on the Bunny

@@ -39,6 +39,18 @@ std::uint32_t defaultWorkgroupSize(const DeviceInfo& device, GpuProfile profile,
 // Ray groups per region (see groupRegions in gpu/work_plan.hpp).
 std::uint32_t defaultRayGroups(const DeviceInfo& device, GpuProfile profile, unsigned regions);
 
+// The discrete profile's leaf rule (shaders/dacrt.comp, leafCostsMoreThanSplits): a node whose
+// leaf would cost more than this many splits splits on. Measured on the Dragon at 1920x1080
+// (docs/gpu.md, "The gpu profiles"): 8 and 16 gave the least work and the shortest chain (2,
+// 4 and 32 more); under the cpu profile the rule stays off (0), the kernel as before.
+inline constexpr std::uint32_t kDiscreteLeafOverSplit = 8;
+std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile);
+
+// Whether Step 1's ray groups are cut to equal estimated cost (gpu/ray_cost_estimate.hpp,
+// costedRayGroups) rather than to equal ray counts: the discrete profile's many groups, whose
+// costs otherwise follow what each band of the image meets.
+bool balancesRayGroups(const DeviceInfo& device, GpuProfile profile);
+
 // Regions (sub-scenes).
 unsigned defaultGpuRegions(const DeviceInfo& device, GpuProfile profile);
 

@@ -13,6 +13,7 @@
 #include "gpu/binding_set.hpp"
 #include "gpu/device_defaults.hpp"
 #include "gpu/dispatch_recorder.hpp"
+#include "gpu/ray_cost_estimate.hpp"
 #include "gpu/stage_clocks.hpp"
 #include "gpu/work_plan.hpp"
 #include "gpu/work_spread.hpp"
@@ -317,8 +318,15 @@ void GpuTracer::divide(Frame& frame) {
     frame.division = divideScene(frame.geometry, regions, axis, pool_, frame.hostPlan);
     const std::vector<TransferRound> schedule = transferSchedule(frame.division);
     const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, tuning_.profile, regions);
-    frame.ownWork = gpu::planWorkItems(frame.division, schedule, groups);
-    frame.triIdCount = std::uint64_t(frame.division.triIds.size()) * frame.work->groups;
+    // The discrete profile cuts the groups to equal estimated cost where the rays share an
+    // origin to estimate from (estimateStep1RayCosts), else to equal ray counts.
+    const std::vector<std::uint32_t> rayCosts = gpu::balancesRayGroups(device, tuning_.profile)
+                                                    ? gpu::estimateStep1RayCosts(frame.geometry, frame.division, pool_)
+                                                    : std::vector<std::uint32_t>{};
+    frame.ownWork = gpu::planWorkItems(frame.division, schedule, groups,
+                                       rayCosts.empty() ? gpu::evenRayGroups(frame.division, groups)
+                                                        : gpu::costedRayGroups(frame.division, groups, rayCosts));
+    frame.triIdCount = frame.work->triangleIds;
     frame.result.regions = regions;
     frame.result.axis = axis;
     frame.result.counters.raysCulled = frame.division.culledRays;
@@ -408,7 +416,7 @@ void GpuTracer::upload(Frame& frame) const {
     gpu::DacrtBindingSet& set = *frame.set;
     const FrameGeometry& g = frame.geometry;
     const gpu::WorkPlan& work = *frame.work;
-    const std::vector<std::uint32_t> slotTriIds = gpu::groupTriangleIds(frame.division, work.groups);
+    const std::vector<std::uint32_t> slotTriIds = gpu::groupTriangleIds(frame.division, work.grouping);
     std::vector<Hit> misses;
     misses.reserve(g.rays->size());
     for (const Ray& ray : *g.rays) misses.push_back(missHit(ray));
@@ -445,6 +453,7 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .loopBudget = gpu::loopBudgetOf(context_.info()),
         .sharedStart = sharedStart,
         .anyHit = anyHit,
+        .leafOverSplit = gpu::defaultLeafOverSplit(context_.info(), tuning_.profile),
         .addressed = frame.set->addressed(),
         .chunkBytes = frame.set->kernelChunkBytes(),
         .stageClocks = tuning_.stageClocks,
@@ -518,7 +527,7 @@ TraceResult GpuTracer::traceSecondary(GpuPassSource& source, const FrameGeometry
     if (!source.divided) divideForSecondaryRays(source, geometry, frame.result);
     frame.rays = secondarySlots(pass, source.primaryRays);
     frame.work = &source.work;
-    frame.triIdCount = std::uint64_t(source.division.triIds.size()) * source.work.groups;
+    frame.triIdCount = source.work.triangleIds;
     frame.result.regions = unsigned(source.division.regions.size());
     frame.result.axis = source.division.axis;
     frame.result.gpu->rayGroups = source.work.groups;
@@ -562,8 +571,11 @@ void GpuTracer::divideForSecondaryRays(GpuPassSource& source, const FrameGeometr
     MemoryPlan unused;
     source.division = divideScene(triangles, regions, axis, pool_, unused);
     const std::uint32_t groups = tuning_.rayGroups ? tuning_.rayGroups : gpu::defaultRayGroups(device, tuning_.profile, regions);
-    source.work = gpu::planWorkItems(source.division, transferSchedule(source.division, false), groups);
-    const std::vector<std::uint32_t> ids = gpu::groupTriangleIds(source.division, groups);
+    // The device bins the rays by slot, region k's group g in slot k * groups + g
+    // (shaders/secondary.comp): every region has the same groups.
+    source.work = gpu::planWorkItems(source.division, transferSchedule(source.division, false), groups,
+                                     gpu::evenRayGroups(source.division, groups));
+    const std::vector<std::uint32_t> ids = gpu::groupTriangleIds(source.division, source.work.grouping);
     // Beyond one binding, in the chunks that the passes then address (planPass); on a device
     // without buffer device addresses the buffer (or the pass's plan) names the limit.
     const std::uint64_t idBytes = std::max<std::uint64_t>(ids.size(), 1) * 8;

@@ -18,6 +18,7 @@ std::vector<std::uint32_t> KernelSpecialization::values() const {
     v[DACRT_SPEC_SHARED_START] = sharedStart ? 1u : 0u;
     v[DACRT_SPEC_ANY_HIT] = anyHit ? 1u : 0u;
     v[DACRT_SPEC_CHUNK_BYTES] = chunkBytes;
+    v[DACRT_SPEC_LEAF_OVER_SPLIT] = leafOverSplit;
     return v;
 }
 

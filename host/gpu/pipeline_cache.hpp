@@ -21,6 +21,7 @@ struct KernelSpecialization {
     std::uint32_t loopBudget = 0;
     bool sharedStart = false;
     bool anyHit = false;
+    std::uint32_t leafOverSplit = 0;  // kLeafOverSplit in shaders/dacrt.comp (defaultLeafOverSplit)
     // The addressed kernel (DACRT_ADDRESSED) rather than the one that binds every array, with
     // chunks of chunkBytes (0: every array one chunk): DacrtBindingSet::addressed, kernelChunkBytes.
     bool addressed = false;

@@ -11,7 +11,7 @@ struct DeviceReport {
     std::string driver;
     std::uint32_t workgroupSize = 0;
     std::uint32_t subgroupSize = 0;
-    std::uint32_t rayGroups = 0;  // work items per region and round
+    std::uint32_t rayGroups = 0;  // work items per region and round (the discrete profile: on average)
     struct Dispatch {
         std::string name;
         double gpuMs = 0.0;  // the device's timestamps

@@ -96,7 +96,8 @@ public:
     // open, under these options' GpuTuning::profile (docs/gpu.md); none where no device is open.
     struct GpuDefaults {
         unsigned regions = 0;           // sub-scenes (TraceOptions::regions 0)
-        std::uint32_t rayGroups = 0;    // work items per sub-scene and round, with that many sub-scenes
+        std::uint32_t rayGroups = 0;    // work items per sub-scene and round, with that many sub-scenes (the
+                                        // discrete profile: on average, shared out among them by estimated cost)
     };
     std::optional<GpuDefaults> gpuDefaults() const;
     // Vulkan validation errors so far (with options.validate; 0 otherwise).

@@ -195,37 +195,6 @@ TEST(GpuBlocks, PrimaryRaysShareTheirStart) {
     EXPECT_FALSE(raysShareStart(rays)) << "one tmin differs";
 }
 
-TEST(GpuBlocks, RayGroupsSplitEachRegionsRaysAndCopyItsTriangles) {
-    const Scene s = sceneFromMeshes({icosphere({-0.5f, 0.0f, 0.0f}, 0.6f, 2), box({0.2f, -0.5f, -0.5f}, {0.9f, 0.5f, 0.4f})});
-    const Frame frame(sceneFromMeshes({icosphere({-0.5f, 0.0f, 0.0f}, 0.6f, 2), box({0.2f, -0.5f, -0.5f}, {0.9f, 0.5f, 0.4f})}),
-                      defaultCamera(s, 20, 15), 20, 15);
-    ThreadPool pool(1);
-    MemoryPlan plan;
-    const Division d = divideScene(frame.geometry, 3, 0, pool, plan);
-    for (std::uint32_t groups : {1u, 2u, 7u, 500u}) {
-        const std::vector<Region> slots = gpu::groupRegions(d, groups);
-        const std::vector<std::uint32_t> triIds = gpu::groupTriangleIds(d, groups);
-        ASSERT_EQ(slots.size(), d.regions.size() * groups);
-        EXPECT_EQ(triIds.size(), d.triIds.size() * groups);
-        for (std::size_t k = 0; k < d.regions.size(); ++k) {
-            const Region& region = d.regions[k];
-            std::uint32_t next = region.rayBegin;  // the groups tile the region's rays in order
-            for (std::uint32_t j = 0; j < groups; ++j) {
-                const Region& slot = slots[k * groups + j];
-                EXPECT_EQ(slot.rayBegin, next);
-                EXPECT_EQ(slot.terminated, slot.rayBegin);
-                EXPECT_LE(slot.rayEnd - slot.rayBegin, (region.rayEnd - region.rayBegin + groups - 1) / groups);
-                next = slot.rayEnd;
-                EXPECT_EQ(slot.lo, region.lo);
-                EXPECT_EQ(slot.hi, region.hi);
-                EXPECT_TRUE(std::equal(triIds.begin() + slot.triBegin, triIds.begin() + slot.triEnd,
-                                       d.triIds.begin() + region.triBegin, d.triIds.begin() + region.triEnd));
-            }
-            EXPECT_EQ(next, region.rayEnd);
-        }
-    }
-}
-
 TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
     DACRT_REQUIRE_GPU(context);
     const std::uint32_t wg = GetParam() * context->info().subgroupSize;
