@@ -331,6 +331,13 @@ std::uint32_t computeQueueFamily(VkPhysicalDevice physical, DeviceInfo& info) {
     return queueFamily;
 }
 
+// Puts a feature structure at the head of the device's pNext chain.
+template <typename Feature>
+void link(Feature& feature, void*& chain) {
+    feature.pNext = chain;
+    chain = &feature;
+}
+
 // The logical device with one queue of `queueFamily`, and the extensions and features `info`
 // says the device has and dacrt uses.
 void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const DeviceInfo& info, VkDevice& device) {
@@ -353,8 +360,7 @@ void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const De
     control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
     if (info.fullSubgroups) {
         control.computeFullSubgroups = VK_TRUE;
-        control.pNext = chain;
-        chain = &control;
+        link(control, chain);
         enabled.push_back(VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
     }
     // Ray query where the device has it: the rayquery backend builds acceleration
@@ -368,9 +374,8 @@ void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const De
     if (info.rayQuery) {
         rayQuery.rayQuery = VK_TRUE;
         accel.accelerationStructure = VK_TRUE;
-        rayQuery.pNext = chain;
-        accel.pNext = &rayQuery;
-        chain = &accel;
+        link(rayQuery, chain);
+        link(accel, chain);
         for (const char* e : kRayQueryExtensions) enabled.push_back(e);
     }
     // The subgroup clock where the device has it: the kernel's stage clocks (--stage-clocks).
@@ -378,16 +383,14 @@ void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const De
     clock.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_CLOCK_FEATURES_KHR;
     if (info.subgroupClock) {
         clock.shaderSubgroupClock = VK_TRUE;
-        clock.pNext = chain;
-        chain = &clock;
+        link(clock, chain);
         enabled.push_back(VK_KHR_SHADER_CLOCK_EXTENSION_NAME);
     }
     // Device addresses where the device has them: the acceleration structures' inputs, and the
     // gpu kernels' arrays beyond maxStorageBufferRange.
     if (info.bufferDeviceAddress || info.rayQuery) {
         addresses.bufferDeviceAddress = VK_TRUE;
-        addresses.pNext = chain;
-        chain = &addresses;
+        link(addresses, chain);
     }
     deviceInfo.pNext = chain;
     deviceInfo.enabledExtensionCount = std::uint32_t(enabled.size());
