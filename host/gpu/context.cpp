@@ -338,6 +338,13 @@ void link(Feature& feature, void*& chain) {
     chain = &feature;
 }
 
+// A device extension with its feature structure linked.
+template <typename Feature>
+void enable(const char* extension, Feature& feature, void*& chain, std::vector<const char*>& enabled) {
+    link(feature, chain);
+    enabled.push_back(extension);
+}
+
 // The logical device with one queue of `queueFamily`, and the extensions and features `info`
 // says the device has and dacrt uses.
 void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const DeviceInfo& info, VkDevice& device) {
@@ -360,8 +367,7 @@ void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const De
     control.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_SIZE_CONTROL_FEATURES_EXT;
     if (info.fullSubgroups) {
         control.computeFullSubgroups = VK_TRUE;
-        link(control, chain);
-        enabled.push_back(VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
+        enable(VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME, control, chain, enabled);
     }
     // Ray query where the device has it: the rayquery backend builds acceleration
     // structures from device addresses and traces them from a compute shader.
@@ -383,8 +389,7 @@ void createDevice(VkPhysicalDevice physical, std::uint32_t queueFamily, const De
     clock.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_CLOCK_FEATURES_KHR;
     if (info.subgroupClock) {
         clock.shaderSubgroupClock = VK_TRUE;
-        link(clock, chain);
-        enabled.push_back(VK_KHR_SHADER_CLOCK_EXTENSION_NAME);
+        enable(VK_KHR_SHADER_CLOCK_EXTENSION_NAME, clock, chain, enabled);
     }
     // Device addresses where the device has them: the acceleration structures' inputs, and the
     // gpu kernels' arrays beyond maxStorageBufferRange.
