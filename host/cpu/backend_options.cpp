@@ -61,7 +61,7 @@ constexpr std::array<BackendOption, 20> kBackendOptions{{
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,
      [](const RequestedOptions& r) { return r.workgroupSize != 0; }},
     {"--ray-groups", kGpu, "work items per region, each a band of its rays with its own copy of the region's triangle ids",
-     "default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; 2048 / regions on a GPU",
+     "default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; the discrete profile shares 2048 in all (given: G times the regions) out among the regions by estimated cost",
      kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.rayGroups != 0; }},
     {"--gpu-profile", kGpu,
      "whose defaults the regions, ray groups and workgroup size take where not given: auto (the device's kind), cpu "
