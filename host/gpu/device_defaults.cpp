@@ -61,7 +61,9 @@ std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile)
     return takesCpuDefaults(device, profile) ? 0u : kDiscreteLeafOverSplit;
 }
 
-bool balancesRayGroups(const DeviceInfo& device, GpuProfile profile) { return !takesCpuDefaults(device, profile); }
+bool balancesRayGroups(const DeviceInfo& device, GpuProfile profile) {
+    return !takesCpuDefaults(device, profile) && loopBudgetOf(device) == 0;
+}
 
 unsigned defaultGpuRegions(const DeviceInfo& device, GpuProfile profile) {
     // A CPU device runs one workgroup per thread: one region per core, as for the cpu backend,

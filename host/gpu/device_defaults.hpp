@@ -48,7 +48,9 @@ std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile)
 
 // Whether Step 1's ray groups are cut to equal estimated cost (gpu/ray_cost_estimate.hpp,
 // costedRayGroups) rather than to equal ray counts: the discrete profile's many groups, whose
-// costs otherwise follow what each band of the image meets.
+// costs otherwise follow what each band of the image meets. Not under a loop limiter, where
+// items that take turns on a shared copy of triangle ids wait for each other slice by slice,
+// one dispatch each (docs/gpu.md, "The gpu profiles").
 bool balancesRayGroups(const DeviceInfo& device, GpuProfile profile);
 
 // Regions (sub-scenes).
