@@ -94,8 +94,7 @@ bool predecessorsFinished(ItemContext c) {
     if (c.lane == 0)
         sReady = atomicAdd(regions[c.item.rayRegion].rayItemsDone, 0u) == c.item.raySeq &&
                  atomicAdd(regions[c.item.triRegion].triItemsDone, 0u) == c.item.triSeq;
-    memoryBarrierShared();
-    barrier();
+    workgroupSync();
     if (!sReady) {
         if (c.lane == 0) atomicAdd(counters.notReady, 1u);
         return false;
@@ -304,8 +303,7 @@ void saveSlice(ItemContext c, Slice s) {
     if (!s.progressed && c.lane == 0) atomicAdd(counters.tooLarge, 1u);
     if (s.stackSlot == 0u) {
         if (c.lane == 0) sStackSlot = atomicAdd(counters.stackSlotsTaken, 1u) + 1u;
-        memoryBarrierShared();
-        barrier();
+        workgroupSync();
         s.stackSlot = sStackSlot;
     }
     workgroupSync();

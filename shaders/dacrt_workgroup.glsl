@@ -8,11 +8,17 @@
 
 // Makes buffer and shared writes of every invocation visible to the whole workgroup. A
 // workgroup of one subgroup needs only a subgroup barrier.
+// Orders every invocation of the subgroup's earlier accesses before its later ones: a subgroup
+// barrier, but where the subgroup runs in lockstep (kLockstepSubgroups), memory barriers only.
+void subgroupSync() {
+    subgroupMemoryBarrierBuffer();
+    subgroupMemoryBarrierShared();
+    if (!kLockstepSubgroups) subgroupBarrier();
+}
+
 void workgroupSync() {
     if (gl_NumSubgroups == 1) {
-        subgroupMemoryBarrierBuffer();
-        subgroupMemoryBarrierShared();
-        subgroupBarrier();
+        subgroupSync();
     } else {
         memoryBarrierBuffer();
         memoryBarrierShared();
@@ -164,7 +170,7 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         uint keptBefore = workgroupExclusiveSum(myKept, total);
         // Kept ids move down in place: every id of the chunk must be read before any of the
         // chunk's slots is written (several subgroups already met at a barrier in the sum).
-        subgroupBarrier();
+        subgroupSync();
         // Every invocation before this one had a full run of ids (runs fill in order).
         uint droppedBefore = min(lane * kIdsPerInvocation, end - base) - keptBefore;
         uint k = begin + kept + keptBefore, d = scratch + dropped + droppedBefore;

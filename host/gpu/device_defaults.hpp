@@ -46,6 +46,14 @@ std::uint32_t defaultRayGroups(const DeviceInfo& device, GpuProfile profile, uns
 inline constexpr std::uint32_t kDiscreteLeafOverSplit = 8;
 std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile);
 
+// Whether the device runs each subgroup as the lanes of one SIMD thread, so that the kernel may
+// drop its subgroup-scope execution barriers (kLockstepSubgroups): llvmpipe does (lavapipe
+// compiles a subgroup into one vector loop of its thread); a GPU's lanes may diverge.
+bool runsSubgroupsInLockstep(const DeviceInfo& device);
+// Whether the kernel drops them by default: where the device runs subgroups in lockstep and the
+// frames measured faster without them (llvmpipe from Mesa 25 on).
+bool dropsSubgroupBarriers(const DeviceInfo& device);
+
 // Whether Step 1's ray groups are cut to equal estimated cost (gpu/ray_cost_estimate.hpp,
 // costedRayGroups) rather than to equal ray counts: the discrete profile's many groups, whose
 // costs otherwise follow what each band of the image meets. Not under a loop limiter, where

@@ -4,6 +4,7 @@
 
 #include "core/errors.hpp"
 #include "gpu/context.hpp"
+#include "gpu/device_defaults.hpp"
 
 namespace dacrt {
 namespace {
@@ -50,4 +51,20 @@ TEST(DeviceChoice, NoMatchIsAnInputErrorListingTheChoices) {
 }
 
 }  // namespace
+TEST(DeviceChoice, OnlyLlvmpipeFromMesa25DropsTheKernelsSubgroupBarriers) {
+    gpu::DeviceInfo d = device(0, "llvmpipe (LLVM 19.1.7, 256 bits)", VK_PHYSICAL_DEVICE_TYPE_CPU);
+    d.driver = "llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM 19.1.7)";
+    EXPECT_TRUE(gpu::runsSubgroupsInLockstep(d));
+    EXPECT_TRUE(gpu::dropsSubgroupBarriers(d));
+    d.driver = "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)";
+    EXPECT_TRUE(gpu::runsSubgroupsInLockstep(d));
+    EXPECT_FALSE(gpu::dropsSubgroupBarriers(d)) << "measured slower on Mesa 22.3.6";
+    d = device(1, "NVIDIA H200", VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU);
+    d.driver = "NVIDIA 550.54.15";
+    EXPECT_FALSE(gpu::runsSubgroupsInLockstep(d));
+    d = device(2, "SwiftShader Device (Subzero)", VK_PHYSICAL_DEVICE_TYPE_CPU);
+    d.driver = "SwiftShader driver 5.0.0";
+    EXPECT_FALSE(gpu::runsSubgroupsInLockstep(d)) << "a CPU device is not lockstep by its type alone";
+}
+
 }  // namespace dacrt

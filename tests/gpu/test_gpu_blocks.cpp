@@ -14,7 +14,9 @@
 #include "core/procedural.hpp"
 #include "support/frames.hpp"
 #include "gpu/binding_set.hpp"
+#include "gpu/device_defaults.hpp"
 #include "gpu/dispatch_recorder.hpp"
+#include "gpu/pipeline_cache.hpp"
 #include "gpu/embedded_shaders.hpp"
 #include "gpu/work_plan.hpp"
 #include "gpu/work_spread.hpp"
@@ -89,7 +91,19 @@ WorkgroupTestPush blockPush(std::uint32_t mode, const glm::vec3& lo, const glm::
 
 // Runs workgroup_test.comp once over `in` and reads everything back into `in`; the scratch
 // halves and the loop probe follow from the inputs.
-std::uint32_t runBlock(gpu::Context& context, BlockInputs& in, WorkgroupTestPush push, std::uint32_t workgroupSize) {
+// The block's shape: its workgroup in subgroups, and whether its subgroup barriers are dropped
+// (kLockstepSubgroups: only on a device that runs subgroups in lockstep).
+struct BlockShape {
+    std::uint32_t subgroups = 1;
+    bool lockstep = false;
+};
+
+void PrintTo(const BlockShape& shape, std::ostream* os) {
+    *os << shape.subgroups << " subgroups" << (shape.lockstep ? ", lockstep" : "");
+}
+
+std::uint32_t runBlock(gpu::Context& context, BlockInputs& in, WorkgroupTestPush push, std::uint32_t workgroupSize,
+                       bool lockstep) {
     push.rayScratchHalf = std::uint32_t(in.rayIds.size());
     push.triScratchHalf = std::uint32_t(in.triIds.size());
     push.loopProbe = 2;
@@ -111,8 +125,10 @@ std::uint32_t runBlock(gpu::Context& context, BlockInputs& in, WorkgroupTestPush
     upload(DACRT_BINDING_TRI_IDS, in.triIds);
     const GpuCounters zero{};
     set[DACRT_BINDING_COUNTERS].upload(&zero, sizeof(zero));
+    const gpu::KernelSpecialization specialization{
+        .workgroupSize = workgroupSize, .rayLimit = 16, .triLimit = 16, .maxDepth = 48, .lockstepSubgroups = lockstep};
     gpu::ComputePipeline pipeline(context, gpu::workgroupTestSpirv(), DACRT_BINDING_COUNT, sizeof(WorkgroupTestPush),
-                                  {workgroupSize, 16, 16, 48}, "workgroup_test");
+                                  specialization.values(), "workgroup_test");
     set.bindTo(pipeline);
     gpu::DispatchRecorder recorder(context, 1);
     recorder.dispatch("block", pipeline, 1, &push);
@@ -128,13 +144,19 @@ std::uint32_t runBlock(gpu::Context& context, BlockInputs& in, WorkgroupTestPush
 
 // Workgroup sizes in subgroups: the kernel's workgroups are whole subgroups (GpuTracer
 // refuses others, and full subgroups are requested where the device can promise them).
-class GpuBlocks : public ::testing::TestWithParam<std::uint32_t> {};
+class GpuBlocks : public ::testing::TestWithParam<BlockShape> {};
+
+// The workgroup size of the test's shape; skips a lockstep shape on a device without lockstep subgroups.
+#define DACRT_BLOCK_WORKGROUP(context, wg)                                                              \
+    if (GetParam().lockstep && !gpu::runsSubgroupsInLockstep((context)->info()))                        \
+        GTEST_SKIP() << "the device does not run its subgroups in lockstep";                            \
+    const std::uint32_t wg = GetParam().subgroups * (context)->info().subgroupSize
 
 }  // namespace
 
 TEST_P(GpuBlocks, RayPartitionsAreStableAndExact) {
     DACRT_REQUIRE_GPU(context);
-    const std::uint32_t wg = GetParam() * context->info().subgroupSize;
+    DACRT_BLOCK_WORKGROUP(context, wg);
     Random rng(wg);
     for (const auto& [count, begin, end] : {std::tuple{1000u, 0u, 1000u}, std::tuple{777u, 13u, 700u},
                                            std::tuple{5u, 1u, 4u}, std::tuple{300u, 150u, 150u}}) {
@@ -156,7 +178,7 @@ TEST_P(GpuBlocks, RayPartitionsAreStableAndExact) {
             WorkgroupTestPush push = blockPush(0, lo, hi, begin, end);
             push.rule = rule;
             push.axis = 0;
-            const std::uint32_t result = runBlock(*context, in, push, wg);
+            const std::uint32_t result = runBlock(*context, in, push, wg, GetParam().lockstep);
             EXPECT_EQ(result, std::uint32_t(pivot - expected.begin())) << "rule " << rule << " range " << begin << ".." << end;
             EXPECT_EQ(in.rayIds, expected) << "rule " << rule << " range " << begin << ".." << end;
         }
@@ -166,7 +188,7 @@ TEST_P(GpuBlocks, RayPartitionsAreStableAndExact) {
 
 TEST_P(GpuBlocks, TrianglePartitionsAreStableAndExact) {
     DACRT_REQUIRE_GPU(context);
-    const std::uint32_t wg = GetParam() * context->info().subgroupSize;
+    DACRT_BLOCK_WORKGROUP(context, wg);
     Random rng(100 + wg);
     for (const auto& [count, begin, end] : {std::tuple{2000u, 0u, 2000u}, std::tuple{501u, 7u, 499u}, std::tuple{3u, 0u, 3u}}) {
         BlockInputs in = randomInputs(rng, 4, count);
@@ -175,7 +197,7 @@ TEST_P(GpuBlocks, TrianglePartitionsAreStableAndExact) {
         const auto pivot = std::stable_partition(expected.begin() + begin, expected.begin() + end, [&](std::uint32_t id) {
             return shared::boundsOverlap(in.bounds[id].lo, in.bounds[id].hi, lo, hi);
         });
-        const std::uint32_t result = runBlock(*context, in, blockPush(1, lo, hi, begin, end), wg);
+        const std::uint32_t result = runBlock(*context, in, blockPush(1, lo, hi, begin, end), wg, GetParam().lockstep);
         EXPECT_EQ(result, std::uint32_t(pivot - expected.begin()));
         EXPECT_EQ(in.triIds, expected);
     }
@@ -197,7 +219,7 @@ TEST(GpuBlocks, PrimaryRaysShareTheirStart) {
 
 TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
     DACRT_REQUIRE_GPU(context);
-    const std::uint32_t wg = GetParam() * context->info().subgroupSize;
+    DACRT_BLOCK_WORKGROUP(context, wg);
     Random rng(200 + wg);
     // Few rays and many triangles (lanes share a ray and reduce their bests), many rays and few
     // triangles, and both; `copies` > 0 repeats that many triangles throughout, so that equal
@@ -231,7 +253,7 @@ TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
         WorkgroupTestPush push = blockPush(2, lo, hi, begin, end);
         push.triBegin = triBegin;
         push.triEnd = triEnd;
-        const std::uint32_t result = runBlock(*context, in, push, wg);
+        const std::uint32_t result = runBlock(*context, in, push, wg, GetParam().lockstep);
         std::size_t differing = 0;
         for (std::size_t i = 0; i < in.hits.size(); ++i)
             differing += in.hits[i].prim != expectedHits[i].prim || in.hits[i].t != expectedHits[i].t ||
@@ -248,9 +270,12 @@ TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
     EXPECT_TRUE(noValidationErrors(*context));
 }
 
-INSTANTIATE_TEST_SUITE_P(WorkgroupSizes, GpuBlocks, ::testing::Values(1u, 4u, 8u),
-                         [](const ::testing::TestParamInfo<std::uint32_t>& info) {
-                             return "subgroups" + std::to_string(info.param);
+INSTANTIATE_TEST_SUITE_P(WorkgroupSizes, GpuBlocks,
+                         ::testing::Values(BlockShape{1, false}, BlockShape{4, false}, BlockShape{8, false},
+                                           BlockShape{1, true}, BlockShape{4, true}),
+                         [](const ::testing::TestParamInfo<BlockShape>& info) {
+                             return "subgroups" + std::to_string(info.param.subgroups) +
+                                    (info.param.lockstep ? "Lockstep" : "");
                          });
 
 TEST(GpuBlocks, TheLongestChainFollowsTheWorkItemsThatWaitForEachOther) {
