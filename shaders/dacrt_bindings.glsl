@@ -16,10 +16,11 @@ layout(constant_id = DACRT_SPEC_ANY_HIT) const bool kAnyHit = false;
 // Nonzero: a node whose leaf would cost more than this many splits splits on (dacrt.comp,
 // leafCostsMoreThanSplits). 0: the leaf limits and stalled splits alone decide.
 layout(constant_id = DACRT_SPEC_LEAF_OVER_SPLIT) const uint kLeafOverSplit = 0;
-// The device runs each subgroup as the lanes of one SIMD thread (llvmpipe), so its invocations
-// cannot be out of step, and a subgroup-scope execution barrier only costs time (on llvmpipe
-// it suspends the invocation's coroutine): memory barriers alone order its loads and stores.
-// false (the default): every subgroup barrier is kept, as a GPU whose lanes may diverge needs.
+// The workgroup is one subgroup, which the device runs as the lanes of one SIMD thread
+// (llvmpipe): its invocations cannot be out of step, so memory barriers alone order its loads
+// and stores, and the kernel specializes to one without any execution barrier. On llvmpipe a
+// kernel with barriers runs as a coroutine that each barrier suspends, and one without them
+// does not. false (the default): every barrier is kept, as a GPU whose lanes may diverge needs.
 layout(constant_id = DACRT_SPEC_LOCKSTEP_SUBGROUPS) const bool kLockstepSubgroups = false;
 
 #ifdef DACRT_ADDRESSED

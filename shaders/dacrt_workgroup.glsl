@@ -6,18 +6,19 @@
 
 #include "stage_clocks.glsl"
 
-// Makes buffer and shared writes of every invocation visible to the whole workgroup. A
-// workgroup of one subgroup needs only a subgroup barrier.
 // Orders every invocation of the subgroup's earlier accesses before its later ones: a subgroup
-// barrier, but where the subgroup runs in lockstep (kLockstepSubgroups), memory barriers only.
+// barrier, but where the workgroup is one subgroup run in lockstep (kLockstepSubgroups), memory
+// barriers only.
 void subgroupSync() {
     subgroupMemoryBarrierBuffer();
     subgroupMemoryBarrierShared();
     if (!kLockstepSubgroups) subgroupBarrier();
 }
 
+// Makes buffer and shared writes of every invocation visible to the whole workgroup. A
+// workgroup of one subgroup needs only a subgroup barrier (none in lockstep).
 void workgroupSync() {
-    if (gl_NumSubgroups == 1) {
+    if (kLockstepSubgroups || gl_NumSubgroups == 1) {
         subgroupSync();
     } else {
         memoryBarrierBuffer();
@@ -31,7 +32,7 @@ void workgroupSync() {
 uint workgroupExclusiveSum(uint value, out uint total) {
     uint inclusive = subgroupInclusiveAdd(value);
     uint subgroupTotal = subgroupAdd(value);  // in uniform control flow: every lane takes part
-    if (gl_NumSubgroups == 1) {
+    if (kLockstepSubgroups || gl_NumSubgroups == 1) {
         total = subgroupTotal;
         return inclusive - value;
     }

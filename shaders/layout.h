@@ -277,7 +277,7 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_ANY_HIT 6        // 1: a ray ends at its first hit in its segment (shadow, occlusion)
 #define DACRT_SPEC_CHUNK_BYTES 7    // the addressed kernels: bytes of every chunk but an array's last
 #define DACRT_SPEC_LEAF_OVER_SPLIT 8  // 0, or how many splits' cost a leaf may reach (kLeafOverSplit)
-#define DACRT_SPEC_LOCKSTEP_SUBGROUPS 9  // 1: a subgroup's invocations run as one SIMD thread (llvmpipe)
+#define DACRT_SPEC_LOCKSTEP_SUBGROUPS 9  // 1: the workgroup is one subgroup, run as one SIMD thread (llvmpipe)
 #define DACRT_SPEC_COUNT 10
 
 #ifdef __cplusplus

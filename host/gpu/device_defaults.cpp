@@ -69,10 +69,8 @@ std::uint32_t defaultRayGroups(const DeviceInfo& device, GpuProfile profile, uns
 
 bool runsSubgroupsInLockstep(const DeviceInfo& device) { return isLlvmpipe(device); }
 
-bool dropsSubgroupBarriers(const DeviceInfo& device) {
-    // Measured (docs/gpu.md, "Subgroups in lockstep"): frames 8-13% faster on Mesa 25.0.7; on
-    // Mesa 22.3.6 the Bunny's 8% faster but the Dragon's and the room's 5-9% slower.
-    return runsSubgroupsInLockstep(device) && mesaMajorOf(device) >= 25;
+bool dropsBarriers(const DeviceInfo& device, std::uint32_t workgroupSize) {
+    return runsSubgroupsInLockstep(device) && workgroupSize == device.subgroupSize;
 }
 
 std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile) {

@@ -50,9 +50,10 @@ std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile)
 // drop its subgroup-scope execution barriers (kLockstepSubgroups): llvmpipe does (lavapipe
 // compiles a subgroup into one vector loop of its thread); a GPU's lanes may diverge.
 bool runsSubgroupsInLockstep(const DeviceInfo& device);
-// Whether the kernel drops them by default: where the device runs subgroups in lockstep and the
-// frames measured faster without them (llvmpipe from Mesa 25 on).
-bool dropsSubgroupBarriers(const DeviceInfo& device);
+// Whether the kernel, in workgroups of workgroupSize invocations, specializes to one without
+// execution barriers (kLockstepSubgroups): where the workgroup is one subgroup that the device
+// runs in lockstep.
+bool dropsBarriers(const DeviceInfo& device, std::uint32_t workgroupSize);
 
 // Whether Step 1's ray groups are cut to equal estimated cost (gpu/ray_cost_estimate.hpp,
 // costedRayGroups) rather than to equal ray counts: the discrete profile's many groups, whose

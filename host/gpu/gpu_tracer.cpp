@@ -454,7 +454,7 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .sharedStart = sharedStart,
         .anyHit = anyHit,
         .leafOverSplit = gpu::defaultLeafOverSplit(context_.info(), tuning_.profile),
-        .lockstepSubgroups = gpu::dropsSubgroupBarriers(context_.info()),
+        .lockstepSubgroups = gpu::dropsBarriers(context_.info(), frame.workgroupSize),
         .addressed = frame.set->addressed(),
         .chunkBytes = frame.set->kernelChunkBytes(),
         .stageClocks = tuning_.stageClocks,

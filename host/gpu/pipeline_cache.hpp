@@ -22,7 +22,7 @@ struct KernelSpecialization {
     bool sharedStart = false;
     bool anyHit = false;
     std::uint32_t leafOverSplit = 0;  // kLeafOverSplit in shaders/dacrt.comp (defaultLeafOverSplit)
-    bool lockstepSubgroups = false;   // kLockstepSubgroups (dropsSubgroupBarriers)
+    bool lockstepSubgroups = false;   // kLockstepSubgroups (dropsBarriers)
     // The addressed kernel (DACRT_ADDRESSED) rather than the one that binds every array, with
     // chunks of chunkBytes (0: every array one chunk): DacrtBindingSet::addressed, kernelChunkBytes.
     bool addressed = false;

@@ -51,17 +51,20 @@ TEST(DeviceChoice, NoMatchIsAnInputErrorListingTheChoices) {
 }
 
 }  // namespace
-TEST(DeviceChoice, OnlyLlvmpipeFromMesa25DropsTheKernelsSubgroupBarriers) {
+TEST(DeviceChoice, OnlyAWorkgroupOfOneLlvmpipeSubgroupDropsTheKernelsBarriers) {
     gpu::DeviceInfo d = device(0, "llvmpipe (LLVM 19.1.7, 256 bits)", VK_PHYSICAL_DEVICE_TYPE_CPU);
     d.driver = "llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM 19.1.7)";
+    d.subgroupSize = 8;
     EXPECT_TRUE(gpu::runsSubgroupsInLockstep(d));
-    EXPECT_TRUE(gpu::dropsSubgroupBarriers(d));
+    EXPECT_TRUE(gpu::dropsBarriers(d, 8));
+    EXPECT_FALSE(gpu::dropsBarriers(d, 16)) << "two subgroups are two SIMD loops: they need their barriers";
     d.driver = "llvmpipe Mesa 22.3.6 (LLVM 15.0.6)";
-    EXPECT_TRUE(gpu::runsSubgroupsInLockstep(d));
-    EXPECT_FALSE(gpu::dropsSubgroupBarriers(d)) << "measured slower on Mesa 22.3.6";
+    EXPECT_TRUE(gpu::dropsBarriers(d, 8));
     d = device(1, "NVIDIA H200", VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU);
     d.driver = "NVIDIA 550.54.15";
+    d.subgroupSize = 32;
     EXPECT_FALSE(gpu::runsSubgroupsInLockstep(d));
+    EXPECT_FALSE(gpu::dropsBarriers(d, 32));
     d = device(2, "SwiftShader Device (Subzero)", VK_PHYSICAL_DEVICE_TYPE_CPU);
     d.driver = "SwiftShader driver 5.0.0";
     EXPECT_FALSE(gpu::runsSubgroupsInLockstep(d)) << "a CPU device is not lockstep by its type alone";
