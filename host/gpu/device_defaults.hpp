@@ -46,9 +46,9 @@ std::uint32_t defaultRayGroups(const DeviceInfo& device, GpuProfile profile, uns
 inline constexpr std::uint32_t kDiscreteLeafOverSplit = 8;
 std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile);
 
-// Whether the device runs each subgroup as the lanes of one SIMD thread, so that the kernel may
-// drop its subgroup-scope execution barriers (kLockstepSubgroups): llvmpipe does (lavapipe
-// compiles a subgroup into one vector loop of its thread); a GPU's lanes may diverge.
+// Whether the device runs each subgroup as the lanes of one SIMD thread, whose invocations cannot
+// be out of step: llvmpipe does (lavapipe compiles a subgroup into one vector loop of its
+// thread); a GPU's lanes may diverge.
 bool runsSubgroupsInLockstep(const DeviceInfo& device);
 // Whether the kernel, in workgroups of workgroupSize invocations, specializes to one without
 // execution barriers (kLockstepSubgroups): where the workgroup is one subgroup that the device

@@ -50,7 +50,6 @@ TEST(DeviceChoice, NoMatchIsAnInputErrorListingTheChoices) {
     EXPECT_THROW(gpu::chooseDevice({}, ""), InputError);
 }
 
-}  // namespace
 TEST(DeviceChoice, OnlyAWorkgroupOfOneLlvmpipeSubgroupDropsTheKernelsBarriers) {
     gpu::DeviceInfo d = device(0, "llvmpipe (LLVM 19.1.7, 256 bits)", VK_PHYSICAL_DEVICE_TYPE_CPU);
     d.driver = "llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM 19.1.7)";
@@ -70,4 +69,5 @@ TEST(DeviceChoice, OnlyAWorkgroupOfOneLlvmpipeSubgroupDropsTheKernelsBarriers) {
     EXPECT_FALSE(gpu::runsSubgroupsInLockstep(d)) << "a CPU device is not lockstep by its type alone";
 }
 
+}  // namespace
 }  // namespace dacrt

@@ -89,8 +89,6 @@ WorkgroupTestPush blockPush(std::uint32_t mode, const glm::vec3& lo, const glm::
     return push;
 }
 
-// Runs workgroup_test.comp once over `in` and reads everything back into `in`; the scratch
-// halves and the loop probe follow from the inputs.
 // The block's shape: its workgroup in subgroups, and whether its barriers are dropped
 // (kLockstepSubgroups: only a workgroup of one subgroup on a device that runs it in lockstep).
 struct BlockShape {
@@ -102,6 +100,8 @@ void PrintTo(const BlockShape& shape, std::ostream* os) {
     *os << shape.subgroups << " subgroups" << (shape.lockstep ? ", lockstep" : "");
 }
 
+// Runs workgroup_test.comp once over `in` and reads everything back into `in`; the scratch
+// halves and the loop probe follow from the inputs.
 std::uint32_t runBlock(gpu::Context& context, BlockInputs& in, WorkgroupTestPush push, std::uint32_t workgroupSize,
                        bool lockstep) {
     push.rayScratchHalf = std::uint32_t(in.rayIds.size());
