@@ -21,6 +21,7 @@
 #include "predicates.glsl"
 #include "dacrt_bindings.glsl"
 #include "dacrt_workgroup.glsl"
+#include "leaf_rule.glsl"
 
 layout(push_constant) uniform Push { DacrtPush push; };
 
@@ -285,7 +286,8 @@ uint stepTraversal(ItemContext c, inout Slice s) {
     bool costly = leafCostsMoreThanSplits(rayCount, triCount);
     bool canSplit = s.depth < kMaxDepth && split > s.lo[axis] && split < s.hi[axis] &&
                     (s.stalls < DACRT_MAX_STALLED_SPLITS || costly);
-    bool isLeaf = (rayCount < kRayLimit && !costly) || triCount < kTriLimit || !canSplit || s.leafNext != 0u;
+    bool isLeaf = (rayCount < kRayLimit && !costly) || triCount < kTriLimit || !canSplit || s.leafNext != 0u ||
+                  leafUnderBalance(rayCount, triCount, kLeafBalance);
     // Under a loop budget a leaf too large for half a slice splits further instead while
     // splitting still separates something: another tree, the same hits (every tree gives
     // brute force's answer). A leaf that must stay one runs in slices.

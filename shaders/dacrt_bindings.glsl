@@ -22,6 +22,9 @@ layout(constant_id = DACRT_SPEC_LEAF_OVER_SPLIT) const uint kLeafOverSplit = 0;
 // kernel with barriers runs as a coroutine that each barrier suspends, and one without them
 // does not. false (the default): every barrier is kept, as a GPU whose lanes may diverge needs.
 layout(constant_id = DACRT_SPEC_LOCKSTEP_SUBGROUPS) const bool kLockstepSubgroups = false;
+// Nonzero: a node is also a leaf where its ray/triangle tests number fewer than this many per
+// id a split would partition (leafUnderBalance, shaders/leaf_rule.glsl). 0: off.
+layout(constant_id = DACRT_SPEC_LEAF_BALANCE) const uint kLeafBalance = 0;
 
 #ifdef DACRT_ADDRESSED
 // Arrays larger than one binding may be (maxStorageBufferRange) are reached by device address,

@@ -278,7 +278,8 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_CHUNK_BYTES 7    // the addressed kernels: bytes of every chunk but an array's last
 #define DACRT_SPEC_LEAF_OVER_SPLIT 8  // 0, or how many splits' cost a leaf may reach (kLeafOverSplit)
 #define DACRT_SPEC_LOCKSTEP_SUBGROUPS 9  // 1: the workgroup is one subgroup, run as one SIMD thread (llvmpipe)
-#define DACRT_SPEC_COUNT 10
+#define DACRT_SPEC_LEAF_BALANCE 10     // 0, or the leaf balance (kLeafBalance, shaders/leaf_rule.glsl)
+#define DACRT_SPEC_COUNT 11
 
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 32);

@@ -123,11 +123,11 @@ void addRayQuery(const BenchCommand& cmd, const Tracer& tracer, std::vector<Back
 
 std::vector<BenchConfig> chooseConfigs(const BenchCommand& cmd, const std::vector<Backend>& backends,
                                        const Tracer& tracer, unsigned hardwareThreads) {
-    const Tracer::GpuDefaults gpu = tracer.gpuDefaults().value_or(Tracer::GpuDefaults{16, 1});
+    const Tracer::GpuDefaults gpu = tracer.gpuDefaults().value_or(Tracer::GpuDefaults{16, 1, 0});
     std::vector<BenchConfig> configs;
     for (Backend b : backends) {
         const std::vector<BenchConfig> more =
-            cmd.suite == BenchSuite::Sweep    ? sweepConfigs(b, hardwareThreads, gpu.regions, gpu.rayGroups)
+            cmd.suite == BenchSuite::Sweep    ? sweepConfigs(b, hardwareThreads, gpu.regions, gpu.rayGroups, gpu.leafBalance)
             : cmd.suite == BenchSuite::Peers  ? peerConfigs(b, hardwareThreads)
             : cmd.suite == BenchSuite::Skips  ? skipConfigs(b, hardwareThreads)
             : cmd.suite == BenchSuite::Passes ? passesConfigs(b, hardwareThreads)

@@ -37,6 +37,8 @@ std::string optionText(const BenchConfig& c) {
     if (d.rayGrouping != DacrtOptions{}.rayGrouping) s << " ray_grouping=" << toString(d.rayGrouping);
     if (c.backend() == Backend::Gpu)
         s << " ray_groups=" << (c.options.gpu.rayGroups ? std::to_string(c.options.gpu.rayGroups) : "auto");
+    if (c.backend() == Backend::Gpu)
+        s << " leaf_balance=" << (c.options.gpu.leafBalance ? std::to_string(*c.options.gpu.leafBalance) : "auto");
     if (c.backend() == Backend::Gpu && c.options.gpu.profile != GpuProfile::Auto)
         s << " profile=" << toString(c.options.gpu.profile);
     const SkipSwitches& k = c.options.trace.skips;
@@ -120,7 +122,7 @@ std::vector<BenchConfig> embreeSweep(const BenchConfig& base) {
 }  // namespace
 
 std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions,
-                                      std::uint32_t gpuDefaultRayGroups) {
+                                      std::uint32_t gpuDefaultRayGroups, std::uint32_t gpuDefaultLeafBalance) {
     const BenchConfig base = baseConfig(b, hardwareThreads);
     if (b == Backend::RayQuery) return rayQuerySweep(base);
     if (b == Backend::Embree) return embreeSweep(base);
@@ -157,9 +159,14 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
             if (l != defaults.triLimit)
                 variant("tri-limit=" + std::to_string(l), [l](BenchConfig& c) { c.options.trace.dacrt.triLimit = l; });
     } else {
+        // A leaf limit given turns the leaf balance's default off: these rows are the limits
+        // alone (and leaf-balance=0 the limits' default).
         for (std::uint32_t l : {8u, 16u, 32u, 64u, 128u})
             if (l != defaults.rayLimit)
                 variant("leaf-limits=" + std::to_string(l), [l](BenchConfig& c) { c.options.trace.dacrt.rayLimit = c.options.trace.dacrt.triLimit = l; });
+        for (std::uint32_t balance : {0u, 12u, kCpuProfileLeafBalance, 32u})
+            if (balance != gpuDefaultLeafBalance)
+                variant("leaf-balance=" + std::to_string(balance), [balance](BenchConfig& c) { c.options.gpu.leafBalance = balance; });
     }
     if (b == Backend::CpuSeq) return out;
     const unsigned defaultRegions = b == Backend::Cpu ? hardwareThreads : gpuDefaultRegions;
@@ -201,14 +208,14 @@ std::vector<BenchConfig> skipConfigs(Backend b, unsigned hardwareThreads) {
 }
 
 std::vector<BenchConfig> peerConfigs(Backend b, unsigned hardwareThreads) {
-    if (isPeer(b)) return sweepConfigs(b, hardwareThreads, 0, 0);
+    if (isPeer(b)) return sweepConfigs(b, hardwareThreads, 0, 0, 0);
     return {baseConfig(b, hardwareThreads)};
 }
 
 std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
     std::vector<BenchConfig> out;
     if (isPeer(b)) {
-        for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0))
+        for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0, 0))
             if (c.name == "default" || c.name == kStoredRays) out.push_back(c);
         return out;
     }
@@ -228,7 +235,7 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
 std::vector<BenchConfig> animationConfigs(Backend b, unsigned hardwareThreads) {
     std::vector<BenchConfig> out;
     if (!isPeer(b)) return {baseConfig(b, hardwareThreads)};
-    for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0)) {
+    for (const BenchConfig& c : sweepConfigs(b, hardwareThreads, 0, 0, 0)) {
         const bool staticBuild = b == Backend::Embree ? c.options.embree.build == EmbreeBuild::Static
                                                       : c.options.rayQueryBuild == RayQueryBuild::Static;
         if (c.name == "default" && !staticBuild) out.push_back(c);

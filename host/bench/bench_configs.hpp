@@ -29,7 +29,7 @@ BenchConfig baseConfig(Backend b, unsigned hardwareThreads);
 
 // sweep: the backend's default, then each option value changed one at a time.
 std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsigned gpuDefaultRegions,
-                                      std::uint32_t gpuDefaultRayGroups);
+                                      std::uint32_t gpuDefaultRayGroups, std::uint32_t gpuDefaultLeafBalance);
 
 // peers: each DACRT backend's default against every mode of the peers (embree, rayquery):
 // the quick, fair comparison, in one run.

@@ -94,7 +94,8 @@ std::vector<std::string> dacrtBackendNames() { return {"brute", "cpu-seq", "cpu"
 void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     addEnumOption(cmd, "--split", o.split, "");
     addEnumOption(cmd, "--split-cost", o.splitCost, "");
-    const std::string gpu = ", " + std::to_string(kGpuLeafLimit) + " on gpu";
+    const std::string gpu = ", " + std::to_string(kGpuLeafLimit) +
+                            " on gpu (off on a CPU device where neither limit is given: --leaf-balance decides)";
     cmd->add_option("--ray-limit", o.rayLimit)
         ->check(CLI::Range(1u, 1u << 30))
         ->default_str(std::to_string(kCpuSimdRayLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +
@@ -273,6 +274,7 @@ Subcommand addRenderCommand(CLI::App& app) {
     cmd->add_option("--ray-groups", render.tracer.gpu.rayGroups)->check(CLI::Range(1u, 64u));
     addEnumOption(cmd, "--gpu-profile", render.tracer.gpu.profile, "");
     cmd->add_flag("--stage-clocks", render.tracer.gpu.stageClocks);
+    cmd->add_option("--leaf-balance", render.tracer.gpu.leafBalance)->check(CLI::Range(0u, kMostLeafBalance));
     addFrameOptions(cmd, *s);
     describeBackendOptions(cmd);
     return {cmd, [s, cmd] {

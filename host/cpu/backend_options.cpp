@@ -21,7 +21,7 @@ constexpr bool kDacrtOption = true;
 static_assert(kPassBatchRays == 65536 && kPassBatchRaysPerTriangle == 8, "--ray-grouping's help names the batch size");
 
 // The order is the help's, and the order in which a refusal names the options.
-constexpr std::array<BackendOption, 20> kBackendOptions{{
+constexpr std::array<BackendOption, 21> kBackendOptions{{
     {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
@@ -63,6 +63,11 @@ constexpr std::array<BackendOption, 20> kBackendOptions{{
     {"--ray-groups", kGpu, "work items per region, each a band of its rays with its own copy of the region's triangle ids",
      "default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; the discrete profile shares 2048 in all (given: G times the regions) out among the regions by estimated cost",
      kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.rayGroups != 0; }},
+    {"--leaf-balance", kGpu,
+     "a node is also a leaf where its ray/triangle tests number fewer than N per id a split would partition "
+     "(rays x triangles < N x (rays + triangles)); 0: off",
+     "default: 20 on a CPU device where neither leaf limit is given (the limits then off), else 0", kAdvanced,
+     !kDacrtOption, [](const RequestedOptions& r) { return r.leafBalance.has_value(); }},
     {"--gpu-profile", kGpu,
      "whose defaults the regions, ray groups and workgroup size take where not given: auto (the device's kind), cpu "
      "(a CPU device's, as lavapipe's) or discrete (a discrete GPU's, at least 2048 work items in Step 1, on any device)",

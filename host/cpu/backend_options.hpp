@@ -5,6 +5,7 @@
 // one option and one backend (checkOptionCombinations) sit beside it.
 #include <cstdint>
 #include <initializer_list>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -39,6 +40,7 @@ struct RequestedOptions {
     bool embreePackets = true;
     GpuProfile gpuProfile = GpuProfile::Auto;
     bool stageClocks = false;
+    std::optional<std::uint32_t> leafBalance;
 };
 
 // One backend-specific option of `dacrt render`.

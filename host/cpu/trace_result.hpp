@@ -52,6 +52,9 @@ struct GpuReport {
     std::uint32_t workgroupSize = 0;
     std::uint32_t subgroupSize = 0;
     std::uint32_t rayGroups = 0;       // ray groups per region asked for (groupRegions; the discrete profile shares them out by cost)
+    std::uint32_t rayLimit = 0;        // the kernel's leaf rule (gpu::kernelLeafRule)
+    std::uint32_t triLimit = 0;
+    std::uint32_t leafBalance = 0;
     std::vector<std::pair<std::string, double>> dispatchMs;  // GPU timestamps, per dispatch
     std::uint32_t dispatches = 0;
     std::uint32_t workItemsRun = 0;

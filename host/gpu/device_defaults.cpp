@@ -77,6 +77,17 @@ std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile)
     return takesCpuDefaults(device, profile) ? 0u : kDiscreteLeafOverSplit;
 }
 
+KernelLeafRule kernelLeafRule(const DacrtOptions& given, const GpuTuning& tuning, const DeviceInfo& device) {
+    const bool limitsGiven = given.rayLimit != 0 || given.triLimit != 0;
+    KernelLeafRule rule;
+    rule.leafBalance = tuning.leafBalance.value_or(
+        takesCpuDefaults(device, tuning.profile) && !limitsGiven ? kCpuProfileLeafBalance : 0u);
+    const std::uint32_t unsetLimit = rule.leafBalance != 0 ? 1u : kGpuLeafLimit;
+    rule.rayLimit = given.rayLimit != 0 ? given.rayLimit : unsetLimit;
+    rule.triLimit = given.triLimit != 0 ? given.triLimit : unsetLimit;
+    return rule;
+}
+
 bool balancesRayGroups(const DeviceInfo& device, GpuProfile profile) {
     return !takesCpuDefaults(device, profile) && loopBudgetOf(device) == 0;
 }

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include <dacrt/backend_tuning.hpp>
+#include <dacrt/options.hpp>
 
 #include "gpu/context.hpp"
 
@@ -45,6 +46,21 @@ std::uint32_t defaultRayGroups(const DeviceInfo& device, GpuProfile profile, uns
 // 4 and 32 more); under the cpu profile the rule stays off (0), the kernel as before.
 inline constexpr std::uint32_t kDiscreteLeafOverSplit = 8;
 std::uint32_t defaultLeafOverSplit(const DeviceInfo& device, GpuProfile profile);
+
+// What makes a node a leaf in the kernel: fewer rays than rayLimit, fewer triangles than
+// triLimit, or the leaf balance (shaders/leaf_rule.glsl; 0: off).
+struct KernelLeafRule {
+    std::uint32_t rayLimit = 0;
+    std::uint32_t triLimit = 0;
+    std::uint32_t leafBalance = 0;
+};
+// The rule for these options (their leaf limits as the caller gave them, 0 where not) and
+// this tuning: the leaf balance as given, else kCpuProfileLeafBalance under the cpu profile
+// where the caller gave neither leaf limit (on lavapipe a partitioned id costs about as much
+// as a ray/triangle test or two, so the best leaves follow the product of the counts, which
+// two limits cannot express) and 0 elsewhere. Under the balance a limit not given is off (1);
+// without it, kGpuLeafLimit.
+KernelLeafRule kernelLeafRule(const DacrtOptions& given, const GpuTuning& tuning, const DeviceInfo& device);
 
 // Whether the device runs each subgroup as the lanes of one SIMD thread, whose invocations cannot
 // be out of step: llvmpipe does (lavapipe compiles a subgroup into one vector loop of its

@@ -272,6 +272,9 @@ GpuTracer::GpuTracer(gpu::Context& context, ThreadPool& pool, const TraceOptions
       resident_(resident),
       arena_(arena) {
     checkGpuOptions(options);
+    if (tuning.leafBalance && *tuning.leafBalance > kMostLeafBalance)
+        throw InputError("a leaf balance of " + std::to_string(*tuning.leafBalance) + " is over the most the kernel takes, " +
+                         std::to_string(kMostLeafBalance));
 }
 
 GpuTracer::~GpuTracer() = default;
@@ -444,21 +447,25 @@ std::uint64_t GpuTracer::stackSlots(std::uint64_t workItems) const {
 
 void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const {
     const auto start = Clock::now();
-    const DacrtOptions leafLimits = options_.dacrt.resolvedFor(Backend::Gpu);
+    const gpu::KernelLeafRule leafRule = gpu::kernelLeafRule(options_.dacrt, tuning_, context_.info());
     gpu::ComputePipeline& pipeline = pipelines_.kernel(gpu::KernelSpecialization{
         .workgroupSize = frame.workgroupSize,
-        .rayLimit = leafLimits.rayLimit,
-        .triLimit = leafLimits.triLimit,
+        .rayLimit = leafRule.rayLimit,
+        .triLimit = leafRule.triLimit,
         .maxDepth = options_.dacrt.maxDepth,
         .loopBudget = gpu::loopBudgetOf(context_.info()),
         .sharedStart = sharedStart,
         .anyHit = anyHit,
         .leafOverSplit = gpu::defaultLeafOverSplit(context_.info(), tuning_.profile),
         .lockstepSubgroups = gpu::dropsBarriers(context_.info(), frame.workgroupSize),
+        .leafBalance = leafRule.leafBalance,
         .addressed = frame.set->addressed(),
         .chunkBytes = frame.set->kernelChunkBytes(),
         .stageClocks = tuning_.stageClocks,
     });
+    frame.result.gpu->rayLimit = leafRule.rayLimit;
+    frame.result.gpu->triLimit = leafRule.triLimit;
+    frame.result.gpu->leafBalance = leafRule.leafBalance;
     // Compilation only (a first use; later frames find the pipeline in the cache), so that
     // render and bench can take it out of the frame.
     PhaseTimes::addTo(frame.result.phases.pipelineCompile, msSince(start));

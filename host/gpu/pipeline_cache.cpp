@@ -20,6 +20,7 @@ std::vector<std::uint32_t> KernelSpecialization::values() const {
     v[DACRT_SPEC_CHUNK_BYTES] = chunkBytes;
     v[DACRT_SPEC_LEAF_OVER_SPLIT] = leafOverSplit;
     v[DACRT_SPEC_LOCKSTEP_SUBGROUPS] = lockstepSubgroups ? 1u : 0u;
+    v[DACRT_SPEC_LEAF_BALANCE] = leafBalance;
     return v;
 }
 

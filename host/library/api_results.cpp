@@ -69,6 +69,7 @@ DeviceReport deviceReportOf(const GpuReport& g) {
     for (std::size_t k = 0; k < g.stageTicks.size(); ++k) stageTicks.push_back({gpu::stageName(k), g.stageTicks[k]});
     return DeviceReport{.device = g.device, .driver = g.driver, .workgroupSize = g.workgroupSize,
                         .subgroupSize = g.subgroupSize, .rayGroups = g.rayGroups,
+                        .rayLimit = g.rayLimit, .triLimit = g.triLimit, .leafBalance = g.leafBalance,
                         .dispatchTimes = std::move(dispatchTimes), .dispatches = g.dispatches,
                         .workItemsRun = g.workItemsRun, .workItemsEmpty = g.workItemsEmpty, .workItemSlices = g.slices,
                         .raysFinished = g.raysFinished, .validationErrors = g.validationErrors,

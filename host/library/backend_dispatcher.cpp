@@ -37,7 +37,7 @@ bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryH
 
 void checkBackendRequest(const BackendRequest& r) {
     checkRequestedOptions({r.trace, r.gpuTuning.workgroupSize, r.gpuTuning.rayGroups, r.embree.robust, r.embree.packets,
-                           r.gpuTuning.profile, r.gpuTuning.stageClocks});
+                           r.gpuTuning.profile, r.gpuTuning.stageClocks, r.gpuTuning.leafBalance});
 }
 
 void checkDeviceChoice(const DeviceChoice& devices, const std::vector<Backend>& backends) {

@@ -186,7 +186,8 @@ std::optional<Tracer::GpuDefaults> Tracer::gpuDefaults() const {
     if (!gpu) return std::nullopt;
     const GpuProfile profile = impl_->options.gpu.profile;
     const unsigned regions = gpu::defaultGpuRegions(gpu->info(), profile);
-    return GpuDefaults{regions, gpu::defaultRayGroups(gpu->info(), profile, regions)};
+    return GpuDefaults{regions, gpu::defaultRayGroups(gpu->info(), profile, regions),
+                       gpu::kernelLeafRule(DacrtOptions{}, GpuTuning{.profile = profile}, gpu->info()).leafBalance};
 }
 
 std::uint32_t Tracer::validationErrors() const { return impl_->dispatcher.validationErrors(); }

@@ -70,6 +70,7 @@ nlohmann::ordered_json gpuJson(const DeviceReport& g) {
             {"workgroup_size", g.workgroupSize},
             {"subgroup_size", g.subgroupSize},
             {"ray_groups", g.rayGroups},
+            {"leaf_rule", {{"ray_limit", g.rayLimit}, {"tri_limit", g.triLimit}, {"leaf_balance", g.leafBalance}}},
             {"dispatches", g.dispatches},
             {"dispatch_times", dispatches},
             {"work_items_run", g.workItemsRun},
@@ -136,7 +137,13 @@ nlohmann::ordered_json optionsJson(const RenderOptions& o) {
         return {{"robust", o.tracer.embree.robust}, {"build", toString(o.tracer.embree.build)},
                 {"packets", o.tracer.embree.packets ? "4x4 rtcIntersect16" : "rtcIntersect1"}};
     const DacrtOptions dacrt = trace.dacrt.resolvedFor(trace.backend);
-    return {{"ray_limit", dacrt.rayLimit}, {"tri_limit", dacrt.triLimit},
+    // The gpu's leaf rule depends on its device (gpu.leaf_rule reports the one it ran): a limit
+    // not given is null here.
+    auto limit = [&](std::uint32_t given, std::uint32_t resolved) -> nlohmann::ordered_json {
+        if (trace.backend != Backend::Gpu) return resolved;
+        return given ? nlohmann::ordered_json(given) : nlohmann::ordered_json(nullptr);
+    };
+    return {{"ray_limit", limit(trace.dacrt.rayLimit, dacrt.rayLimit)}, {"tri_limit", limit(trace.dacrt.triLimit, dacrt.triLimit)},
             {"max_depth", trace.dacrt.maxDepth}, {"split", toString(trace.dacrt.split)},
             {"split_cost", toString(trace.dacrt.splitCost)},
             {"axis", toString(trace.axis)}, {"intersector", toString(trace.dacrt.intersector)},

@@ -3,6 +3,7 @@
 // build and the ray queries' build. Plain data, shared by the public API and the backends
 // themselves.
 #include <cstdint>
+#include <optional>
 
 namespace dacrt {
 
@@ -13,10 +14,21 @@ namespace dacrt {
 // run, with the same hits. The driver's loop limit (llvmpipe) applies under every profile.
 enum class GpuProfile { Auto, Cpu, Discrete };
 
+// The cpu profile's leaf balance (GpuTuning::leafBalance), measured on lavapipe (docs/gpu.md,
+// "The leaf balance": 16 to 24 gave the fastest frames on the Bunny, the Dragon and the room).
+constexpr std::uint32_t kCpuProfileLeafBalance = 20;
+// The largest leaf balance the kernel takes (its square must fit 32 bits; far beyond any use).
+constexpr std::uint32_t kMostLeafBalance = 4096;
+
 struct GpuTuning {
     std::uint32_t workgroupSize = 0;  // 0: the profile's default (gpu::defaultWorkgroupSize)
     std::uint32_t rayGroups = 0;      // 0: the profile's default (gpu::defaultRayGroups)
     GpuProfile profile = GpuProfile::Auto;
+    // The leaf balance (docs/gpu.md, "The leaf balance"): a node is also a leaf where its
+    // ray/triangle tests number fewer than this many per id a split would partition; 0: off.
+    // None: the profile's default, on under the cpu profile where neither leaf limit is given
+    // (the leaf limits are then off: the balance alone decides), off under the discrete one.
+    std::optional<std::uint32_t> leafBalance;
     // Caps below the device's own limits, for tests (docs/gpu.md): every array larger than
     // bufferBytes is reached by device address, as arrays beyond maxStorageBufferRange are, in
     // chunks of at most chunkBytes (rounded down to a multiple of 192 bytes; else of

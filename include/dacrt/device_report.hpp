@@ -12,6 +12,11 @@ struct DeviceReport {
     std::uint32_t workgroupSize = 0;
     std::uint32_t subgroupSize = 0;
     std::uint32_t rayGroups = 0;  // work items per region and round (the discrete profile: on average)
+    // The kernel's leaf rule (GpuTuning::leafBalance): a node is a leaf with fewer rays than
+    // rayLimit, fewer triangles than triLimit, or its tests under the leaf balance (0: off).
+    std::uint32_t rayLimit = 0;
+    std::uint32_t triLimit = 0;
+    std::uint32_t leafBalance = 0;
     struct Dispatch {
         std::string name;
         double gpuMs = 0.0;  // the device's timestamps

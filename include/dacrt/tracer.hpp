@@ -98,6 +98,7 @@ public:
         unsigned regions = 0;           // sub-scenes (TraceOptions::regions 0)
         std::uint32_t rayGroups = 0;    // work items per sub-scene and round, with that many sub-scenes (the
                                         // discrete profile: on average, shared out among them by estimated cost)
+        std::uint32_t leafBalance = 0;  // GpuTuning::leafBalance where no leaf limit is given (0: off)
     };
     std::optional<GpuDefaults> gpuDefaults() const;
     // Vulkan validation errors so far (with options.validate; 0 otherwise).

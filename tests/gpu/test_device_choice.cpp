@@ -5,6 +5,7 @@
 #include "core/errors.hpp"
 #include "gpu/context.hpp"
 #include "gpu/device_defaults.hpp"
+#include "gpu/leaf_rule.hpp"
 
 namespace dacrt {
 namespace {
@@ -67,6 +68,43 @@ TEST(DeviceChoice, OnlyAWorkgroupOfOneLlvmpipeSubgroupDropsTheKernelsBarriers) {
     d = device(2, "SwiftShader Device (Subzero)", VK_PHYSICAL_DEVICE_TYPE_CPU);
     d.driver = "SwiftShader driver 5.0.0";
     EXPECT_FALSE(gpu::runsSubgroupsInLockstep(d)) << "a CPU device is not lockstep by its type alone";
+}
+
+// The kernel's leaf balance, as the kernel computes it in 32 bits, against the inequality it
+// stands for in 64: rays x triangles < balance x (rays + triangles).
+TEST(LeafRule, TheBalanceIsItsInequalityWithoutOverflow) {
+    auto inequality = [](std::uint64_t rays, std::uint64_t tris, std::uint64_t balance) {
+        return rays * tris < balance * (rays + tris);
+    };
+    const std::vector<std::uint32_t> counts = {1, 2, 3, 19, 20, 21, 39, 40, 41, 63, 64, 400, 420, 421,
+                                               4095, 4096, 4097, 65536, 1u << 20, 871414, 1u << 30, 0xFFFFFFFFu};
+    for (std::uint32_t balance : {0u, 1u, 2u, 16u, kCpuProfileLeafBalance, 64u, kMostLeafBalance})
+        for (std::uint32_t rays : counts)
+            for (std::uint32_t tris : counts)
+                EXPECT_EQ(gpu::shared::leafUnderBalance(rays, tris, balance), inequality(rays, tris, balance))
+                    << rays << " rays, " << tris << " triangles, balance " << balance;
+    for (std::uint32_t rays = 1; rays <= 200; ++rays)  // every pair around the boundary of 20
+        for (std::uint32_t tris = 1; tris <= 200; ++tris)
+            ASSERT_EQ(gpu::shared::leafUnderBalance(rays, tris, 20), inequality(rays, tris, 20)) << rays << " x " << tris;
+}
+
+TEST(LeafRule, TheCpuProfileBalancesWhereNoLimitIsGiven) {
+    gpu::DeviceInfo cpu = device(0, "llvmpipe (LLVM 19.1.7, 256 bits)", VK_PHYSICAL_DEVICE_TYPE_CPU);
+    gpu::DeviceInfo discrete = device(1, "NVIDIA H200", VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU);
+    auto rule = [](const gpu::DeviceInfo& d, DacrtOptions o, GpuTuning t) {
+        const gpu::KernelLeafRule r = gpu::kernelLeafRule(o, t, d);
+        return std::tuple(r.rayLimit, r.triLimit, r.leafBalance);
+    };
+    using Rule = std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>;
+    EXPECT_EQ(rule(cpu, {}, {}), Rule(1, 1, kCpuProfileLeafBalance)) << "the balance alone decides";
+    EXPECT_EQ(rule(discrete, {}, {}), Rule(kGpuLeafLimit, kGpuLeafLimit, 0));
+    EXPECT_EQ(rule(cpu, {}, {.profile = GpuProfile::Discrete}), Rule(kGpuLeafLimit, kGpuLeafLimit, 0));
+    EXPECT_EQ(rule(discrete, {}, {.profile = GpuProfile::Cpu}), Rule(1, 1, kCpuProfileLeafBalance));
+    EXPECT_EQ(rule(cpu, {.rayLimit = 8}, {}), Rule(8, kGpuLeafLimit, 0)) << "a limit given: the limits as before";
+    EXPECT_EQ(rule(cpu, {.triLimit = 4}, {}), Rule(kGpuLeafLimit, 4, 0));
+    EXPECT_EQ(rule(cpu, {}, {.leafBalance = 0}), Rule(kGpuLeafLimit, kGpuLeafLimit, 0)) << "the balance turned off";
+    EXPECT_EQ(rule(discrete, {}, {.leafBalance = 12}), Rule(1, 1, 12));
+    EXPECT_EQ(rule(cpu, {.rayLimit = 8}, {.leafBalance = 30}), Rule(8, 1, 30)) << "both given: both apply";
 }
 
 }  // namespace

@@ -191,6 +191,29 @@ TEST(GpuImages, RayGroupsGiveTheSameHits) {
     EXPECT_GT(expectGpuMatchesCpu(*context, inside, {4}, GpuTuning{.rayGroups = 64}), 0u) << "expected transfer rounds";
 }
 
+TEST(GpuImages, EveryLeafBalanceGivesTheSameHits) {
+    // The balance decides every leaf where no limit is given (off: the limits alone): from
+    // nodes split down to single rays or triangles (1) to whole regions as leaves (4096), with
+    // transfer rounds; the kernel reports the rule it ran.
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
+    const Frame inside = insideView({box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)},
+                                    {0.1, 0.0, 0.2}, {0.3, 0.0, -1.0}, 40, 30);
+    for (std::uint32_t balance : {0u, 1u, 2u, 7u, kCpuProfileLeafBalance, 64u, kMostLeafBalance}) {
+        SCOPED_TRACE("leaf balance " + std::to_string(balance));
+        const GpuTuning tuning{.leafBalance = balance};
+        expectGpuMatchesCpu(*context, frame, {1, 3}, tuning);
+        EXPECT_GT(expectGpuMatchesCpu(*context, inside, {4}, tuning), 0u) << "expected transfer rounds";
+        ThreadPool pool(2);
+        const TraceResult r = GpuTracer(*context, pool, gpuOptions(2), tuning).trace(frame.geometry);
+        EXPECT_EQ(r.gpu->leafBalance, balance);
+        EXPECT_EQ(r.gpu->rayLimit, balance ? 1u : kGpuLeafLimit);
+    }
+    ThreadPool pool(2);
+    EXPECT_THROW(GpuTracer(*context, pool, gpuOptions(2), GpuTuning{.leafBalance = kMostLeafBalance + 1}), InputError);
+}
+
 TEST(GpuImages, CameraInsideTheSceneAndOnSplitPlanes) {
     DACRT_REQUIRE_GPU(context);
     // The eye is inside, and on the x = 0 and y = 0 planes.
