@@ -103,7 +103,9 @@ std::vector<Backend> chooseBackends(const BenchCommand& cmd) {
 // alone (the device options then choose nothing, as before the Tracer).
 Tracer openTracer(const BenchCommand& cmd, const std::vector<Backend>& backends) {
     TracerOptions o;
-    const auto vulkan = std::find_if(backends.begin(), backends.end(), runsOnVulkan);
+    // gpu where it is listed, so that gpuDefaults answers under the bench's profile.
+    auto vulkan = std::find(backends.begin(), backends.end(), Backend::Gpu);
+    if (vulkan == backends.end()) vulkan = std::find_if(backends.begin(), backends.end(), runsOnVulkan);
     if (vulkan == backends.end()) return Tracer(o);
     o.trace.backend = *vulkan;
     o.device = cmd.device;

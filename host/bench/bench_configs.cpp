@@ -28,9 +28,15 @@ std::string optionText(const BenchConfig& c) {
         return s.str();
     }
     const DacrtOptions d = c.options.trace.dacrt.resolvedFor(c.backend());
+    // The gpu's leaf rule depends on its device (gpu::kernelLeafRule): limits as given, else auto.
+    const bool gpu = c.backend() == Backend::Gpu;
+    auto limit = [&](std::uint32_t given, std::uint32_t resolved) {
+        return !gpu ? std::to_string(resolved) : given ? std::to_string(given) : std::string("auto");
+    };
     s << "intersector=" << toString(d.intersector) << " triangle_filter=" << toString(d.triangleFilter)
-      << " precision=" << toString(d.precision) << " split=" << toString(d.split) << " ray_limit=" << d.rayLimit
-      << " tri_limit=" << d.triLimit << " axis=" << toString(c.options.trace.axis) << " regions=" << c.options.trace.regions
+      << " precision=" << toString(d.precision) << " split=" << toString(d.split)
+      << " ray_limit=" << limit(c.options.trace.dacrt.rayLimit, d.rayLimit)
+      << " tri_limit=" << limit(c.options.trace.dacrt.triLimit, d.triLimit) << " axis=" << toString(c.options.trace.axis) << " regions=" << c.options.trace.regions
       << " threads=" << c.threads();
     if (d.splitCost != SplitCost::Limits) s << " split_cost=" << toString(d.splitCost);
     if (!d.packets) s << " packets=off";

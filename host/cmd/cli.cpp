@@ -95,7 +95,7 @@ void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     addEnumOption(cmd, "--split", o.split, "");
     addEnumOption(cmd, "--split-cost", o.splitCost, "");
     const std::string gpu = ", " + std::to_string(kGpuLeafLimit) +
-                            " on gpu (off on a CPU device where neither limit is given: --leaf-balance decides)";
+                            " on gpu (off where the leaf balance decides: under the cpu profile if neither limit is given, or with --leaf-balance N)";
     cmd->add_option("--ray-limit", o.rayLimit)
         ->check(CLI::Range(1u, 1u << 30))
         ->default_str(std::to_string(kCpuSimdRayLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +

@@ -66,10 +66,11 @@ constexpr std::array<BackendOption, 21> kBackendOptions{{
     {"--leaf-balance", kGpu,
      "a node is also a leaf where its ray/triangle tests number fewer than N per id a split would partition "
      "(rays x triangles < N x (rays + triangles)); 0: off",
-     "default: 20 on a CPU device where neither leaf limit is given (the limits then off), else 0", kAdvanced,
+     "default: 20 under the cpu profile where neither leaf limit is given (a limit not given is then off), else 0",
+     kAdvanced,
      !kDacrtOption, [](const RequestedOptions& r) { return r.leafBalance.has_value(); }},
     {"--gpu-profile", kGpu,
-     "whose defaults the regions, ray groups and workgroup size take where not given: auto (the device's kind), cpu "
+     "whose defaults the regions, ray groups, workgroup size and leaf rule take where not given: auto (the device's kind), cpu "
      "(a CPU device's, as lavapipe's) or discrete (a discrete GPU's, at least 2048 work items in Step 1, on any device)",
      "default: auto", kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.gpuProfile != GpuProfile::Auto; }},
     {"--stage-clocks", kGpu,

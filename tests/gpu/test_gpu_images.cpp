@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
@@ -200,6 +201,7 @@ TEST(GpuImages, EveryLeafBalanceGivesTheSameHits) {
     const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
     const Frame inside = insideView({box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)},
                                     {0.1, 0.0, 0.2}, {0.3, 0.0, -1.0}, 40, 30);
+    std::map<std::uint32_t, std::uint64_t> tests;  // ray/triangle tests by balance
     for (std::uint32_t balance : {0u, 1u, 2u, 7u, kCpuProfileLeafBalance, 64u, kMostLeafBalance}) {
         SCOPED_TRACE("leaf balance " + std::to_string(balance));
         const GpuTuning tuning{.leafBalance = balance};
@@ -209,7 +211,12 @@ TEST(GpuImages, EveryLeafBalanceGivesTheSameHits) {
         const TraceResult r = GpuTracer(*context, pool, gpuOptions(2), tuning).trace(frame.geometry);
         EXPECT_EQ(r.gpu->leafBalance, balance);
         EXPECT_EQ(r.gpu->rayLimit, balance ? 1u : kGpuLeafLimit);
+        tests[balance] = r.counters.rayTriangleTests;
     }
+    // The kernel applies it: a larger balance makes larger leaves, so more tests (the same hits).
+    EXPECT_LT(tests[1], tests[7]);
+    EXPECT_LT(tests[7], tests[kCpuProfileLeafBalance]);
+    EXPECT_LT(tests[kCpuProfileLeafBalance], tests[kMostLeafBalance]);
     ThreadPool pool(2);
     EXPECT_THROW(GpuTracer(*context, pool, gpuOptions(2), GpuTuning{.leafBalance = kMostLeafBalance + 1}), InputError);
 }
