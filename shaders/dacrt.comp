@@ -60,6 +60,11 @@ struct Slice {
     uint costBefore;   // loop iterations the earlier slices of the work item used
     uint stackSlot;    // TraversalState::stackSlot
     bool progressed;   // this slice did some work (else the work item cannot fit a slice)
+    // With packets: whether the node is one of packets, [terminated, nodeRayEnd) then being its
+    // packet ids; below a flush (rays), the stack size at the flush, under which packets wait.
+    bool packetLevel;
+    uint flushBase;
+    StackEntry next;   // the node a step chose to enter (kStepEnterChild), with its parent's ranges
 };
 
 // What every stage of one work item reads.
@@ -72,11 +77,41 @@ struct ItemContext {
     vec3 rootHi;
     vec3 margin;
     uint retireCost;   // the final partition and the probe, reserved in every slice
+    // Packets (kPacketFlush): whether this work item's rays travel in them, its packet ids
+    // [packetBegin, packetEnd) in the ray id buffer, where a flush gathers its rays, and the
+    // ray slot's `terminated` when the work item started.
+    bool packets;
+    uint packetBegin;
+    uint packetEnd;
+    uint flushAt;
+    uint itemTerminated;
 };
 
 const uint kStepContinue = 0u;
 const uint kStepOutOfBudget = 1u;
 const uint kStepTreeDone = 2u;
+const uint kStepEnterChild = 3u;  // Slice::next becomes the node (enterChild)
+
+// A stack entry's rayRule holds, above its rule, the face of the parent's box that the child
+// moved (axis * 2, + 1 for the high child's lower face), for its one-face triangle filter;
+// kNoFace: the node's own box, whose triangles are the range as it is.
+const uint kFaceShift = 8u;
+const uint kRuleMask = (1u << kFaceShift) - 1u;
+const uint kNoFace = 7u;
+
+StackEntry nodeEntry(vec3 lo, vec3 hi, uint rayEnd, uint rule, uint face, uint triBegin, uint triEnd, uint depth,
+                     uint stalls) {
+    StackEntry e;
+    e.lo = lo;
+    e.hi = hi;
+    e.rayEnd = rayEnd;
+    e.triBegin = triBegin;
+    e.triEnd = triEnd;
+    e.depth = depth;
+    e.stalls = stalls;
+    e.rayRule = rule | (face << kFaceShift);
+    return e;
+}
 
 void loadFrameParameters() {
     gMargin = push.margin;
@@ -86,6 +121,10 @@ void loadFrameParameters() {
     gOrder = push.order;
     gRayScratchHalf = push.rayScratchHalf;
     gTriScratchHalf = push.triScratchHalf;
+    gPacketRaysAt = push.packetRaysAt;
+    gDoneFlagsAt = push.doneFlagsAt;
+    gPacketIdsAt = push.packetIdsAt;
+    gPacketCount = push.packetCount;
     loadArrayBases();
 }
 
@@ -124,14 +163,11 @@ bool startAtRoot(ItemContext c, inout Slice s) {
         if (c.lane == 0) atomicAdd(counters.tooLarge, 1u);
         return false;
     }
-    s.nodeRayEnd = partitionRays(s.terminated, c.rayEnd, kKeepCrossing, c.rootLo - c.margin, c.rootHi + c.margin);
-    s.lo = c.rootLo;
-    s.hi = c.rootHi;
-    s.triBegin = regions[c.item.triRegion].triBegin;
-    s.triEnd = regions[c.item.triRegion].triEnd;
-    s.depth = 0;
+    s.flushBase = 0;
+    if (c.packets) s.terminated = c.packetBegin;
+    s.next = nodeEntry(c.rootLo, c.rootHi, c.packets ? c.packetEnd : c.rayEnd, c.packets ? kKeepPacketCrossing : kKeepCrossing,
+                       kNoFace, regions[c.item.triRegion].triBegin, regions[c.item.triRegion].triEnd, 0u, 0u);
     s.stackSize = 0;
-    s.stalls = 0;
     s.leafNext = 0;
     s.progressed = true;
     return true;
@@ -152,6 +188,8 @@ void resumeSaved(ItemContext c, TraversalState state, inout Slice s) {
     s.progressed = false;
     s.costBefore = state.cost;
     s.stackSlot = state.stackSlot;
+    s.packetLevel = false;  // a work item with packets never saves (no loop budget)
+    s.flushBase = 0u;
     uint from = (s.stackSlot - 1u) * kStackCapacity;  // a saved work item has its slot
     for (uint i = c.lane; i < s.stackSize; i += kWorkgroupSize) sStack[i] = stacks[from + i];
     s.spent = s.stackSize / kWorkgroupSize + 1u;
@@ -188,17 +226,9 @@ uint runLeaf(ItemContext c, inout Slice s, uint rayCount, uint triCount) {
 // this node's ranges, which it filters again later. Rays classified per split (kOrderPerRay,
 // closest hits) visit the low child if they move up, then all of them the high child, then
 // the low child if they move down: two children wait, the high one on top.
-void pushChild(uint slot, vec3 lo, vec3 hi, Slice s, uint rayRule) {
-    StackEntry e;
-    e.lo = lo;
-    e.hi = hi;
-    e.rayEnd = s.nodeRayEnd;
-    e.triBegin = s.triBegin;
-    e.triEnd = s.triEnd;
-    e.depth = s.depth + 1u;
-    e.stalls = s.stalls;
-    e.rayRule = rayRule;
-    sStack[slot] = e;
+StackEntry childEntry(vec3 lo, vec3 hi, Slice s, uint rayRule, int axis, bool highChild) {
+    return nodeEntry(lo, hi, s.nodeRayEnd, rayRule, uint(axis) * 2u + (highChild ? 1u : 0u), s.triBegin, s.triEnd,
+                     s.depth + 1u, s.stalls);
 }
 
 uint splitNode(ItemContext c, inout Slice s, int axis, float split, uint rayCount, uint triCount) {
@@ -209,38 +239,47 @@ uint splitNode(ItemContext c, inout Slice s, int axis, float split, uint rayCoun
     vec3 lowHi = s.hi, highLo = s.lo;
     lowHi[axis] = split;
     highLo[axis] = split;
-    bool perRay = gOrder == kOrderPerRay;
+    bool perRay = gOrder == kOrderPerRay;  // never with packets (the host's choice)
     bool classified = perRay && !kAnyHit;
     bool lowFirst = perRay || gRayOrigin[axis] <= split;
     vec3 nearLo = lowFirst ? s.lo : highLo, nearHi = lowFirst ? lowHi : s.hi;
+    uint crossing = s.packetLevel ? kKeepPacketCrossing : kKeepCrossing;
     if (c.lane == 0) {
         if (classified) {
-            pushChild(s.stackSize, s.lo, lowHi, s, crossingMovingRule(axis, true));
-            pushChild(s.stackSize + 1u, highLo, s.hi, s, kKeepCrossing);
+            sStack[s.stackSize] = childEntry(s.lo, lowHi, s, crossingMovingRule(axis, true), axis, false);
+            sStack[s.stackSize + 1u] = childEntry(highLo, s.hi, s, kKeepCrossing, axis, true);
         } else {
-            pushChild(s.stackSize, lowFirst ? highLo : s.lo, lowFirst ? s.hi : lowHi, s, kKeepCrossing);
+            sStack[s.stackSize] = childEntry(lowFirst ? highLo : s.lo, lowFirst ? s.hi : lowHi, s, crossing, axis, lowFirst);
         }
     }
     s.stackSize += classified ? 2u : 1u;
-    // A rule known only at run time makes every branch of keepRay run under a mask on llvmpipe:
-    // the common rule gets a call of its own, where it is a constant.
-    uint childRayEnd = classified ? partitionRays(s.terminated, s.nodeRayEnd, crossingMovingRule(axis, false),
-                                                  nearLo - c.margin, nearHi + c.margin)
-                                  : partitionRays(s.terminated, s.nodeRayEnd, kKeepCrossing, nearLo - c.margin, nearHi + c.margin);
-    uint childTriEnd = s.triEnd;
-    if (childRayEnd > s.terminated)
-        childTriEnd = partitionTriangles(s.triBegin, s.triEnd, nearLo - c.margin, nearHi + c.margin);
-    s.stalls = childRayEnd == s.nodeRayEnd && childTriEnd == s.triEnd ? s.stalls + 1u : 0u;
-    s.triEnd = childTriEnd;
-    s.lo = nearLo;
-    s.hi = nearHi;
-    s.nodeRayEnd = childRayEnd;
-    ++s.depth;
-    return kStepContinue;
+    s.next = childEntry(nearLo, nearHi, s, classified ? crossingMovingRule(axis, false) : crossing, axis, !lowFirst);
+    return kStepEnterChild;
+}
+
+// A packet node goes on ray by ray: the unfinished rays of its packets are gathered, filtered
+// against it and traced from it as rays; the packets below wait on the stack until the rays'
+// subtree is done (endFlush).
+uint flushPackets(ItemContext c, inout Slice s) {
+    uint gathered = gatherPacketRays(s.terminated, s.nodeRayEnd, c.flushAt);
+    s.flushBase = s.stackSize;
+    s.terminated = c.flushAt;
+    s.next = nodeEntry(s.lo, s.hi, gathered, kKeepCrossing, kNoFace, s.triBegin, s.triEnd, s.depth, s.stalls);
+    return kStepEnterChild;
+}
+
+// A flush's subtree is done: the rays it finished are flagged, so that no later flush gathers
+// them, and the packets take over again.
+void endFlush(ItemContext c, inout Slice s) {
+    markRaysDone(c.flushAt, s.terminated);
+    s.packetLevel = true;
+    s.terminated = c.packetBegin;
+    s.nodeRayEnd = c.packetBegin;
 }
 
 // The far child on top of the stack becomes the node, its rays and triangles filtered again.
 uint popFarChild(ItemContext c, inout Slice s) {
+    if (c.packets && !s.packetLevel && s.stackSize == s.flushBase) endFlush(c, s);
     if (s.stackSize == 0) return kStepTreeDone;
     uint start = stageClock();
     workgroupSync();
@@ -252,17 +291,33 @@ uint popFarChild(ItemContext c, inout Slice s) {
     --s.stackSize;
     workgroupSync();  // the slot may be written again before everyone has read it
     addStageTicks(DACRT_STAGE_STACK_AND_SLICES, start);
-    s.lo = far.lo;
-    s.hi = far.hi;
-    s.nodeRayEnd = far.rayRule == kKeepCrossing  // as in splitNode: the common rule as a constant
-                       ? partitionRays(s.terminated, far.rayEnd, kKeepCrossing, s.lo - c.margin, s.hi + c.margin)
-                       : partitionRays(s.terminated, far.rayEnd, far.rayRule, s.lo - c.margin, s.hi + c.margin);
-    s.triBegin = far.triBegin;
-    s.triEnd = s.nodeRayEnd > s.terminated ? partitionTriangles(far.triBegin, far.triEnd, s.lo - c.margin, s.hi + c.margin)
-                                           : far.triBegin;
-    s.depth = far.depth;
-    s.stalls = s.nodeRayEnd == far.rayEnd && s.triEnd == far.triEnd ? far.stalls + 1u : 0u;
-    return kStepContinue;
+    s.next = far;
+    return kStepEnterChild;
+}
+
+// The node the step chose (a split's near child, the far child popped, the root, a flush's
+// rays) becomes the current one: its rays (or packets) and triangles filtered from its
+// parent's. The traversal's one call of the filters, so that the kernel inlines each once
+// (llvmpipe's compile time grows with every copy). A rule known only at run time makes every
+// branch of keepRay run under a mask on llvmpipe: the common rules get calls of their own,
+// where they are constants.
+void enterChild(ItemContext c, inout Slice s) {
+    StackEntry e = s.next;
+    uint rule = e.rayRule & kRuleMask, face = e.rayRule >> kFaceShift;
+    vec3 lo = e.lo - c.margin, hi = e.hi + c.margin;
+    s.lo = e.lo;
+    s.hi = e.hi;
+    s.packetLevel = rule == kKeepPacketCrossing;
+    s.nodeRayEnd = rule == kKeepCrossing        ? partitionRays(s.terminated, e.rayEnd, kKeepCrossing, lo, hi)
+                   : rule == kKeepPacketCrossing ? partitionPackets(s.terminated, e.rayEnd, lo, hi)
+                                                 : partitionRays(s.terminated, e.rayEnd, rule, lo, hi);
+    s.triBegin = e.triBegin;
+    bool ownBox = face == kNoFace;
+    s.triEnd = ownBox ? e.triEnd
+             : s.nodeRayEnd > s.terminated ? partitionTrianglesAtFace(e.triBegin, e.triEnd, lo, hi, int(face >> 1u), (face & 1u) != 0u)
+                                           : e.triBegin;
+    s.depth = e.depth;
+    s.stalls = ownBox ? e.stalls : (s.nodeRayEnd == e.rayEnd && s.triEnd == e.triEnd ? e.stalls + 1u : 0u);
 }
 
 // A leaf tests every one of its rays against every one of its triangles, a split only
@@ -277,12 +332,27 @@ bool leafCostsMoreThanSplits(uint rayCount, uint triCount) {
            leafTestCost(rayCount, triCount) > kLeafOverSplit * (partitionCost(rayCount) + partitionCost(triCount) + kStepOverhead);
 }
 
+// The most rays a packet holds (8x8 pixels), for the leaf balance's bound on a packet node's rays.
+const uint kPacketRays = 64u;
+
+// A packet node splits as a ray node does, or goes on ray by ray where it has fewer than
+// kPacketFlush packets, or where its rays would be a leaf at once, however many they are.
+uint stepPacketNode(ItemContext c, inout Slice s, int axis, float split) {
+    uint packetCount = s.nodeRayEnd - s.terminated, triCount = s.triEnd - s.triBegin;
+    bool canSplit = s.depth < kMaxDepth && split > s.lo[axis] && split < s.hi[axis] &&
+                    s.stalls < DACRT_MAX_STALLED_SPLITS;
+    bool flush = packetCount < kPacketFlush || triCount < kTriLimit || !canSplit ||
+                 leafUnderBalance(min(packetCount, 0xFFFFFFFFu / kPacketRays) * kPacketRays, triCount, kLeafBalance);
+    return flush ? flushPackets(c, s) : splitNode(c, s, axis, split, packetCount, triCount);
+}
+
 // One step of the depth-first traversal: a leaf (or a slice of one), a split, or a pop.
 uint stepTraversal(ItemContext c, inout Slice s) {
     if (!(s.terminated < s.nodeRayEnd && s.triBegin < s.triEnd)) return popFarChild(c, s);
     uint rayCount = s.nodeRayEnd - s.terminated, triCount = s.triEnd - s.triBegin;
     int axis = longestAxis(s.lo, s.hi);
     float split = 0.5 * (s.lo[axis] + s.hi[axis]);
+    if (s.packetLevel) return stepPacketNode(c, s, axis, split);
     bool costly = leafCostsMoreThanSplits(rayCount, triCount);
     bool canSplit = s.depth < kMaxDepth && split > s.lo[axis] && split < s.hi[axis] &&
                     (s.stalls < DACRT_MAX_STALLED_SPLITS || costly);
@@ -336,9 +406,13 @@ void saveSlice(ItemContext c, Slice s) {
 // The tree is done: rays no later work item can change are finished here (see RetireRule on
 // the CPU side), and the work item is marked finished.
 void retireRays(ItemContext c, Slice s) {
+    // With packets the slot's ray ids are as the work item found them: the rays its flushes
+    // finished go first, as the traversal of rays would have left them.
+    if (c.packets) s.terminated = partitionRays(c.itemTerminated, c.rayEnd, kKeepDone, c.rootLo, c.rootHi);
     uint rule = c.item.retire == 0u ? kKeepStill : (c.item.retire == 1u ? kKeepStuckHigh : kKeepStuckLow);
     uint before = s.terminated;
     uint terminated = partitionRays(s.terminated, c.rayEnd, rule, c.rootLo - c.margin, c.rootHi + c.margin);
+    if (c.packets) markRaysDone(before, terminated);  // no later flush gathers them
     bool cutShort = loopLimiterFired(push.loopProbe);
     if (c.lane == 0) {
         atomicAdd(counters.raysRetired, terminated - before);
@@ -370,6 +444,11 @@ void runWorkItem(inout ItemContext c) {
     c.rootHi = regions[c.item.triRegion].hi;
     c.margin = vec3(gMargin);
     c.retireCost = partitionCost(c.rayEnd - s.terminated) + 4u;
+    c.packets = kPacketFlush != 0u && c.item.packetBegin < c.item.packetEnd;
+    c.packetBegin = gPacketIdsAt + c.item.packetBegin;
+    c.packetEnd = gPacketIdsAt + c.item.packetEnd;
+    c.flushAt = gRayScratchHalf / 2u + regions[c.item.rayRegion].rayBegin;  // packets: the scratch half is at 2n
+    c.itemTerminated = s.terminated;
 
     // Nothing to trace (no live ray, or, in a transfer, none moving towards the triangles'
     // region): finish at once.
@@ -382,14 +461,18 @@ void runWorkItem(inout ItemContext c) {
         }
         return;
     }
+    uint outcome = kStepContinue;
     if (state.phase == kPhaseNew) {
         if (!startAtRoot(c, s)) return;
+        outcome = kStepEnterChild;
     } else {
         resumeSaved(c, state, s);
     }
 
-    uint outcome = kStepContinue;
-    while (outcome == kStepContinue) outcome = stepTraversal(c, s);
+    while (outcome == kStepContinue || outcome == kStepEnterChild) {
+        if (outcome == kStepEnterChild) enterChild(c, s);
+        outcome = stepTraversal(c, s);
+    }
     if (outcome == kStepOutOfBudget)
         saveSlice(c, s);
     else

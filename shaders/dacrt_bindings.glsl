@@ -25,6 +25,9 @@ layout(constant_id = DACRT_SPEC_LOCKSTEP_SUBGROUPS) const bool kLockstepSubgroup
 // Nonzero: a node is also a leaf where its ray/triangle tests number fewer than this many per
 // id a split would partition (leafUnderBalance, shaders/leaf_rule.glsl). 0: off.
 layout(constant_id = DACRT_SPEC_LEAF_BALANCE) const uint kLeafBalance = 0;
+// Nonzero: primary rays travel the top of the tree as packets of 8x8 pixels (shaders/
+// ray_packets.glsl), and a node with fewer than this many packets goes on ray by ray. 0: off.
+layout(constant_id = DACRT_SPEC_PACKET_FLUSH) const uint kPacketFlush = 0;
 
 #ifdef DACRT_ADDRESSED
 // Arrays larger than one binding may be (maxStorageBufferRange) are reached by device address,
@@ -97,6 +100,7 @@ layout(std430, binding = DACRT_BINDING_WORK_ITEMS) readonly buffer WorkItemBuffe
 layout(std430, binding = DACRT_BINDING_COUNTERS) coherent buffer CounterBuffer { GpuCounters counters; };
 layout(std430, binding = DACRT_BINDING_STATES) coherent buffer StateBuffer { TraversalState states[]; };
 layout(std430, binding = DACRT_BINDING_STACKS) coherent buffer StackBuffer { StackEntry stacks[]; };
+layout(std430, binding = DACRT_BINDING_PACKETS) readonly buffer PacketBuffer { PacketBounds packets[]; };
 
 // Frame parameters, set from push constants at the start of main.
 float gMargin;
@@ -106,6 +110,10 @@ uint gAxis;
 uint gOrder;         // kOrder*
 uint gRayScratchHalf;
 uint gTriScratchHalf;
+uint gPacketRaysAt;  // DacrtPush's packet sections of the ray id buffer
+uint gDoneFlagsAt;
+uint gPacketIdsAt;
+uint gPacketCount;
 
 const uint kWorkgroupSize = gl_WorkGroupSize.x;
 

@@ -5,6 +5,7 @@
 #define DACRT_WORKGROUP_GLSL
 
 #include "stage_clocks.glsl"
+#include "ray_packets.glsl"
 
 // Orders every invocation of the subgroup's earlier accesses before its later ones: a subgroup
 // barrier, but where the workgroup is one subgroup run in lockstep (kLockstepSubgroups), memory
@@ -67,6 +68,10 @@ const uint kKeepStuckLow = 4u;     // rays moving down gAxis that cannot reach t
 // Rays that may cross the cell and move up (or not at all) along axis a: kKeepCrossingUp + 2a;
 // those moving down: kKeepCrossingUp + 2a + 1 (the children of a kOrderPerRay split).
 const uint kKeepCrossingUp = 6u;
+// Rules 12 and up: not rays' crossing. Packets that may cross the (widened) cell (their ids are
+// packet ids), and rays that have their final hit (rayDone).
+const uint kKeepPacketCrossing = 12u;
+const uint kKeepDone = 13u;
 
 uint crossingMovingRule(int axis, bool down) {
     return kKeepCrossingUp + 2u * uint(axis) + (down ? 1u : 0u);
@@ -93,7 +98,7 @@ bool keepRay(uint id, uint rule, vec3 lo, vec3 hi) {
     float bestT = HITS(id).t;
     if (rule == kKeepCrossing) return rayMayCrossCell(ray, lo, hi, bestT);
     if (rule == kKeepFinished) return HITS(id).prim != kMissPrim && (kAnyHit || hitEndsInBox(ray, lo, hi, bestT));
-    if (rule >= kKeepCrossingUp) {
+    if (rule >= kKeepCrossingUp && rule < kKeepPacketCrossing) {
         uint axis = (rule - kKeepCrossingUp) >> 1u;
         bool down = ((rule - kKeepCrossingUp) & 1u) == 1u;
         return (ray.invDir[axis] < 0.0) == down && rayMayCrossCell(ray, lo, hi, bestT);  // invDir has dir's sign
@@ -140,19 +145,30 @@ uint leafRaysWithin(uint rayCount, uint triCount, uint available) {
 }
 
 const uint kKeepOverlapping = 5u;  // triangles whose bounds overlap the (widened) cell
+// Triangles of a node that overlap its child, which differs from the node's box in one face
+// only (along `axis`): the low child's upper face, or the high child's lower face. The node's
+// triangles overlap the node's cell on every other face already, so one comparison of
+// boundsOverlap's six gives its answer (the cpu backend's one-face filter).
+const uint kKeepBelowFace = 14u;  // bounds.lo[axis] <= hi[axis]
+const uint kKeepAboveFace = 15u;  // bounds.hi[axis] >= lo[axis]
 
-bool keepId(uint id, uint rule, vec3 lo, vec3 hi) {
+bool keepId(uint id, uint rule, vec3 lo, vec3 hi, int axis) {
     if (rule == kKeepOverlapping) return boundsOverlap(TRIANGLE_BOUNDS(id).lo, TRIANGLE_BOUNDS(id).hi, lo, hi);
+    if (rule == kKeepBelowFace) return TRIANGLE_BOUNDS(id).lo[axis] <= hi[axis];
+    if (rule == kKeepAboveFace) return TRIANGLE_BOUNDS(id).hi[axis] >= lo[axis];
+    if (rule == kKeepPacketCrossing) return packetMayCrossCell(packets[id], lo, hi);
+    if (rule == kKeepDone) return rayDone(id);
     return keepRay(id, rule, lo, hi);
 }
 
-// Stable partition of rayIds[begin, end) (or triIds, for kKeepOverlapping): the ids `rule`
-// keeps first, in their order, then the others in theirs. Kept ids move down in place (never
+// Stable partition of rayIds[begin, end) (or triIds, for kKeepOverlapping; the packet ids in the
+// ray id buffer, for kKeepPacketCrossing): the ids `rule` keeps first, in their order, then the
+// others in theirs. Kept ids move down in place (never
 // onto an unread id); dropped ids wait in the buffer's scratch half and are copied back
 // behind them. Returns the end of the kept ids.
-uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
-    bool triangleIds = rule == kKeepOverlapping;
-    uint scratch = (triangleIds ? gTriScratchHalf : gRayScratchHalf) + begin;
+uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi, int axis) {
+    bool triangleIds = rule == kKeepOverlapping || rule == kKeepBelowFace || rule == kKeepAboveFace;
+    uint scratch = (triangleIds ? gTriScratchHalf : (rule == kKeepPacketCrossing ? gPacketCount : gRayScratchHalf)) + begin;
     uint kept = 0, dropped = 0;
     uint lane = gl_LocalInvocationIndex;
     for (uint base = begin; base < end; base += kPartitionChunk) {
@@ -164,7 +180,7 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
             uint index = first + e;
             bool inRange = index < end;
             ids[e] = inRange ? (triangleIds ? TRI_IDS(index) : RAY_IDS(index)) : 0u;
-            keeps[e] = inRange && keepId(ids[e], rule, lo, hi);
+            keeps[e] = inRange && keepId(ids[e], rule, lo, hi, axis);
             myKept += keeps[e] ? 1u : 0u;
         }
         uint total;
@@ -195,20 +211,85 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
         }
     }
     workgroupSync();
-    if ((rule == kKeepCrossing || rule >= kKeepCrossingUp) && lane == 0) atomicAdd(counters.rayBoxTests, end - begin);
+    if ((rule == kKeepCrossing || (rule >= kKeepCrossingUp && rule < kKeepPacketCrossing)) && lane == 0)
+        atomicAdd(counters.rayBoxTests, end - begin);
+    if (rule == kKeepPacketCrossing && lane == 0) atomicAdd(counters.packetBoxTests, end - begin);
     return keptEnd;
 }
 
 uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
     uint start = stageClock();
-    uint kept = partitionIds(begin, end, rule, lo, hi);
+    uint kept = partitionIds(begin, end, rule, lo, hi, 0);
     addStageTicks(DACRT_STAGE_RAY_PARTITIONS, start);
     return kept;
 }
 
+// The packet ids [begin, end) that may cross the cell first (a packet level's ray partition).
+uint partitionPackets(uint begin, uint end, vec3 lo, vec3 hi) {
+    uint start = stageClock();
+    uint kept = partitionIds(begin, end, kKeepPacketCrossing, lo, hi, 0);
+    addStageTicks(DACRT_STAGE_RAY_PARTITIONS, start);
+    return kept;
+}
+
+// The rays of the packets whose ids are at [begin, end) that have no final hit yet, copied to
+// the ray ids from `to` in packet order; returns the end of the copies. A flush's gathering
+// counts with the ray partitions, whose work it does.
+uint gatherPacketRays(uint begin, uint end, uint to) {
+    uint start = stageClock();
+    uint lane = gl_LocalInvocationIndex;
+    uint count = 0;
+    for (uint p = begin; p < end; ++p) {
+        PacketBounds packet = packets[RAY_IDS(p)];
+        for (uint base = packet.rayBegin; base < packet.rayEnd; base += kPartitionChunk) {
+            uint first = base + lane * kIdsPerInvocation;
+            uint ids[kIdsPerInvocation];
+            bool live[kIdsPerInvocation];
+            uint mine = 0;
+            [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
+                bool inRange = first + e < packet.rayEnd;
+                ids[e] = inRange ? RAY_IDS(gPacketRaysAt + first + e) : 0u;
+                live[e] = inRange && !rayDone(ids[e]);
+                mine += live[e] ? 1u : 0u;
+            }
+            uint total;
+            uint slot = to + count + workgroupExclusiveSum(mine, total);
+            [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
+                if (!live[e]) continue;
+                RAY_IDS(slot) = ids[e];  // RAY_IDS reads its index twice: no increment inside
+                ++slot;
+            }
+            count += total;
+        }
+    }
+    workgroupSync();
+    addStageTicks(DACRT_STAGE_RAY_PARTITIONS, start);
+    return to + count;
+}
+
+// Flags the rays whose ids are at [begin, end) as having their final hit.
+void markRaysDone(uint begin, uint end) {
+    for (uint k = begin + gl_LocalInvocationIndex; k < end; k += kWorkgroupSize) {
+        uint id = RAY_IDS(k);
+        RAY_IDS(gDoneFlagsAt + id) = 1u;
+    }
+    workgroupSync();
+}
+
 uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
     uint start = stageClock();
-    uint kept = partitionIds(begin, end, kKeepOverlapping, lo, hi);
+    uint kept = partitionIds(begin, end, kKeepOverlapping, lo, hi, 0);
+    addStageTicks(DACRT_STAGE_TRIANGLE_PARTITIONS, start);
+    return kept;
+}
+
+// The node's triangles [begin, end) that overlap its child (the widened cell lo, hi), which
+// moved one face of the node's box along `axis`: the upper face (the low child) or the lower
+// one (the high child).
+uint partitionTrianglesAtFace(uint begin, uint end, vec3 lo, vec3 hi, int axis, bool highChild) {
+    uint start = stageClock();
+    uint kept = highChild ? partitionIds(begin, end, kKeepAboveFace, lo, hi, axis)
+                          : partitionIds(begin, end, kKeepBelowFace, lo, hi, axis);
     addStageTicks(DACRT_STAGE_TRIANGLE_PARTITIONS, start);
     return kept;
 }

@@ -82,6 +82,23 @@ struct WorkItem {
     uint retire;
     uint raySeq;
     uint triSeq;
+    uint packetBegin;  // its ray slot's packets [packetBegin, packetEnd) (DACRT_SPEC_PACKET_FLUSH), else empty
+    uint packetEnd;
+    uint pad2;
+};
+
+// A ray packet of the kernel (DACRT_SPEC_PACKET_FLUSH): the rays of one 8x8 pixel tile of one
+// ray slot, at [rayBegin, rayEnd) of the ray id buffer's packet rays (DacrtPush::packetRaysAt),
+// with the smallest and largest invDir of its rays per axis. Rays that share their start
+// compute (lo - origin) * invDir with the same first factor and rounding is monotone, so the
+// four corner products bound every ray's rounded slab values (the cpu backend's RayPacket). An
+// axis where some ray's invDir is 0 (the filter's branch) or not finite is left unbounded.
+struct PacketBounds {
+    vec3 invLo;
+    uint rayBegin;
+    vec3 invHi;
+    uint rayEnd;
+    uint unboundedAxes;  // bit per axis
     uint pad0;
     uint pad1;
     uint pad2;
@@ -131,6 +148,13 @@ struct DacrtPush {
     float rayTmin;         // every ray's tmin, where DACRT_SPEC_SHARED_START says they share it
     uint order;            // kOrder*
     uint stackSlots;       // traversal stacks the stack buffer holds (taken in turn by work items that save one)
+    // With packets (DACRT_SPEC_PACKET_FLUSH), the ray id buffer holds after the ray ids (n):
+    // the rays gathered from packets [n, 2n), the scratch half [2n, 4n) (rayScratchHalf 2n),
+    // then these sections; all 0 without packets.
+    uint packetRaysAt;     // each slot's ray ids by tile, at the slot's own positions
+    uint doneFlagsAt;      // one flag per ray id: nonzero once the ray has its final hit
+    uint packetIdsAt;      // packet ids, then as many again of scratch
+    uint packetCount;      // packet ids (the scratch is that far behind them)
 };
 
 // A light as a secondary pass traces it (from Scene::lights or --light), in float32.
@@ -202,6 +226,7 @@ struct GpuCounters {
     uint terminatedStep1;  // rays finished by Step 1 work items (hit or retired), as the cpu backend counts them
     uint stackSlotsTaken;  // work items that saved a stack (more than DacrtPush::stackSlots: the frame fails)
     uint raysCulled;       // secondary.comp: rays made that miss the division's widened box (no region)
+    uint packetBoxTests;   // packets tested against a cell (each stands for its rays)
     // The kernel's stage clocks (the DACRT_STAGE_CLOCKS build, --stage-clocks): clock ticks
     // each stage took over the frame's work items, as 64-bit sums of (low, high) words.
     uint stageTicks[2 * DACRT_STAGE_COUNT];
@@ -244,7 +269,8 @@ struct WorkgroupTestPush {
 // array, the index of its first chunk (uint firstChunk[DACRT_ADDRESSED_ARRAYS]), then every
 // chunk's address (uvec2: low, high word) from byte DACRT_CHUNK_TABLE_ADDRESSES.
 #define DACRT_BINDING_ADDRESSES 13
-#define DACRT_BINDING_COUNT 14
+#define DACRT_BINDING_PACKETS 14       // PacketBounds of the frame's packets (DACRT_SPEC_PACKET_FLUSH)
+#define DACRT_BINDING_COUNT 15
 
 // The addressed arrays, by their index in the chunk table.
 #define DACRT_ARRAY_RAYS 0u
@@ -279,7 +305,8 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_LEAF_OVER_SPLIT 8  // 0, or how many splits' cost a leaf may reach (kLeafOverSplit)
 #define DACRT_SPEC_LOCKSTEP_SUBGROUPS 9  // 1: the workgroup is one subgroup, run as one SIMD thread (llvmpipe)
 #define DACRT_SPEC_LEAF_BALANCE 10     // 0, or the leaf balance (kLeafBalance, shaders/leaf_rule.glsl)
-#define DACRT_SPEC_COUNT 11
+#define DACRT_SPEC_PACKET_FLUSH 11     // 0, or packets: a node with fewer goes on ray by ray (kPacketFlush)
+#define DACRT_SPEC_COUNT 12
 
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 32);
@@ -291,7 +318,13 @@ static_assert(offsetof(TraversalState, cost) == 56 && offsetof(TraversalState, s
 static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalState, stackSize) == 44);
 static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depth) == 36);
 static_assert(offsetof(StackEntry, stalls) == 40 && offsetof(StackEntry, rayRule) == 44);
-static_assert(sizeof(DacrtPush) == 48 && offsetof(DacrtPush, loopProbe) == 32);
+static_assert(sizeof(DacrtPush) == 64 && offsetof(DacrtPush, loopProbe) == 32);
+static_assert(offsetof(DacrtPush, packetRaysAt) == 48 && offsetof(DacrtPush, doneFlagsAt) == 52);
+static_assert(offsetof(DacrtPush, packetIdsAt) == 56 && offsetof(DacrtPush, packetCount) == 60);
+static_assert(offsetof(WorkItem, packetBegin) == 20 && offsetof(WorkItem, packetEnd) == 24);
+static_assert(sizeof(PacketBounds) == 48 && offsetof(PacketBounds, rayBegin) == 12);
+static_assert(offsetof(PacketBounds, invHi) == 16 && offsetof(PacketBounds, rayEnd) == 28);
+static_assert(offsetof(PacketBounds, unboundedAxes) == 32);
 static_assert(offsetof(DacrtPush, rayTmin) == 36 && offsetof(DacrtPush, order) == 40);
 static_assert(offsetof(DacrtPush, stackSlots) == 44);
 static_assert(sizeof(ShadowLight) == 48 && offsetof(ShadowLight, type) == 12);
@@ -308,8 +341,8 @@ static_assert(offsetof(DacrtPush, firstWorkItem) == 16 && offsetof(DacrtPush, ax
 static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, triScratchHalf) == 28);
 static_assert(offsetof(GpuCounters, raysRetired) == 20);
 static_assert(offsetof(GpuCounters, terminatedStep1) == 48 && offsetof(GpuCounters, stackSlotsTaken) == 52);
-static_assert(offsetof(GpuCounters, raysCulled) == 56 && offsetof(GpuCounters, stageTicks) == 60);
-static_assert(sizeof(GpuCounters) == 60 + 8 * DACRT_STAGE_COUNT);
+static_assert(offsetof(GpuCounters, raysCulled) == 56 && offsetof(GpuCounters, packetBoxTests) == 60);
+static_assert(offsetof(GpuCounters, stageTicks) == 64 && sizeof(GpuCounters) == 64 + 8 * DACRT_STAGE_COUNT);
 static_assert(offsetof(GpuCounters, itemsFinished) == 32 && offsetof(GpuCounters, tooLarge) == 44);
 static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, loopLimitHits) == 28);
 static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);

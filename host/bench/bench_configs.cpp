@@ -40,6 +40,7 @@ std::string optionText(const BenchConfig& c) {
       << " threads=" << c.threads();
     if (d.splitCost != SplitCost::Limits) s << " split_cost=" << toString(d.splitCost);
     if (!d.packets) s << " packets=off";
+    if (d.packets && d.packetFlush != kPacketFlushDefault) s << " packet_flush=" << d.packetFlush;
     if (d.rayGrouping != DacrtOptions{}.rayGrouping) s << " ray_grouping=" << toString(d.rayGrouping);
     if (c.backend() == Backend::Gpu)
         s << " ray_groups=" << (c.options.gpu.rayGroups ? std::to_string(c.options.gpu.rayGroups) : "auto");
@@ -153,11 +154,11 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
         });
     }
     const DacrtOptions defaults = base.options.trace.dacrt.resolvedFor(b);
+    variant("packets=off", [](BenchConfig& c) { c.options.trace.dacrt.packets = false; });
+    for (std::uint32_t f : {4u, 64u, 256u})
+        if (f != defaults.packetFlush)
+            variant("packet-flush=" + std::to_string(f), [f](BenchConfig& c) { c.options.trace.dacrt.packetFlush = f; });
     if (cpu) {
-        variant("packets=off", [](BenchConfig& c) { c.options.trace.dacrt.packets = false; });
-        for (std::uint32_t f : {4u, 64u, 256u})
-            if (f != defaults.packetFlush)
-                variant("packet-flush=" + std::to_string(f), [f](BenchConfig& c) { c.options.trace.dacrt.packetFlush = f; });
         for (std::uint32_t l : {4u, 8u, 16u, 32u, 64u})
             if (l != defaults.rayLimit)
                 variant("ray-limit=" + std::to_string(l), [l](BenchConfig& c) { c.options.trace.dacrt.rayLimit = l; });

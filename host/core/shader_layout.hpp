@@ -20,6 +20,7 @@ using shared::ShadowLight;
 using shared::GpuCounters;
 using shared::WorkgroupTestPush;
 using shared::WorkItem;
+using shared::PacketBounds;
 using shared::Hit;
 using shared::Ray;
 using shared::StackEntry;

@@ -55,6 +55,8 @@ struct GpuReport {
     std::uint32_t rayLimit = 0;        // the kernel's leaf rule (gpu::kernelLeafRule)
     std::uint32_t triLimit = 0;
     std::uint32_t leafBalance = 0;
+    std::uint32_t packets = 0;       // ray packets the kernel traced (0: rays alone; kernelUsesPackets)
+    std::uint32_t packetFlush = 0;   // ... and the packet count below which a node went on ray by ray
     std::vector<std::pair<std::string, double>> dispatchMs;  // GPU timestamps, per dispatch
     std::uint32_t dispatches = 0;
     std::uint32_t workItemsRun = 0;

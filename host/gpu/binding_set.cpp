@@ -1,4 +1,5 @@
 #include "gpu/binding_set.hpp"
+#include "gpu/ray_packets.hpp"
 
 #include <algorithm>
 #include <string>
@@ -70,7 +71,9 @@ DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& c) {
     p[DACRT_BINDING_TRIANGLES] = {"triangles", c.triangles * sizeof(Triangle)};
     p[DACRT_BINDING_TRIANGLE_BOUNDS] = {"triangle bounds", c.triangles * sizeof(Bounds)};
     p[DACRT_BINDING_HITS] = {"hits", c.rays * sizeof(Hit)};
-    p[DACRT_BINDING_RAY_IDS] = {"ray ids and scratch", c.rayIds * 8};
+    p[DACRT_BINDING_RAY_IDS] = c.packets ? PlannedBuffer{"ray ids, scratch and packet sections",
+                                                         packetSections(c.rayIds, c.rays, c.packets).end * 4}
+                                         : PlannedBuffer{"ray ids and scratch", c.rayIds * 8};
     p[DACRT_BINDING_TRI_IDS] = {"triangle ids and scratch", c.triangleIds * 8};
     p[DACRT_BINDING_REGIONS] = {"regions", c.regions * sizeof(Region)};
     p[DACRT_BINDING_WORK_ITEMS] = {"work items", c.workItems * sizeof(WorkItem)};
@@ -80,6 +83,7 @@ DacrtBufferPlan planDacrtBuffers(const DacrtBufferCounts& c) {
     p[DACRT_BINDING_SOURCE_RAYS] = {"primary rays (secondary passes)", std::max<std::uint64_t>(c.sourceRays, 1) * sizeof(Ray)};
     p[DACRT_BINDING_SOURCE_HITS] = {"primary hits (secondary passes)", std::max<std::uint64_t>(c.sourceRays, 1) * sizeof(Hit)};
     p[DACRT_BINDING_ADDRESSES] = {"chunk table (addressed arrays)", chunkTableBytes(DACRT_ADDRESSED_ARRAYS)};
+    p[DACRT_BINDING_PACKETS] = {"ray packets", std::max<std::uint64_t>(c.packets, 1) * sizeof(PacketBounds)};
     return p;
 }
 

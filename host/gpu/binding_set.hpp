@@ -31,6 +31,7 @@ struct DacrtBufferCounts {
     // (stackSlotsFor); 0: one per work item.
     std::uint64_t stackSlots = 0;
     std::uint64_t sourceRays = 0;    // secondary passes: the primary rays they start from (0: a primary pass)
+    std::uint64_t packets = 0;       // ray packets (gpu/ray_packets.hpp); the ray ids then have their sections
 };
 
 // The traversal stacks a frame keeps: none is saved without a loop budget (one slot, bound and

@@ -14,6 +14,7 @@
 #include "gpu/device_defaults.hpp"
 #include "gpu/dispatch_recorder.hpp"
 #include "gpu/ray_cost_estimate.hpp"
+#include "gpu/ray_packets.hpp"
 #include "gpu/stage_clocks.hpp"
 #include "gpu/work_plan.hpp"
 #include "gpu/work_spread.hpp"
@@ -66,6 +67,7 @@ struct GpuTracer::Frame {
     Division division;                      // a primary frame's (a pass traces its source's)
     gpu::WorkPlan ownWork;
     const gpu::WorkPlan* work = &ownWork;   // a secondary pass: its source's
+    std::optional<gpu::RayPackets> packets; // where the kernel traces packets (kernelUsesPackets)
     std::uint32_t workgroupSize = 0;
     std::uint64_t triIdCount = 0;           // triangle ids over every ray group
     gpu::DacrtBufferPlan buffers{};
@@ -330,6 +332,13 @@ void GpuTracer::divide(Frame& frame) {
                                        rayCosts.empty() ? gpu::evenRayGroups(frame.division, groups)
                                                         : gpu::costedRayGroups(frame.division, groups, rayCosts));
     frame.triIdCount = frame.work->triangleIds;
+    if (gpu::kernelUsesPackets(frame.geometry, options_.dacrt, device)) {
+        frame.packets = gpu::buildRayPackets(frame.geometry, frame.division.rayIds, frame.ownWork.slots, pool_);
+        for (WorkItem& item : frame.ownWork.items) {
+            item.packetBegin = frame.packets->slotFirstPacket[item.rayRegion];
+            item.packetEnd = frame.packets->slotFirstPacket[item.rayRegion + 1];
+        }
+    }
     frame.result.regions = regions;
     frame.result.axis = axis;
     frame.result.counters.raysCulled = frame.division.culledRays;
@@ -350,6 +359,7 @@ void GpuTracer::planMemory(Frame& frame) const {
         .workItems = work.items.size(),
         .maxDepth = options_.dacrt.maxDepth,
         .stackSlots = frame.stackSlots = stackSlots(work.items.size()),
+        .packets = frame.packets ? frame.packets->packets.size() : 0,
     });
     MemoryPlan& plan = frame.result.memory;
     // The frame's own arrays on the host, which the device's are uploaded from and the hits
@@ -361,6 +371,10 @@ void GpuTracer::planMemory(Frame& frame) const {
     plan.add("host: hits", g.rays->size() * sizeof(Hit));
     for (const auto& [name, bytes] : frame.hostPlan.buffers) plan.add("host: " + name, bytes);
     plan.add("host: triangle ids per ray group", frame.triIdCount * 4);
+    if (frame.packets) {
+        plan.add("host: packet rays", frame.packets->packetRays.size() * 4);
+        plan.add("host: packets", frame.packets->packets.size() * (sizeof(PacketBounds) + 4));
+    }
     gpu::addressLargeArrays(frame.buffers, limits_);
     checkStageClocks(frame.buffers);
     gpu::addToMemoryPlan(frame.buffers, limits_, plan);
@@ -375,7 +389,11 @@ void GpuTracer::planMemory(Frame& frame) const {
                                    (frame.trianglesOnDevice ? 0 : triangleBytes) +
                                    std::uint64_t(frame.division.rayIds.size()) * 4 + frame.triIdCount * 4 +
                                    work.slots.size() * sizeof(Region) + work.items.size() *
-                                   (sizeof(WorkItem) + sizeof(TraversalState)) + sizeof(GpuCounters);
+                                   (sizeof(WorkItem) + sizeof(TraversalState)) + sizeof(GpuCounters) +
+                                   (frame.packets ? (frame.packets->packetRays.size() + g.rays->size() +
+                                                     frame.packets->packets.size()) * 4 +
+                                                        frame.packets->packets.size() * sizeof(PacketBounds)
+                                                  : 0);
     plan.addWork("bytes uploaded", uploaded, "rays, misses, triangles and bounds, ids, regions, work items");
     plan.addWork("skipped: triangle and bounds upload (bytes)", frame.trianglesOnDevice ? triangleBytes : 0,
                  frame.keepsTriangles ? (frame.trianglesOnDevice ? "on the device since an earlier frame" : "uploaded, kept for the next frame")
@@ -433,6 +451,7 @@ void GpuTracer::upload(Frame& frame) const {
     }
     upload(DACRT_BINDING_HITS, misses);
     upload(DACRT_BINDING_RAY_IDS, frame.division.rayIds);
+    if (frame.packets) uploadPackets(frame);
     upload(DACRT_BINDING_TRI_IDS, slotTriIds);
     upload(DACRT_BINDING_REGIONS, work.slots);
     upload(DACRT_BINDING_WORK_ITEMS, work.items);
@@ -459,6 +478,7 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .leafOverSplit = gpu::defaultLeafOverSplit(context_.info(), tuning_.profile),
         .lockstepSubgroups = gpu::dropsBarriers(context_.info(), frame.workgroupSize),
         .leafBalance = leafRule.leafBalance,
+        .packetFlush = frame.packets ? options_.dacrt.resolvedFor(Backend::Gpu).packetFlush : 0u,
         .addressed = frame.set->addressed(),
         .chunkBytes = frame.set->kernelChunkBytes(),
         .stageClocks = tuning_.stageClocks,
@@ -466,11 +486,36 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
     frame.result.gpu->rayLimit = leafRule.rayLimit;
     frame.result.gpu->triLimit = leafRule.triLimit;
     frame.result.gpu->leafBalance = leafRule.leafBalance;
+    frame.result.gpu->packets = frame.packets ? std::uint32_t(frame.packets->packets.size()) : 0u;
+    frame.result.gpu->packetFlush = frame.packets ? options_.dacrt.resolvedFor(Backend::Gpu).packetFlush : 0u;
     // Compilation only (a first use; later frames find the pipeline in the cache), so that
     // render and bench can take it out of the frame.
     PhaseTimes::addTo(frame.result.phases.pipelineCompile, msSince(start));
     frame.set->bindTo(pipeline);
     frame.kernel = &pipeline;
+}
+
+namespace {
+
+gpu::PacketSections packetSectionsOf(const FrameGeometry& g, const Division& division, const gpu::RayPackets& packets) {
+    return gpu::packetSections(division.rayIds.size(), g.rays->size(), packets.packets.size());
+}
+
+}  // namespace
+
+// The packet sections of the ray id buffer (no ray done yet; every slot's packet ids in order)
+// and the packets.
+void GpuTracer::uploadPackets(Frame& frame) const {
+    const gpu::RayPackets& packets = *frame.packets;
+    const gpu::PacketSections at = packetSectionsOf(frame.geometry, frame.division, packets);
+    gpu::Buffer& ids = (*frame.set)[DACRT_BINDING_RAY_IDS];
+    ids.upload(packets.packetRays.data(), packets.packetRays.size() * 4, std::uint64_t(at.packetRays) * 4);
+    const std::vector<std::uint32_t> notDone(frame.geometry.rays->size(), 0u);
+    ids.upload(notDone.data(), notDone.size() * 4, std::uint64_t(at.doneFlags) * 4);
+    std::vector<std::uint32_t> packetIds(packets.packets.size());
+    for (std::uint32_t k = 0; k < packetIds.size(); ++k) packetIds[k] = k;
+    ids.upload(packetIds.data(), packetIds.size() * 4, std::uint64_t(at.packetIds) * 4);
+    (*frame.set)[DACRT_BINDING_PACKETS].upload(packets.packets.data(), packets.packets.size() * sizeof(PacketBounds));
 }
 
 // Step 1 and the transfer rounds in one command buffer, then continuations until every work
@@ -487,6 +532,14 @@ void GpuTracer::dispatch(Frame& frame) const {
     push.rayTmin = frame.geometry.rays->front().tmin;
     push.order = frame.geometry.order == ChildOrder::PerRay ? shared::kOrderPerRay : shared::kOrderNearSide;
     push.stackSlots = std::uint32_t(frame.stackSlots);
+    if (frame.packets) {
+        const gpu::PacketSections at = packetSectionsOf(frame.geometry, frame.division, *frame.packets);
+        push.rayScratchHalf = std::uint32_t(at.scratch);
+        push.packetRaysAt = std::uint32_t(at.packetRays);
+        push.doneFlagsAt = std::uint32_t(at.doneFlags);
+        push.packetIdsAt = std::uint32_t(at.packetIds);
+        push.packetCount = std::uint32_t(frame.packets->packets.size());
+    }
     frame.counters = dispatchSchedule(*frame.work, context_, *frame.kernel, *frame.set, push, *frame.result.gpu);
     dispatchContinuations(*frame.work, context_, *frame.kernel, *frame.set, push, frame.counters, *frame.result.gpu);
     frame.result.phases.dispatch = msSince(start);
@@ -509,6 +562,7 @@ void GpuTracer::readBack(Frame& frame) const {
     checkLoopLimit(counters, work.items.size(), context_.info());
     result.counters.raysCulled += counters.raysCulled;  // a secondary pass's (the division counted a frame's)
     result.counters.rayBoxTests = counters.rayBoxTests;
+    result.counters.packetBoxTests = counters.packetBoxTests;
     result.counters.rayTriangleTests = counters.rayTriangleTests;
     result.counters.leaves = counters.leaves;
     result.counters.raysFinishedWithoutHit = counters.raysRetired;

@@ -81,6 +81,7 @@ private:
     void planBufferReuse(Frame& frame) const;
     void checkStageClocks(const gpu::DacrtBufferPlan& buffers) const;
     void upload(Frame& frame) const;
+    void uploadPackets(Frame& frame) const;
     void dispatch(Frame& frame) const;
     void readBack(Frame& frame) const;
     // A secondary pass's own stages.

@@ -21,6 +21,7 @@ std::vector<std::uint32_t> KernelSpecialization::values() const {
     v[DACRT_SPEC_LEAF_OVER_SPLIT] = leafOverSplit;
     v[DACRT_SPEC_LOCKSTEP_SUBGROUPS] = lockstepSubgroups ? 1u : 0u;
     v[DACRT_SPEC_LEAF_BALANCE] = leafBalance;
+    v[DACRT_SPEC_PACKET_FLUSH] = packetFlush;
     return v;
 }
 

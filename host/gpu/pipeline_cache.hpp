@@ -24,6 +24,7 @@ struct KernelSpecialization {
     std::uint32_t leafOverSplit = 0;  // kLeafOverSplit in shaders/dacrt.comp (defaultLeafOverSplit)
     bool lockstepSubgroups = false;   // kLockstepSubgroups (dropsBarriers)
     std::uint32_t leafBalance = 0;    // kLeafBalance (kernelLeafRule)
+    std::uint32_t packetFlush = 0;    // kPacketFlush: 0, or packets (kernelUsesPackets) flushed below this many
     // The addressed kernel (DACRT_ADDRESSED) rather than the one that binds every array, with
     // chunks of chunkBytes (0: every array one chunk): DacrtBindingSet::addressed, kernelChunkBytes.
     bool addressed = false;

@@ -70,6 +70,7 @@ DeviceReport deviceReportOf(const GpuReport& g) {
     return DeviceReport{.device = g.device, .driver = g.driver, .workgroupSize = g.workgroupSize,
                         .subgroupSize = g.subgroupSize, .rayGroups = g.rayGroups,
                         .rayLimit = g.rayLimit, .triLimit = g.triLimit, .leafBalance = g.leafBalance,
+                        .packets = g.packets, .packetFlush = g.packetFlush,
                         .dispatchTimes = std::move(dispatchTimes), .dispatches = g.dispatches,
                         .workItemsRun = g.workItemsRun, .workItemsEmpty = g.workItemsEmpty, .workItemSlices = g.slices,
                         .raysFinished = g.raysFinished, .validationErrors = g.validationErrors,

@@ -71,6 +71,7 @@ nlohmann::ordered_json gpuJson(const DeviceReport& g) {
             {"subgroup_size", g.subgroupSize},
             {"ray_groups", g.rayGroups},
             {"leaf_rule", {{"ray_limit", g.rayLimit}, {"tri_limit", g.triLimit}, {"leaf_balance", g.leafBalance}}},
+            {"packets", {{"count", g.packets}, {"flush", g.packetFlush}}},
             {"dispatches", g.dispatches},
             {"dispatch_times", dispatches},
             {"work_items_run", g.workItemsRun},

@@ -17,6 +17,11 @@ struct DeviceReport {
     std::uint32_t rayLimit = 0;
     std::uint32_t triLimit = 0;
     std::uint32_t leafBalance = 0;
+    // The kernel's ray packets: how many (0: it traced rays alone, as it does without
+    // DacrtOptions::packets, for rays of no image or on a device with a loop limiter), and the
+    // packet count below which a node went on ray by ray.
+    std::uint32_t packets = 0;
+    std::uint32_t packetFlush = 0;
     struct Dispatch {
         std::string name;
         double gpuMs = 0.0;  // the device's timestamps

@@ -38,9 +38,10 @@ TEST(BackendOptions, ATracerRefusesTheDacrtOptionsItDoesNotTake) {
     gpu.backend = Backend::Gpu;
     gpu.dacrt.split = SplitMethod::CentroidMean;
     gpu.dacrt.splitCost = SplitCost::RaySampling;
-    gpu.dacrt.packets = false;
+    gpu.dacrt.intersector = Intersector::MollerTrumbore;
+    gpu.dacrt.packets = false;  // taken by the gpu too
     EXPECT_NE(refusal([&] { checkTraceOptions(gpu); })
-                  .find("--split, --split-cost and --packets are not options of --backend gpu"),
+                  .find("--split, --split-cost and --intersector are not options of --backend gpu"),
               std::string::npos);
     TraceOptions brute;
     brute.backend = Backend::Brute;

@@ -55,13 +55,14 @@ void expectConsistentWorkReport(const TraceResult& r) {
 // items too large for llvmpipe's loop limiter run in several slices; none may be cut short).
 // Returns the transfer work items of all the frames traced.
 std::uint64_t expectGpuMatchesCpu(gpu::Context& context, const Frame& frame, std::initializer_list<unsigned> regionCounts,
-                                  const GpuTuning& tuning = {}) {
+                                  const GpuTuning& tuning = {}, const DacrtOptions& dacrt = {}) {
     const TraceResult reference = frame.trace(Backend::CpuSeq);
     std::uint64_t transferWorkItems = 0;
     for (unsigned regions : regionCounts) {
         TraceOptions o;
         o.backend = Backend::Gpu;
         o.regions = regions;
+        o.dacrt = dacrt;
         ThreadPool pool(2);
         const TraceResult r = GpuTracer(context, pool, o, tuning).trace(frame.geometry);
         EXPECT_TRUE(identicalHits(reference.hits, r.hits)) << r.regions << " regions, " << r.gpu->rayGroups << " ray groups";
@@ -219,6 +220,46 @@ TEST(GpuImages, EveryLeafBalanceGivesTheSameHits) {
     EXPECT_LT(tests[kCpuProfileLeafBalance], tests[kMostLeafBalance]);
     ThreadPool pool(2);
     EXPECT_THROW(GpuTracer(*context, pool, gpuOptions(2), GpuTuning{.leafBalance = kMostLeafBalance + 1}), InputError);
+}
+
+TEST(GpuImages, EveryPacketFlushGivesTheSameHits) {
+    // Packets split down to single packets (1), to the default's 16, or never (a whole
+    // region's packets flushed at once), and no packets; the default also under the discrete
+    // profile (many ray slots, each with its own packets); with transfer rounds. A device with
+    // a loop budget (llvmpipe before Mesa 25) traces rays alone. Every flush is a pipeline of its
+    // own (a specialization constant), so the list is short.
+    DACRT_REQUIRE_GPU(context);
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 61, 37), 61, 37);  // tiles cut at the image's edges
+    const Frame inside = insideView({box({-3, -2, -4}, {3, 2, 4}), icosphere({0.5f, 0.2f, -1.5f}, 0.5f, 2)},
+                                    {0.1, 0.0, 0.2}, {0.3, 0.0, -1.0}, 40, 30);
+    const bool packets = gpu::loopBudgetOf(context->info()) == 0;
+    struct Case {
+        std::uint32_t flush;
+        GpuTuning tuning;
+    };
+    for (const Case& k : {Case{1u, {}}, Case{kPacketFlushDefault, {}}, Case{kPacketFlushDefault, kDiscreteProfile},
+                          Case{100000u, {}}}) {
+        SCOPED_TRACE("packet flush " + std::to_string(k.flush) + (k.tuning.profile == GpuProfile::Discrete ? ", discrete" : ""));
+        const DacrtOptions dacrt{.packetFlush = k.flush};
+        expectGpuMatchesCpu(*context, frame, {1, 3}, k.tuning, dacrt);
+        EXPECT_GT(expectGpuMatchesCpu(*context, inside, {4}, k.tuning, dacrt), 0u) << "expected transfer rounds";
+        TraceOptions o = gpuOptions(2);
+        o.dacrt = dacrt;
+        ThreadPool pool(2);
+        const TraceResult r = GpuTracer(*context, pool, o, k.tuning).trace(frame.geometry);
+        EXPECT_EQ(r.counters.packetBoxTests > 0, packets);
+        EXPECT_EQ(r.gpu->packets > 0, packets);
+        EXPECT_EQ(r.gpu->packetFlush, packets ? k.flush : 0u);
+    }
+    TraceOptions off = gpuOptions(2);
+    off.dacrt.packets = false;
+    expectGpuMatchesCpu(*context, frame, {1, 3}, {}, off.dacrt);
+    ThreadPool pool(2);
+    const TraceResult r = GpuTracer(*context, pool, off, {}).trace(frame.geometry);
+    EXPECT_EQ(r.counters.packetBoxTests, 0u);
+    EXPECT_EQ(r.gpu->packets, 0u);
+    EXPECT_GT(r.counters.rayBoxTests, 0u);
 }
 
 TEST(GpuImages, CameraInsideTheSceneAndOnSplitPlanes) {
