@@ -346,8 +346,25 @@ void GpuTracer::divide(Frame& frame) {
     frame.result.phases.divide = msSince(start);
 }
 
-// Every buffer, host and device, from the counts; checked against the device's limits.
+// Packets make the ray id buffer about three times as long: a frame that fits the device only
+// without them is planned again without them (the same hits, more ray/box tests).
 void GpuTracer::planMemory(Frame& frame) const {
+    if (frame.packets) {
+        const MemoryPlan before = frame.result.memory;
+        try {
+            planBuffers(frame);
+            return;
+        } catch (const InputError&) {
+            frame.result.memory = before;
+            frame.packets.reset();
+            for (WorkItem& item : frame.ownWork.items) item.packetBegin = item.packetEnd = 0;
+        }
+    }
+    planBuffers(frame);
+}
+
+// Every buffer, host and device, from the counts; checked against the device's limits.
+void GpuTracer::planBuffers(Frame& frame) const {
     const FrameGeometry& g = frame.geometry;
     const gpu::WorkPlan& work = *frame.work;
     frame.buffers = gpu::planDacrtBuffers(gpu::DacrtBufferCounts{
@@ -374,6 +391,7 @@ void GpuTracer::planMemory(Frame& frame) const {
     if (frame.packets) {
         plan.add("host: packet rays", frame.packets->packetRays.size() * 4);
         plan.add("host: packets", frame.packets->packets.size() * (sizeof(PacketBounds) + 4));
+        plan.add("host: ray finished flags (zeros uploaded)", g.rays->size() * 4);
     }
     gpu::addressLargeArrays(frame.buffers, limits_);
     checkStageClocks(frame.buffers);
@@ -394,7 +412,8 @@ void GpuTracer::planMemory(Frame& frame) const {
                                                      frame.packets->packets.size()) * 4 +
                                                         frame.packets->packets.size() * sizeof(PacketBounds)
                                                   : 0);
-    plan.addWork("bytes uploaded", uploaded, "rays, misses, triangles and bounds, ids, regions, work items");
+    plan.addWork("bytes uploaded", uploaded, frame.packets ? "rays, misses, triangles and bounds, ids, regions, work items, packets"
+                                                      : "rays, misses, triangles and bounds, ids, regions, work items");
     plan.addWork("skipped: triangle and bounds upload (bytes)", frame.trianglesOnDevice ? triangleBytes : 0,
                  frame.keepsTriangles ? (frame.trianglesOnDevice ? "on the device since an earlier frame" : "uploaded, kept for the next frame")
                                       : g.trianglesVersion ? "skip off (--no-skip uploads)" : "the triangles' version is unknown");

@@ -78,6 +78,7 @@ private:
     // A primary frame's stages.
     void divide(Frame& frame);
     void planMemory(Frame& frame) const;
+    void planBuffers(Frame& frame) const;
     void planBufferReuse(Frame& frame) const;
     void checkStageClocks(const gpu::DacrtBufferPlan& buffers) const;
     void upload(Frame& frame) const;

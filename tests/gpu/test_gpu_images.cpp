@@ -465,6 +465,36 @@ TEST(GpuImages, AFrameBeyondTheDeviceMemoryIsRefusedBeforeAllocation) {
     EXPECT_FALSE(planned);
 }
 
+TEST(GpuImages, AFrameThatFitsOnlyWithoutPacketsIsTracedWithout) {
+    // Packets lengthen the ray id buffer: under a memory cap between the frame's device bytes
+    // without packets and with them, the frame is planned again without them, the same hits.
+    DACRT_REQUIRE_GPU(context);
+    if (gpu::loopBudgetOf(context->info()) != 0) GTEST_SKIP() << "no packets on a device with a loop budget";
+    const Scene s = shapes();
+    const Frame frame(shapes(), defaultCamera(s, 48, 36), 48, 36);
+    auto deviceBytes = [&](bool packets) {
+        TraceOptions o = gpuOptions(2);
+        o.dacrt.packets = packets;
+        ThreadPool pool(2);
+        std::uint64_t bytes = 0;
+        GpuTracer(*context, pool, o, {}).trace(frame.geometry, [&](const MemoryPlan& plan) {
+            for (const auto& [name, b] : plan.buffers)
+                if (name.rfind("device: ", 0) == 0) bytes += b;
+            return false;  // planned only
+        });
+        return bytes;
+    };
+    const std::uint64_t without = deviceBytes(false), with = deviceBytes(true);
+    ASSERT_LT(without, with);
+    ThreadPool pool(2);
+    const TraceResult r =
+        GpuTracer(*context, pool, gpuOptions(2), GpuTuning{.memoryBytes = (without + with) / 2}).trace(frame.geometry);
+    EXPECT_EQ(r.gpu->packets, 0u);
+    EXPECT_EQ(r.counters.packetBoxTests, 0u);
+    EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, r.hits));
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
 TEST(GpuImages, TrianglesStayOnTheDeviceAcrossFramesUntilTheyChange) {
     // The uploads skip: frames of one trianglesVersion upload the triangles once, and a frame
     // whose triangles moved (a new version) uploads them again: the hits are always the ones
