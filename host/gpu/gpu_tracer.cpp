@@ -332,18 +332,22 @@ void GpuTracer::divide(Frame& frame) {
                                        rayCosts.empty() ? gpu::evenRayGroups(frame.division, groups)
                                                         : gpu::costedRayGroups(frame.division, groups, rayCosts));
     frame.triIdCount = frame.work->triangleIds;
-    if (gpu::kernelUsesPackets(frame.geometry, options_.dacrt, device)) {
-        frame.packets = gpu::buildRayPackets(frame.geometry, frame.division.rayIds, frame.ownWork.slots, pool_);
-        for (WorkItem& item : frame.ownWork.items) {
-            item.packetBegin = frame.packets->slotFirstPacket[item.rayRegion];
-            item.packetEnd = frame.packets->slotFirstPacket[item.rayRegion + 1];
-        }
-    }
+    if (gpu::kernelUsesPackets(frame.geometry, options_.dacrt, device))
+        setPackets(frame, gpu::buildRayPackets(frame.geometry, frame.division.rayIds, frame.ownWork.slots, pool_));
     frame.result.regions = regions;
     frame.result.axis = axis;
     frame.result.counters.raysCulled = frame.division.culledRays;
     frame.result.gpu->rayGroups = groups;
     frame.result.phases.divide = msSince(start);
+}
+
+// The frame's packets (none: nullopt), and each work item's range of its ray slot's.
+void GpuTracer::setPackets(Frame& frame, std::optional<gpu::RayPackets> packets) {
+    frame.packets = std::move(packets);
+    for (WorkItem& item : frame.ownWork.items) {
+        item.packetBegin = frame.packets ? frame.packets->slotFirstPacket[item.rayRegion] : 0u;
+        item.packetEnd = frame.packets ? frame.packets->slotFirstPacket[item.rayRegion + 1] : 0u;
+    }
 }
 
 // Packets make the ray id buffer about three times as long: a frame that fits the device only
@@ -356,8 +360,7 @@ void GpuTracer::planMemory(Frame& frame) const {
             return;
         } catch (const InputError&) {
             frame.result.memory = before;
-            frame.packets.reset();
-            for (WorkItem& item : frame.ownWork.items) item.packetBegin = item.packetEnd = 0;
+            setPackets(frame, std::nullopt);
         }
     }
     planBuffers(frame);
@@ -486,6 +489,7 @@ std::uint64_t GpuTracer::stackSlots(std::uint64_t workItems) const {
 void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const {
     const auto start = Clock::now();
     const gpu::KernelLeafRule leafRule = gpu::kernelLeafRule(options_.dacrt, tuning_, context_.info());
+    const std::uint32_t packetFlush = frame.packets ? options_.dacrt.resolvedFor(Backend::Gpu).packetFlush : 0u;
     gpu::ComputePipeline& pipeline = pipelines_.kernel(gpu::KernelSpecialization{
         .workgroupSize = frame.workgroupSize,
         .rayLimit = leafRule.rayLimit,
@@ -497,7 +501,7 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .leafOverSplit = gpu::defaultLeafOverSplit(context_.info(), tuning_.profile),
         .lockstepSubgroups = gpu::dropsBarriers(context_.info(), frame.workgroupSize),
         .leafBalance = leafRule.leafBalance,
-        .packetFlush = frame.packets ? options_.dacrt.resolvedFor(Backend::Gpu).packetFlush : 0u,
+        .packetFlush = packetFlush,
         .addressed = frame.set->addressed(),
         .chunkBytes = frame.set->kernelChunkBytes(),
         .stageClocks = tuning_.stageClocks,
@@ -506,7 +510,7 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
     frame.result.gpu->triLimit = leafRule.triLimit;
     frame.result.gpu->leafBalance = leafRule.leafBalance;
     frame.result.gpu->packets = frame.packets ? std::uint32_t(frame.packets->packets.size()) : 0u;
-    frame.result.gpu->packetFlush = frame.packets ? options_.dacrt.resolvedFor(Backend::Gpu).packetFlush : 0u;
+    frame.result.gpu->packetFlush = packetFlush;
     // Compilation only (a first use; later frames find the pipeline in the cache), so that
     // render and bench can take it out of the frame.
     PhaseTimes::addTo(frame.result.phases.pipelineCompile, msSince(start));

@@ -3,6 +3,7 @@
 // rounds as compute dispatches (one workgroup per work item) recorded in one command buffer.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <dacrt/backend_tuning.hpp>
@@ -16,6 +17,7 @@
 #include "gpu/binding_set.hpp"
 #include "gpu/context.hpp"
 #include "gpu/pipeline_cache.hpp"
+#include "gpu/ray_packets.hpp"
 #include "gpu/buffer_arena.hpp"
 #include "gpu/resident_triangles.hpp"
 
@@ -77,6 +79,7 @@ private:
 
     // A primary frame's stages.
     void divide(Frame& frame);
+    static void setPackets(Frame& frame, std::optional<gpu::RayPackets> packets);
     void planMemory(Frame& frame) const;
     void planBuffers(Frame& frame) const;
     void planBufferReuse(Frame& frame) const;
