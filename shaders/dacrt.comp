@@ -117,6 +117,7 @@ void loadFrameParameters() {
     gMargin = push.margin;
     gRayOrigin = push.rayOrigin;
     gRayTmin = push.rayTmin;
+    gRayTmax = push.rayTmax;
     gAxis = push.axis;
     gOrder = push.order;
     gRayScratchHalf = push.rayScratchHalf;

@@ -13,6 +13,11 @@ layout(constant_id = DACRT_SPEC_LOOP_BUDGET) const uint kLoopBudget = 0;
 layout(constant_id = DACRT_SPEC_SHARED_START) const bool kSharedStart = false;
 // Shadow and occlusion rays: a ray ends at its first hit in its segment, wherever it lies.
 layout(constant_id = DACRT_SPEC_ANY_HIT) const bool kAnyHit = false;
+// Any-hit rays that share their segment [tmin, tmax] (a secondary pass's): a ray leaves the
+// traversal at its first hit, so a live ray's best hit is still its start (no hit at tmax), and
+// filters and leaves take tmin, tmax and that start from push constants instead of loading them.
+layout(constant_id = DACRT_SPEC_SHARED_SEGMENT) const bool kSharedSegmentSpec = false;
+const bool kSharedSegment = kSharedSegmentSpec && kAnyHit;
 // Nonzero: a node whose leaf would cost more than this many splits splits on (dacrt.comp,
 // leafCostsMoreThanSplits). 0: the leaf limits and stalled splits alone decide.
 layout(constant_id = DACRT_SPEC_LEAF_OVER_SPLIT) const uint kLeafOverSplit = 0;
@@ -106,6 +111,7 @@ layout(std430, binding = DACRT_BINDING_PACKETS) readonly buffer PacketBuffer { P
 float gMargin;
 vec3 gRayOrigin;
 float gRayTmin;
+float gRayTmax;       // kSharedSegment
 uint gAxis;
 uint gOrder;         // kOrder*
 uint gRayScratchHalf;

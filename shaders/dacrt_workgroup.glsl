@@ -82,8 +82,23 @@ uint crossingMovingRule(int axis, bool down) {
 Ray rayStart(uint id) {
     Ray ray;
     ray.origin = kSharedStart ? gRayOrigin : RAYS(id).origin;
-    ray.tmin = kSharedStart ? gRayTmin : RAYS(id).tmin;
+    ray.tmin = kSharedStart || kSharedSegment ? gRayTmin : RAYS(id).tmin;
     return ray;
+}
+
+// The best hit a live ray has so far: its start where any-hit rays share their segment.
+Hit liveRayHit(uint id) {
+    if (!kSharedSegment) return HITS(id);
+    Hit start;
+    start.t = gRayTmax;
+    start.prim = kMissPrim;
+    start.u = 0.0;
+    start.v = 0.0;
+    return start;
+}
+
+float liveRayBestT(uint id) {
+    return kSharedSegment ? gRayTmax : HITS(id).t;
 }
 
 // The fields of a ray that its filters read: origin, tmin and invDir.
@@ -95,7 +110,7 @@ Ray filterRay(uint id) {
 
 bool keepRay(uint id, uint rule, vec3 lo, vec3 hi) {
     Ray ray = filterRay(id);
-    float bestT = HITS(id).t;
+    float bestT = liveRayBestT(id);
     if (rule == kKeepCrossing) return rayMayCrossCell(ray, lo, hi, bestT);
     if (rule == kKeepFinished) return HITS(id).prim != kMissPrim && (kAnyHit || hitEndsInBox(ray, lo, hi, bestT));
     if (rule >= kKeepCrossingUp && rule < kKeepPacketCrossing) {
@@ -329,7 +344,7 @@ void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
         bool rayActive = index < rayEnd;
         uint id = rayActive ? RAY_IDS(index) : 0u;
         Ray ray = leafRay(id);
-        Hit best = HITS(id);
+        Hit best = liveRayHit(id);
         for (uint tile = triBegin; tile < triEnd; tile += gl_SubgroupSize) {
             uint tileSize = min(gl_SubgroupSize, triEnd - tile);
             uint myPrim = lane < tileSize ? TRI_IDS(tile + lane) : 0u;

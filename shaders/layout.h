@@ -145,7 +145,7 @@ struct DacrtPush {
     uint rayScratchHalf;   // ray id count: the ray id buffer's second half, scratch, starts here
     uint triScratchHalf;   // triangle id count: likewise in the triangle id buffer
     uint loopProbe;        // 2; a loop of this many iterations at the end detects a loop limiter
-    float rayTmin;         // every ray's tmin, where DACRT_SPEC_SHARED_START says they share it
+    float rayTmin;         // every ray's tmin, where DACRT_SPEC_SHARED_START or _SHARED_SEGMENT says they share it
     uint order;            // kOrder*
     uint stackSlots;       // traversal stacks the stack buffer holds (taken in turn by work items that save one)
     // With packets (DACRT_SPEC_PACKET_FLUSH), the ray id buffer holds after the ray ids (n):
@@ -155,6 +155,7 @@ struct DacrtPush {
     uint doneFlagsAt;      // one flag per ray id: nonzero once the ray has its final hit
     uint packetIdsAt;      // packet ids, then as many again of scratch
     uint packetCount;      // packet ids (the scratch is that far behind them)
+    float rayTmax;         // every ray's tmax, where DACRT_SPEC_SHARED_SEGMENT says they share it
 };
 
 // A light as a secondary pass traces it (from Scene::lights or --light), in float32.
@@ -306,7 +307,8 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_LOCKSTEP_SUBGROUPS 9  // 1: the workgroup is one subgroup, run as one SIMD thread (llvmpipe)
 #define DACRT_SPEC_LEAF_BALANCE 10     // 0, or the leaf balance (kLeafBalance, shaders/leaf_rule.glsl)
 #define DACRT_SPEC_PACKET_FLUSH 11     // 0, or packets: a node with fewer goes on ray by ray (kPacketFlush)
-#define DACRT_SPEC_COUNT 12
+#define DACRT_SPEC_SHARED_SEGMENT 12   // 1: any-hit rays that all have tmin rayTmin and tmax rayTmax (DacrtPush)
+#define DACRT_SPEC_COUNT 13
 
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 32);
@@ -318,7 +320,7 @@ static_assert(offsetof(TraversalState, cost) == 56 && offsetof(TraversalState, s
 static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalState, stackSize) == 44);
 static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depth) == 36);
 static_assert(offsetof(StackEntry, stalls) == 40 && offsetof(StackEntry, rayRule) == 44);
-static_assert(sizeof(DacrtPush) == 64 && offsetof(DacrtPush, loopProbe) == 32);
+static_assert(sizeof(DacrtPush) == 68 && offsetof(DacrtPush, loopProbe) == 32 && offsetof(DacrtPush, rayTmax) == 64);
 static_assert(offsetof(DacrtPush, packetRaysAt) == 48 && offsetof(DacrtPush, doneFlagsAt) == 52);
 static_assert(offsetof(DacrtPush, packetIdsAt) == 56 && offsetof(DacrtPush, packetCount) == 60);
 static_assert(offsetof(WorkItem, packetBegin) == 20 && offsetof(WorkItem, packetEnd) == 24);

@@ -24,6 +24,9 @@ float dot3(vec3 a, vec3 b) {
     return d;
 }
 
+// Where every secondary ray's segment starts (the kernel takes it once: DACRT_SPEC_SHARED_SEGMENT).
+const float kSegmentStart = 0.0f;
+
 // The ray from origin along direction (of any length, not normalized), hits in (0, tmax]:
 // makeRay's rules (flush below 2^-64, the watertight permutation and shear) with exact
 // division. The direction must have a component of at least 2^-64 and at most 2^62.
@@ -34,7 +37,7 @@ Ray segmentRay(vec3 origin, vec3 direction, float tmax) {
     if (abs(d.z) < kSmallestDirection) d.z = 0.0f;
     Ray r;
     r.origin = origin;
-    r.tmin = 0.0f;
+    r.tmin = kSegmentStart;
     r.dir = d;
     r.tmax = tmax;
     r.invDir = vec3(d.x == 0.0f ? 0.0f : divideRounded(1.0f, d.x), d.y == 0.0f ? 0.0f : divideRounded(1.0f, d.y),
@@ -132,6 +135,13 @@ GeneratedRay noRay() {
     return g;
 }
 
+// Where a shadow ray's segment ends: at the light (t = 1 on the segment to it), or nowhere for a
+// directional light. Every shadow ray of a light shares it, as every occlusion ray of a pass
+// shares its length.
+float shadowSegmentEnd(IN(ShadowLight) light) {
+    return light.type == kLightDirectional ? kNoHitT : 1.0f;
+}
+
 // The shadow ray of a surface towards a light: to a point or spot light the segment up to it
 // (t in (0, 1]), to a directional light the whole ray against its direction. None where the
 // light cannot reach the surface: the surface faces away from it (in shadow without a ray),
@@ -156,7 +166,7 @@ GeneratedRay shadowRay(IN(SurfaceSample) s, IN(ShadowLight) light) {
     precise vec3 direction = directional ? -light.direction : light.position - s.origin;
     if (max(abs(direction.x), max(abs(direction.y), abs(direction.z))) < kSmallestDirection) return noRay();
     GeneratedRay g;
-    g.ray = segmentRay(s.origin, direction, directional ? kNoHitT : 1.0f);
+    g.ray = segmentRay(s.origin, direction, shadowSegmentEnd(light));
     g.traced = true;
     return g;
 }

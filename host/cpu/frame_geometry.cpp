@@ -24,6 +24,13 @@ bool raysShareStart(const std::vector<Ray>& rays) {
     });
 }
 
+bool raysShareSegment(const std::vector<Ray>& rays) {
+    return !rays.empty() && std::all_of(rays.begin(), rays.end(), [&](const Ray& r) {
+        return std::memcmp(&r.tmin, &rays.front().tmin, sizeof(r.tmin)) == 0 &&
+               std::memcmp(&r.tmax, &rays.front().tmax, sizeof(r.tmax)) == 0;
+    });
+}
+
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
                             const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth) {
     FrameGeometry g;

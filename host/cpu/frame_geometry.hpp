@@ -66,6 +66,8 @@ struct FrameGeometry {
 // kernels (SIMD filters, compute shaders) then take them once instead of loading them per
 // ray, with the per-ray arithmetic unchanged.
 bool raysShareStart(const std::vector<Ray>& rays);
+// Whether every ray has the first one's tmin and tmax, bit for bit (false without rays).
+bool raysShareSegment(const std::vector<Ray>& rays);
 
 // Widening applied to every box before a ray or triangle filter, so that rounding in the
 // intersection test can never move a hit out of the cells that test it. See

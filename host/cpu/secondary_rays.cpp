@@ -28,6 +28,10 @@ std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, 
     return primary * perHit + pass.firstSample + k;
 }
 
+float passSegmentEnd(const SecondaryPass& pass) {
+    return pass.kind == shared::kPassShadow ? shared::shadowSegmentEnd(pass.light) : pass.occlusionDistance;
+}
+
 std::uint64_t secondarySlots(const SecondaryPass& pass, std::uint64_t primaryRays) {
     const std::uint64_t slots = primaryRays * pass.raysPerHit;
     const std::uint64_t streams = primaryRays * std::max(pass.raysPerHit, pass.samplesPerHit);

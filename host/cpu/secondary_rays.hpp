@@ -82,6 +82,9 @@ struct SecondaryRays {
     std::uint64_t slotCount = 0;
 };
 
+// Where every ray of the pass ends (each starts at shared::kSegmentStart).
+float passSegmentEnd(const SecondaryPass& pass);
+
 // Largest slot count of a pass (slots are 32-bit on the device, kNotTracedPrim reserved).
 constexpr std::uint64_t kMaxSecondarySlots = 0xFFFFFFF0ull;
 // Throws InputError when the pass has more slots than kMaxSecondarySlots.

@@ -302,7 +302,10 @@ TraceResult GpuTracer::trace(const FrameGeometry& geometry, const PlanHook& onPl
     if (onPlan && !onPlan(frame.result.memory)) return std::move(frame.result);
 
     upload(frame);
-    compileKernel(frame, geometry.raysShareStart, geometry.query == HitQuery::Any);
+    const bool anyHit = geometry.query == HitQuery::Any;
+    compileKernel(frame, KernelRays{.sharedStart = geometry.raysShareStart,
+                                    .anyHit = anyHit,
+                                    .sharedSegment = anyHit && raysShareSegment(*geometry.rays)});
     dispatch(frame);
     readBack(frame);
     if (keep) {
@@ -486,7 +489,7 @@ std::uint64_t GpuTracer::stackSlots(std::uint64_t workItems) const {
     return gpu::stackSlotsFor(workItems, options_.dacrt.maxDepth, context_.info(), gpu::loopBudgetOf(context_.info()) != 0);
 }
 
-void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const {
+void GpuTracer::compileKernel(Frame& frame, const KernelRays& rays) const {
     const auto start = Clock::now();
     const gpu::KernelLeafRule leafRule = gpu::kernelLeafRule(options_.dacrt, tuning_, context_.info());
     const std::uint32_t packetFlush = frame.packets ? options_.dacrt.resolvedFor(Backend::Gpu).packetFlush : 0u;
@@ -496,8 +499,8 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .triLimit = leafRule.triLimit,
         .maxDepth = options_.dacrt.maxDepth,
         .loopBudget = gpu::loopBudgetOf(context_.info()),
-        .sharedStart = sharedStart,
-        .anyHit = anyHit,
+        .sharedStart = rays.sharedStart,
+        .anyHit = rays.anyHit,
         .leafOverSplit = gpu::defaultLeafOverSplit(context_.info(), tuning_.profile),
         .lockstepSubgroups = gpu::dropsBarriers(context_.info(), frame.workgroupSize),
         .leafBalance = leafRule.leafBalance,
@@ -505,6 +508,7 @@ void GpuTracer::compileKernel(Frame& frame, bool sharedStart, bool anyHit) const
         .addressed = frame.set->addressed(),
         .chunkBytes = frame.set->kernelChunkBytes(),
         .stageClocks = tuning_.stageClocks,
+        .sharedSegment = rays.sharedSegment,
     });
     frame.result.gpu->rayLimit = leafRule.rayLimit;
     frame.result.gpu->triLimit = leafRule.triLimit;
@@ -553,6 +557,7 @@ void GpuTracer::dispatch(Frame& frame) const {
     push.triScratchHalf = std::uint32_t(frame.triIdCount);
     push.loopProbe = 2;
     push.rayTmin = frame.geometry.rays->front().tmin;
+    push.rayTmax = frame.geometry.rays->front().tmax;  // every ray's where compileKernel found them shared
     push.order = frame.geometry.order == ChildOrder::PerRay ? shared::kOrderPerRay : shared::kOrderNearSide;
     push.stackSlots = std::uint32_t(frame.stackSlots);
     if (frame.packets) {
@@ -627,7 +632,7 @@ TraceResult GpuTracer::traceSecondary(GpuPassSource& source, const FrameGeometry
     if (onPlan && !onPlan(frame.result.memory)) return std::move(frame.result);
 
     uploadPass(frame, source);
-    compileKernel(frame, false, true);
+    compileKernel(frame, KernelRays{.anyHit = true, .sharedSegment = true});  // secondary_rays.glsl's segments
     const auto start = Clock::now();
     frame.rayMaker = &pipelines_.secondary(frame.set->addressed(), frame.set->kernelChunkBytes());
     frame.set->bindTo(*frame.rayMaker);
@@ -732,6 +737,8 @@ void GpuTracer::dispatchPass(Frame& frame, const GpuPassSource& source, const Se
     push.triScratchHalf = std::uint32_t(frame.triIdCount);
     push.loopProbe = 2;
     push.order = shared::kOrderPerRay;  // any hit: every ray visits the low child, then the high
+    push.rayTmin = shared::kSegmentStart;
+    push.rayTmax = passSegmentEnd(pass);
     push.stackSlots = std::uint32_t(frame.stackSlots);
     const Prelude prelude = makeRaysOnDevice(*frame.rayMaker, secondaryPush(source, pass), frame.rays,
                                              context_.info().maxComputeWorkGroupCountX);

@@ -96,7 +96,13 @@ private:
     // Shared by both.
     TraceResult startResult() const;
     std::uint64_t stackSlots(std::uint64_t workItems) const;
-    void compileKernel(Frame& frame, bool sharedStart, bool anyHit) const;
+    // What the rays of a trace share, which the kernel then takes once (DACRT_SPEC_SHARED_*).
+    struct KernelRays {
+        bool sharedStart = false;    // origin and tmin (push rayOrigin, rayTmin)
+        bool anyHit = false;
+        bool sharedSegment = false;  // any hit: tmin and tmax (push rayTmin, rayTmax)
+    };
+    void compileKernel(Frame& frame, const KernelRays& rays) const;
 
     gpu::Context& context_;
     ThreadPool& pool_;

@@ -31,6 +31,7 @@ struct KernelSpecialization {
     std::uint32_t chunkBytes = 0;
     // The kernel with its stage clocks (DACRT_STAGE_CLOCKS, GpuTuning::stageClocks).
     bool stageClocks = false;
+    bool sharedSegment = false;  // kSharedSegmentSpec: any-hit rays with one tmin and tmax
     std::vector<std::uint32_t> values() const;  // in constant_id order
 };
 

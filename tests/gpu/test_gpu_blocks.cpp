@@ -217,6 +217,22 @@ TEST(GpuBlocks, PrimaryRaysShareTheirStart) {
     EXPECT_FALSE(raysShareStart(rays)) << "one tmin differs";
 }
 
+TEST(GpuBlocks, RaysShareTheirSegmentOnlyWithEveryTminAndTmaxAlike) {
+    Camera camera;
+    camera.eye = glm::dvec3(0.1, 0.2, 3.0);
+    camera.yfovRadians = 0.8;
+    std::vector<Ray> rays = primaryRays(camera, 8, 6);
+    EXPECT_TRUE(raysShareSegment(rays));
+    rays[5].origin.x += 1.0f;
+    EXPECT_TRUE(raysShareSegment(rays)) << "origins do not matter";
+    rays[23].tmax = std::nextafter(rays[23].tmax, 0.0f);
+    EXPECT_FALSE(raysShareSegment(rays)) << "one tmax a unit in the last place shorter";
+    rays = primaryRays(camera, 8, 6);
+    rays[40].tmin = 1e-6f;
+    EXPECT_FALSE(raysShareSegment(rays)) << "one tmin differs";
+    EXPECT_FALSE(raysShareSegment({})) << "no rays";
+}
+
 TEST_P(GpuBlocks, LeavesMatchTheCpuLeafExactly) {
     DACRT_REQUIRE_GPU(context);
     DACRT_BLOCK_WORKGROUP(context, wg);

@@ -140,6 +140,32 @@ TEST(GpuImages, RaysFromSurfacesInEveryDirection) {
     EXPECT_TRUE(noValidationErrors(*context));
 }
 
+TEST(GpuImages, AnyHitRaysOfDifferentLengthsAreTracedWithTheirOwn) {
+    // A pass's rays share their segment, and the kernel then takes tmin and tmax once
+    // (DACRT_SPEC_SHARED_SEGMENT); where one ray in three is shorter they do not, and each ray's
+    // own segment and best hit are read.
+    DACRT_REQUIRE_GPU(context);
+    CameraOptions view;
+    view.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(shapes(), 40, 30, view);
+    const TraceResult primary = frame.trace(Backend::CpuSeq);
+    PassFrame pass(frame, primary.hits, occlusionPass(3, 0.8f));
+    ASSERT_TRUE(raysShareSegment(pass.rays.rays));
+    for (std::size_t i = 0; i < pass.rays.rays.size(); i += 3) pass.rays.rays[i].tmax = 0.25f;
+    ASSERT_FALSE(raysShareSegment(pass.rays.rays));
+    const TraceResult reference = pass.trace(Backend::CpuSeq);
+    std::size_t occluded = 0;
+    for (const Hit& h : reference.hits) occluded += h.prim != kMissPrim;
+    ASSERT_GT(occluded, 0u);
+    ASSERT_LT(occluded, reference.hits.size());
+    for (unsigned regions : {1u, 3u}) {
+        ThreadPool pool(2);
+        const TraceResult r = GpuTracer(*context, pool, gpuOptions(regions), GpuTuning{0, 2}).trace(pass.geometry);
+        EXPECT_TRUE(identicalVisibility(reference.hits, r.hits)) << regions << " regions";
+    }
+    EXPECT_TRUE(noValidationErrors(*context));
+}
+
 TEST(GpuImages, SecondaryPassesMadeOnTheDeviceMatchTheHost) {
     // The primary hits stay on the device; shaders/secondary.comp makes each pass's rays there
     // (the host's code, bit for bit) and bins them; the visibility of every slot equals the
