@@ -36,8 +36,9 @@ struct Counters {
     }
 };
 
-// One dispatch of the gpu's schedule (Step 1 or a transfer round): its work items and their
-// costs, in loop iterations of the kernel's cost model (docs/gpu.md).
+// One dispatch of the gpu's schedule (Step 1, a transfer round, or rounds on disjoint slots
+// together: gpu::dispatchedPasses): its work items and their costs, in loop iterations of the
+// kernel's cost model (docs/gpu.md).
 struct GpuWorkPass {
     std::string name;
     std::uint32_t items = 0;
@@ -64,7 +65,7 @@ struct GpuReport {
     std::uint32_t slices = 0;          // work item slices (more than work items: continuations)
     std::uint64_t raysFinished = 0;    // rays finished (with a hit or without), over all steps
     std::uint32_t validationErrors = 0;
-    std::vector<GpuWorkPass> workPasses;  // gpu: Step 1, then each transfer round
+    std::vector<GpuWorkPass> workPasses;  // gpu: Step 1, then the transfer rounds' dispatches
     std::uint64_t workCost = 0;           // gpu: every work item's cost, summed
     std::uint64_t longestChainCost = 0;   // gpu: the costliest chain of work items that wait for each other
     // gpu with stage clocks: each stage's clock ticks (DACRT_STAGE_* order); empty without.

@@ -164,12 +164,13 @@ GpuCounters dispatchSchedule(const gpu::WorkPlan& work, gpu::Context& context, g
                              const gpu::DacrtBindingSet& set, DacrtPush& push, GpuReport& report,
                              const Prelude& prelude = {}) {
     const std::uint32_t perDispatch = context.info().maxComputeWorkGroupCountX;
+    const std::vector<std::pair<std::string, std::uint32_t>> passes = gpu::dispatchedPasses(work);
     std::uint32_t dispatchCount = prelude.dispatches;
-    for (const auto& pass : work.passes) dispatchCount += dispatchesFor(pass.second, perDispatch);
+    for (const auto& pass : passes) dispatchCount += dispatchesFor(pass.second, perDispatch);
     gpu::DispatchRecorder recorder(context, dispatchCount);
     if (prelude.record) prelude.record(recorder);
     std::uint32_t first = 0;
-    for (const auto& [name, count] : work.passes) {
+    for (const auto& [name, count] : passes) {
         recordPass(recorder, name, pipeline, push, first, count, perDispatch);
         first += count;
     }

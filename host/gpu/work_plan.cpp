@@ -160,4 +160,27 @@ WorkPlan planWorkItems(const Division& division, const std::vector<TransferRound
     return plan;
 }
 
+std::vector<std::pair<std::string, std::uint32_t>> dispatchedPasses(const WorkPlan& plan) {
+    std::vector<std::pair<std::string, std::uint32_t>> merged;
+    std::vector<bool> raySlotUsed(plan.slots.size(), false), triSlotUsed(plan.slots.size(), false);
+    std::uint32_t first = 0;
+    for (const auto& [name, count] : plan.passes) {
+        const auto items = plan.items.begin() + first;
+        const bool disjoint = !merged.empty() && std::none_of(items, items + count, [&](const WorkItem& w) {
+            return raySlotUsed[w.rayRegion] || triSlotUsed[w.triRegion];
+        });
+        if (!disjoint) {
+            merged.emplace_back(name, count);
+            std::fill(raySlotUsed.begin(), raySlotUsed.end(), false);
+            std::fill(triSlotUsed.begin(), triSlotUsed.end(), false);
+        } else {
+            merged.back().first += " + " + name;
+            merged.back().second += count;
+        }
+        for (auto w = items; w != items + count; ++w) raySlotUsed[w->rayRegion] = triSlotUsed[w->triRegion] = true;
+        first += count;
+    }
+    return merged;
+}
+
 }  // namespace dacrt::gpu

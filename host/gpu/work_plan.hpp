@@ -62,4 +62,10 @@ struct WorkPlan {
 WorkPlan planWorkItems(const Division& division, const std::vector<TransferRound>& schedule, std::uint32_t groups,
                        const RayGroups& grouping);
 
+// The plan's passes as dispatches: consecutive passes whose work items use no ray slot and no
+// triangle slot in common run as one dispatch ("toward-low 1 + toward-high 1"), since none of
+// them waits for another; apart, each would keep the device to its own few work items (with
+// two regions, a transfer round is one work item: one of a CPU device's threads).
+std::vector<std::pair<std::string, std::uint32_t>> dispatchedPasses(const WorkPlan& plan);
+
 }  // namespace dacrt::gpu

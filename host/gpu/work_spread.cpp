@@ -20,8 +20,9 @@ std::uint64_t longestChainCost(const WorkPlan& work, const std::vector<std::uint
 
 void addWorkItemLines(const WorkPlan& work, MemoryPlan& plan) {
     plan.addWork("gpu work items", work.items.size(), "Step 1 and transfer pairs, per ray group");
-    for (std::size_t p = 0; p < work.passes.size(); ++p)
-        plan.addWork("gpu work items: " + work.passes[p].first, work.passes[p].second,
+    const std::vector<std::pair<std::string, std::uint32_t>> dispatches = dispatchedPasses(work);
+    for (std::size_t p = 0; p < dispatches.size(); ++p)
+        plan.addWork("gpu work items: " + dispatches[p].first, dispatches[p].second,
                      p == 0 ? "one dispatch, independent of each other"
                             : "one dispatch, each after the earlier items on its ray and triangle slots");
     plan.addWork("gpu longest chain of work items", longestChainCost(work, std::vector<std::uint32_t>(work.items.size(), 1)),
@@ -32,7 +33,7 @@ void reportWorkSpread(const WorkPlan& work, const std::vector<std::uint32_t>& co
     report.workPasses.clear();
     report.workCost = 0;
     std::size_t first = 0;
-    for (const auto& [name, count] : work.passes) {
+    for (const auto& [name, count] : dispatchedPasses(work)) {
         GpuWorkPass pass{name, count, 0, 0.0};
         std::uint64_t sum = 0;
         for (std::size_t i = first; i < first + count; ++i) {

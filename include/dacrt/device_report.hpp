@@ -34,7 +34,8 @@ struct DeviceReport {
     std::uint64_t raysFinished = 0;    // with a hit or without, over all steps
     std::uint32_t validationErrors = 0;
 
-    // The schedule's dispatches (Step 1, then each transfer round), each with its work items
+    // The schedule's dispatches (Step 1, then the transfer rounds: one each, or those on disjoint
+    // region slots together, as "toward-low 1 + toward-high 1"), each with its work items
     // and their costs: the loop iterations of the kernel's cost model that a work item spent
     // (docs/gpu.md, "Work items and parallelism"), deterministic for a frame and options.
     struct WorkPass {

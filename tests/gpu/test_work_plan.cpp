@@ -196,3 +196,78 @@ TEST(WorkPlan, TheEstimateCountsTheTriangleBoundsARayCrosses) {
     moved.raysShareStart = false;
     EXPECT_TRUE(gpu::estimateStep1RayCosts(moved, d, pool).empty());
 }
+
+namespace {
+
+// A plan of `slots` slots with the given passes, each a list of (ray slot, triangle slot).
+gpu::WorkPlan handMadePlan(std::uint32_t slots,
+                           const std::vector<std::pair<std::string, std::vector<std::pair<std::uint32_t, std::uint32_t>>>>& passes) {
+    gpu::WorkPlan plan;
+    plan.slots.resize(slots);
+    for (const auto& [name, items] : passes) {
+        plan.passes.emplace_back(name, std::uint32_t(items.size()));
+        for (const auto& [ray, tri] : items) {
+            WorkItem w{};
+            w.rayRegion = ray;
+            w.triRegion = tri;
+            plan.items.push_back(w);
+        }
+    }
+    return plan;
+}
+
+}  // namespace
+
+TEST(WorkPlan, PassesOnDisjointSlotsShareADispatch) {
+    using Dispatches = std::vector<std::pair<std::string, std::uint32_t>>;
+    // Two regions: each transfer round is one work item, and the two directions touch
+    // different slots, so they run together.
+    const gpu::WorkPlan two = handMadePlan(2, {{"step1", {{0, 0}, {1, 1}}}, {"toward-low 1", {{1, 0}}}, {"toward-high 1", {{0, 1}}}});
+    EXPECT_EQ(gpu::dispatchedPasses(two), (Dispatches{{"step1", 2}, {"toward-low 1 + toward-high 1", 2}}));
+    // Three regions: ray slot 1 is in both directions' rounds, which stay apart.
+    const gpu::WorkPlan three = handMadePlan(
+        3, {{"step1", {{0, 0}, {1, 1}, {2, 2}}}, {"toward-low 1", {{1, 0}, {2, 1}}}, {"toward-high 1", {{0, 1}, {1, 2}}}});
+    EXPECT_EQ(gpu::dispatchedPasses(three), (Dispatches{{"step1", 3}, {"toward-low 1", 2}, {"toward-high 1", 2}}));
+    // A triangle slot in common keeps passes apart as well; a later pass may join again.
+    const gpu::WorkPlan tri = handMadePlan(4, {{"a", {{0, 0}}}, {"b", {{1, 0}}}, {"c", {{2, 2}}}, {"d", {{3, 3}}}});
+    EXPECT_EQ(gpu::dispatchedPasses(tri), (Dispatches{{"a", 1}, {"b + c + d", 3}}));
+    EXPECT_TRUE(gpu::dispatchedPasses(gpu::WorkPlan{}).empty());
+}
+
+TEST(WorkPlan, MergedDispatchesKeepEveryWorkItemInOrderWithoutAWaitInside) {
+    for (unsigned regions : {2u, 3u, 5u}) {
+        const DividedFrame f(regions);
+        const Division& d = f.division;
+        for (std::uint32_t groups : {1u, 3u}) {
+            SCOPED_TRACE(std::to_string(regions) + " regions, " + std::to_string(groups) + " groups");
+            const gpu::WorkPlan plan = gpu::planWorkItems(d, transferSchedule(d), groups, gpu::evenRayGroups(d, groups));
+            const auto dispatches = gpu::dispatchedPasses(plan);
+            std::size_t pass = 0, first = 0;
+            for (const auto& [name, count] : dispatches) {
+                // The dispatch is a run of whole passes, named in order; a work item of a later
+                // pass of the run shares no slot with the run's earlier passes.
+                std::string names;
+                std::uint32_t items = 0;
+                std::vector<bool> raySlot(plan.slots.size(), false), triSlot(plan.slots.size(), false);
+                while (items < count) {
+                    ASSERT_LT(pass, plan.passes.size());
+                    names += (names.empty() ? "" : " + ") + plan.passes[pass].first;
+                    std::vector<bool> rayHere = raySlot, triHere = triSlot;
+                    for (std::uint32_t i = 0; i < plan.passes[pass].second; ++i) {
+                        const WorkItem& w = plan.items[first + items + i];
+                        if (items > 0) EXPECT_FALSE(raySlot[w.rayRegion] || triSlot[w.triRegion]) << name;
+                        rayHere[w.rayRegion] = triHere[w.triRegion] = true;
+                    }
+                    raySlot = rayHere;
+                    triSlot = triHere;
+                    items += plan.passes[pass++].second;
+                }
+                EXPECT_EQ(items, count);
+                EXPECT_EQ(names, name);
+                first += count;
+            }
+            EXPECT_EQ(pass, plan.passes.size());
+            EXPECT_EQ(first, plan.items.size());
+        }
+    }
+}
