@@ -204,30 +204,35 @@ TEST_P(GpuBlocks, TrianglePartitionsAreStableAndExact) {
     EXPECT_TRUE(noValidationErrors(*context));
 }
 
-TEST(GpuBlocks, PrimaryRaysShareTheirStart) {
+namespace {
+
+Camera smallCamera() {
     Camera camera;
     camera.eye = glm::dvec3(0.1, 0.2, 3.0);
     camera.yfovRadians = 0.8;
-    std::vector<Ray> rays = primaryRays(camera, 8, 6);
+    return camera;
+}
+
+}  // namespace
+
+TEST(GpuBlocks, PrimaryRaysShareTheirStart) {
+    std::vector<Ray> rays = primaryRays(smallCamera(), 8, 6);
     EXPECT_TRUE(raysShareStart(rays));
     rays[17].origin.y = std::nextafter(rays[17].origin.y, 10.0f);
     EXPECT_FALSE(raysShareStart(rays)) << "one origin a unit in the last place away";
-    rays = primaryRays(camera, 8, 6);
+    rays = primaryRays(smallCamera(), 8, 6);
     rays[40].tmin = 1e-6f;
     EXPECT_FALSE(raysShareStart(rays)) << "one tmin differs";
 }
 
 TEST(GpuBlocks, RaysShareTheirSegmentOnlyWithEveryTminAndTmaxAlike) {
-    Camera camera;
-    camera.eye = glm::dvec3(0.1, 0.2, 3.0);
-    camera.yfovRadians = 0.8;
-    std::vector<Ray> rays = primaryRays(camera, 8, 6);
+    std::vector<Ray> rays = primaryRays(smallCamera(), 8, 6);
     EXPECT_TRUE(raysShareSegment(rays));
     rays[5].origin.x += 1.0f;
     EXPECT_TRUE(raysShareSegment(rays)) << "origins do not matter";
     rays[23].tmax = std::nextafter(rays[23].tmax, 0.0f);
     EXPECT_FALSE(raysShareSegment(rays)) << "one tmax a unit in the last place shorter";
-    rays = primaryRays(camera, 8, 6);
+    rays = primaryRays(smallCamera(), 8, 6);
     rays[40].tmin = 1e-6f;
     EXPECT_FALSE(raysShareSegment(rays)) << "one tmin differs";
     EXPECT_FALSE(raysShareSegment({})) << "no rays";

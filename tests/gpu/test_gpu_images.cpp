@@ -103,6 +103,13 @@ Frame insideView(const std::vector<Mesh>& meshes, glm::dvec3 eye, glm::dvec3 tar
     return Frame(sceneFromMeshes(meshes), defaultCamera(s, width, height, o), width, height);
 }
 
+// The shapes from above and in front: their hits face every way, and so do rays leaving them.
+CameraOptions viewFromAboveFront() {
+    CameraOptions view;
+    view.eye = glm::dvec3(0.5, 1.5, 4.0);
+    return view;
+}
+
 }  // namespace
 
 TEST(GpuImages, ProceduralShapes) {
@@ -118,9 +125,7 @@ TEST(GpuImages, RaysFromSurfacesInEveryDirection) {
     // (kOrderPerRay: rays classified per split for closest hits), any hit or the closest, with
     // transfer rounds in both directions and ray groups.
     DACRT_REQUIRE_GPU(context);
-    CameraOptions view;
-    view.eye = glm::dvec3(0.5, 1.5, 4.0);
-    const Frame frame(shapes(), 40, 30, view);
+    const Frame frame(shapes(), 40, 30, viewFromAboveFront());
     const TraceResult primary = frame.trace(Backend::CpuSeq);
     for (const SecondaryPass& p : {occlusionPass(3, 0.8f), occlusionPass(2, kNoHitT), pointShadowPass({0.3f, 1.6f, 0.4f})}) {
         for (HitQuery query : {HitQuery::Closest, HitQuery::Any}) {
@@ -145,9 +150,7 @@ TEST(GpuImages, AnyHitRaysOfDifferentLengthsAreTracedWithTheirOwn) {
     // (DACRT_SPEC_SHARED_SEGMENT); where one ray in three is shorter they do not, and each ray's
     // own segment and best hit are read.
     DACRT_REQUIRE_GPU(context);
-    CameraOptions view;
-    view.eye = glm::dvec3(0.5, 1.5, 4.0);
-    const Frame frame(shapes(), 40, 30, view);
+    const Frame frame(shapes(), 40, 30, viewFromAboveFront());
     const TraceResult primary = frame.trace(Backend::CpuSeq);
     PassFrame pass(frame, primary.hits, occlusionPass(3, 0.8f));
     ASSERT_TRUE(raysShareSegment(pass.rays.rays));
