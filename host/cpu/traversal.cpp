@@ -300,17 +300,8 @@ std::uint32_t DacrtTraversal::buildPackets(std::uint32_t begin, std::uint32_t en
         RayPacket& p = packet_.packets[packets];
         p.begin = tileBegin;
         p.end = start[t];
-        p.invLo = glm::vec3(kNoHitT);
-        p.invHi = glm::vec3(-kNoHitT);
-        p.unboundedAxes = 0;
-        for (std::uint32_t k = p.begin; k < p.end; ++k) {
-            const glm::vec3& inv = rays_[packet_.packetRays[k]].invDir;
-            for (int a = 0; a < 3; ++a) {
-                if (inv[a] == 0.0f) p.unboundedAxes |= 1u << a;
-                p.invLo[a] = std::min(p.invLo[a], inv[a]);
-                p.invHi[a] = std::max(p.invHi[a], inv[a]);
-            }
-        }
+        startPacketBounds(p);
+        for (std::uint32_t k = p.begin; k < p.end; ++k) addToPacketBounds(p, rays_[packet_.packetRays[k]].invDir);
         packet_.packetIds[packets] = packets;
         ++packets;
     }

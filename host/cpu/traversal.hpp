@@ -1,6 +1,8 @@
 #pragma once
 // Sequential divide-and-conquer ray tracing (Mora 2011) over in-place id arrays: the
 // building block of both the cpu-seq backend and every work item of the parallel scheme.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -32,13 +34,31 @@ std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange
 // per axis. Rays that share their start compute (lo - origin) * invDir with the same first
 // factor, and rounding is monotone, so the packet's four corner products bound every ray's
 // rounded slab values: a packet the bounds reject holds no ray the ray filter would keep.
-// An axis where some ray has invDir 0 (the filter's branch) is left unbounded.
+// Some axes are left unbounded (addToPacketBounds).
 struct RayPacket {
     std::uint32_t begin = 0, end = 0;  // its rays: packetRays[begin, end)
     glm::vec3 invLo{0.0f}, invHi{0.0f};
     std::uint32_t unboundedAxes = 0;   // bit per axis
 };
 constexpr std::uint32_t kPacketTile = 8;
+
+// A packet's bounds with no ray yet, then grown by each ray's invDir: the cpu's RayPacket and
+// the gpu's PacketBounds (shaders/layout.h) alike. An axis where some ray's invDir is 0 (the
+// ray filter's branch) or not finite (no product could be trusted) gets no bound.
+template <typename Packet>
+void startPacketBounds(Packet& p) {
+    p.invLo = glm::vec3(kNoHitT);
+    p.invHi = glm::vec3(-kNoHitT);
+    p.unboundedAxes = 0;
+}
+template <typename Packet>
+void addToPacketBounds(Packet& p, const glm::vec3& invDir) {
+    for (int a = 0; a < 3; ++a) {
+        if (invDir[a] == 0.0f || !std::isfinite(invDir[a])) p.unboundedAxes |= 1u << a;
+        p.invLo[a] = std::min(p.invLo[a], invDir[a]);
+        p.invHi[a] = std::max(p.invHi[a], invDir[a]);
+    }
+}
 
 // Packets' working arrays, one set per worker: rays grouped by tile, the rays of a node's
 // packets when it goes on ray by ray, the packets and their ids (partitioned like ray ids),

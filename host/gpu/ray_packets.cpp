@@ -1,7 +1,6 @@
 #include "gpu/ray_packets.hpp"
 
 #include <algorithm>
-#include <cmath>
 
 #include "cpu/traversal.hpp"
 #include "gpu/device_defaults.hpp"
@@ -26,17 +25,8 @@ PacketBounds boundPacket(const FrameGeometry& g, const std::vector<std::uint32_t
     PacketBounds p{};
     p.rayBegin = begin;
     p.rayEnd = end;
-    p.invLo = glm::vec3(kNoHitT);
-    p.invHi = glm::vec3(-kNoHitT);
-    for (std::uint32_t k = begin; k < end; ++k) {
-        const glm::vec3& inv = (*g.rays)[packetRays[k]].invDir;
-        for (int a = 0; a < 3; ++a) {
-            // The ray filter's branch (invDir 0), and products that could be NaN: no bound.
-            if (inv[a] == 0.0f || !std::isfinite(inv[a])) p.unboundedAxes |= 1u << a;
-            p.invLo[a] = std::min(p.invLo[a], inv[a]);
-            p.invHi[a] = std::max(p.invHi[a], inv[a]);
-        }
-    }
+    startPacketBounds(p);
+    for (std::uint32_t k = begin; k < end; ++k) addToPacketBounds(p, (*g.rays)[packetRays[k]].invDir);
     return p;
 }
 
