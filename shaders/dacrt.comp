@@ -94,10 +94,16 @@ const uint kStepEnterChild = 3u;  // Slice::next becomes the node (enterChild)
 
 // A stack entry's rayRule holds, above its rule, the face of the parent's box that the child
 // moved (axis * 2, + 1 for the high child's lower face), for its one-face triangle filter;
-// kNoFace: the node's own box, whose triangles are the range as it is.
+// kNoFace: the node's own box, whose triangles are the range as it is. Above the face,
+// kSiblingWaits marks a near child whose sibling waits on top of the stack for the end of the
+// triangles it filters (StackEntry::siblingTriEnd).
 const uint kFaceShift = 8u;
 const uint kRuleMask = (1u << kFaceShift) - 1u;
+const uint kFaceMask = 7u;
 const uint kNoFace = 7u;
+const uint kSiblingWaits = 1u << 11u;
+const uint kSiblingNotFiltered = 0xFFFFFFFFu;
+const uint kStallsShift = 16u;
 
 StackEntry nodeEntry(vec3 lo, vec3 hi, uint rayEnd, uint rule, uint face, uint triBegin, uint triEnd, uint depth,
                      uint stalls) {
@@ -107,8 +113,8 @@ StackEntry nodeEntry(vec3 lo, vec3 hi, uint rayEnd, uint rule, uint face, uint t
     e.rayEnd = rayEnd;
     e.triBegin = triBegin;
     e.triEnd = triEnd;
-    e.depth = depth;
-    e.stalls = stalls;
+    e.depthAndStalls = depth | (stalls << kStallsShift);
+    e.siblingTriEnd = kSiblingNotFiltered;
     e.rayRule = rule | (face << kFaceShift);
     return e;
 }
@@ -255,6 +261,7 @@ uint splitNode(ItemContext c, inout Slice s, int axis, float split, uint rayCoun
     }
     s.stackSize += classified ? 2u : 1u;
     s.next = childEntry(nearLo, nearHi, s, classified ? crossingMovingRule(axis, false) : crossing, axis, !lowFirst);
+    if (!classified) s.next.rayRule |= kSiblingWaits;
     return kStepEnterChild;
 }
 
@@ -285,7 +292,8 @@ uint popFarChild(ItemContext c, inout Slice s) {
     uint start = stageClock();
     workgroupSync();
     StackEntry far = sStack[s.stackSize - 1u];
-    uint cost = partitionCost(far.rayEnd - s.terminated) + partitionCost(far.triEnd - far.triBegin) + kStepOverhead;
+    uint filtered = far.siblingTriEnd != kSiblingNotFiltered ? far.siblingTriEnd : far.triEnd;
+    uint cost = partitionCost(far.rayEnd - s.terminated) + partitionCost(filtered - far.triBegin) + kStepOverhead;
     if (overBudget(s.spent, cost + c.retireCost)) return kStepOutOfBudget;
     s.spent += cost;
     s.progressed = true;
@@ -304,7 +312,7 @@ uint popFarChild(ItemContext c, inout Slice s) {
 // where they are constants.
 void enterChild(ItemContext c, inout Slice s) {
     StackEntry e = s.next;
-    uint rule = e.rayRule & kRuleMask, face = e.rayRule >> kFaceShift;
+    uint rule = e.rayRule & kRuleMask, face = (e.rayRule >> kFaceShift) & kFaceMask;
     vec3 lo = e.lo - c.margin, hi = e.hi + c.margin;
     s.lo = e.lo;
     s.hi = e.hi;
@@ -312,13 +320,25 @@ void enterChild(ItemContext c, inout Slice s) {
     s.nodeRayEnd = rule == kKeepCrossing        ? partitionRays(s.terminated, e.rayEnd, kKeepCrossing, lo, hi)
                    : rule == kKeepPacketCrossing ? partitionPackets(s.terminated, e.rayEnd, lo, hi)
                                                  : partitionRays(s.terminated, e.rayEnd, rule, lo, hi);
-    s.triBegin = e.triBegin;
     bool ownBox = face == kNoFace;
-    s.triEnd = ownBox ? e.triEnd
-             : s.nodeRayEnd > s.terminated ? partitionTrianglesAtFace(e.triBegin, e.triEnd, lo, hi, int(face >> 1u), (face & 1u) != 0u)
-                                           : e.triBegin;
-    s.depth = e.depth;
-    s.stalls = ownBox ? e.stalls : (s.nodeRayEnd == e.rayEnd && s.triEnd == e.triEnd ? e.stalls + 1u : 0u);
+    bool hasRays = s.nodeRayEnd > s.terminated;
+    int faceAxis = int(face >> 1u);
+    bool highChild = (face & 1u) != 0u;
+    // A second child whose sibling filtered the parent's triangles takes those of the sibling's
+    // that reach past the split (moved to the end of the sibling's range) and every one behind
+    // it, which the sibling did not take: they lie beyond its face, inside this child's cell.
+    bool afterSibling = !ownBox && hasRays && e.siblingTriEnd != kSiblingNotFiltered;
+    uint filterEnd = afterSibling ? e.siblingTriEnd : e.triEnd;
+    uint filtered = !ownBox && hasRays ? partitionTrianglesAtFace(e.triBegin, filterEnd, lo, hi, faceAxis, highChild, afterSibling)
+                                       : e.triBegin;
+    s.triBegin = afterSibling ? filtered : e.triBegin;
+    s.triEnd = ownBox ? e.triEnd : (afterSibling ? e.triEnd : filtered);
+    if ((e.rayRule & kSiblingWaits) != 0u && c.lane == 0)
+        sStack[s.stackSize - 1u].siblingTriEnd = hasRays ? s.triEnd : kSiblingNotFiltered;
+    s.depth = e.depthAndStalls & ((1u << kStallsShift) - 1u);
+    uint stalls = e.depthAndStalls >> kStallsShift;
+    s.stalls = ownBox ? stalls
+                      : (s.nodeRayEnd == e.rayEnd && s.triBegin == e.triBegin && s.triEnd == e.triEnd ? stalls + 1u : 0u);
 }
 
 // A leaf tests every one of its rays against every one of its triangles, a split only

@@ -166,11 +166,18 @@ const uint kKeepOverlapping = 5u;  // triangles whose bounds overlap the (widene
 // boundsOverlap's six gives its answer (the cpu backend's one-face filter).
 const uint kKeepBelowFace = 14u;  // bounds.lo[axis] <= hi[axis]
 const uint kKeepAboveFace = 15u;  // bounds.hi[axis] >= lo[axis]
+// For these two, bit 2 of `axis` (kBeyondFace) asks for the complement: the triangles wholly
+// beyond the face, which the child does not take (bounds are never NaN: the loader refuses
+// them). A second child filters its sibling's triangles so (enterChild), that those it shares
+// with the sibling end next to those only it has.
+const int kBeyondFace = 4;
 
 bool keepId(uint id, uint rule, vec3 lo, vec3 hi, int axis) {
     if (rule == kKeepOverlapping) return boundsOverlap(TRIANGLE_BOUNDS(id).lo, TRIANGLE_BOUNDS(id).hi, lo, hi);
-    if (rule == kKeepBelowFace) return TRIANGLE_BOUNDS(id).lo[axis] <= hi[axis];
-    if (rule == kKeepAboveFace) return TRIANGLE_BOUNDS(id).hi[axis] >= lo[axis];
+    int faceAxis = axis & 3;
+    bool beyond = (axis & kBeyondFace) != 0;
+    if (rule == kKeepBelowFace) return (TRIANGLE_BOUNDS(id).lo[faceAxis] <= hi[faceAxis]) != beyond;
+    if (rule == kKeepAboveFace) return (TRIANGLE_BOUNDS(id).hi[faceAxis] >= lo[faceAxis]) != beyond;
     if (rule == kKeepPacketCrossing) return packetMayCrossCell(packets[id], lo, hi);
     if (rule == kKeepDone) return rayDone(id);
     return keepRay(id, rule, lo, hi);
@@ -300,11 +307,13 @@ uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
 
 // The node's triangles [begin, end) that overlap its child (the widened cell lo, hi), which
 // moved one face of the node's box along `axis`: the upper face (the low child) or the lower
-// one (the high child).
-uint partitionTrianglesAtFace(uint begin, uint end, vec3 lo, vec3 hi, int axis, bool highChild) {
+// one (the high child). beyond: those wholly beyond that face first instead, the triangles
+// the child does not take.
+uint partitionTrianglesAtFace(uint begin, uint end, vec3 lo, vec3 hi, int axis, bool highChild, bool beyond) {
     uint start = stageClock();
-    uint kept = highChild ? partitionIds(begin, end, kKeepAboveFace, lo, hi, axis)
-                          : partitionIds(begin, end, kKeepBelowFace, lo, hi, axis);
+    int face = axis | (beyond ? kBeyondFace : 0);
+    uint kept = highChild ? partitionIds(begin, end, kKeepAboveFace, lo, hi, face)
+                          : partitionIds(begin, end, kKeepBelowFace, lo, hi, face);
     addStageTicks(DACRT_STAGE_TRIANGLE_PARTITIONS, start);
     return kept;
 }

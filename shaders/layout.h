@@ -127,9 +127,12 @@ struct StackEntry {   // a child waiting, with its parent's ranges
     vec3 hi;
     uint triBegin;
     uint triEnd;
-    uint depth;
-    uint stalls;      // the parent's stalled splits
-    uint rayRule;     // which of the parent's live rays visit it (kKeepCrossing*)
+    uint depthAndStalls;  // the child's depth, and above bit 16 the parent's stalled splits
+    // Where its sibling's triangles end when the sibling went first and filtered the parent's
+    // [triBegin, triEnd): the child then filters [triBegin, siblingTriEnd) only, the rest of
+    // the range being its own already; kSiblingNotFiltered otherwise.
+    uint siblingTriEnd;
+    uint rayRule;     // which of the parent's live rays visit it (kKeepCrossing*), its face, kSiblingWaits
 };
 
 // Which child of a split each ray meets first (FrameGeometry::order).
@@ -318,8 +321,8 @@ static_assert(sizeof(TraversalState) == 64 && offsetof(TraversalState, phase) ==
 static_assert(offsetof(TraversalState, stalls) == 48 && offsetof(TraversalState, leafNext) == 52);
 static_assert(offsetof(TraversalState, cost) == 56 && offsetof(TraversalState, stackSlot) == 60);
 static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalState, stackSize) == 44);
-static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depth) == 36);
-static_assert(offsetof(StackEntry, stalls) == 40 && offsetof(StackEntry, rayRule) == 44);
+static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depthAndStalls) == 36);
+static_assert(offsetof(StackEntry, siblingTriEnd) == 40 && offsetof(StackEntry, rayRule) == 44);
 static_assert(sizeof(DacrtPush) == 68 && offsetof(DacrtPush, loopProbe) == 32 && offsetof(DacrtPush, rayTmax) == 64);
 static_assert(offsetof(DacrtPush, packetRaysAt) == 48 && offsetof(DacrtPush, doneFlagsAt) == 52);
 static_assert(offsetof(DacrtPush, packetIdsAt) == 56 && offsetof(DacrtPush, packetCount) == 60);

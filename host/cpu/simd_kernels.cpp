@@ -164,20 +164,30 @@ std::uint32_t PartitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids
                           : partitionRays<false>(rays, hits, ids, count, cell, scratch);
 }
 
-std::uint32_t PartitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
-                                       bool lowSide, float bound, std::uint32_t* scratch) {
-    const float* b = reinterpret_cast<const float*>(bounds) + (lowSide ? 0 : 4) + axis;
+template <bool kLowSide, bool kReaching>
+HWY_INLINE std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
+                                                  int axis, float bound, std::uint32_t* scratch) {
+    const float* b = reinterpret_cast<const float*>(bounds) + (kLowSide ? 0 : 4) + axis;
     const DF df;
     const DI di;
     const DU du;
     const VF face = hn::Set(df, bound);
-    if (lowSide)
-        return stablePartition(ids, count, scratch, [&](VU id) {
-            return hn::RebindMask(du, hn::GatherIndex(df, b, hn::ShiftLeft<3>(hn::BitCast(di, id))) <= face);
-        });
     return stablePartition(ids, count, scratch, [&](VU id) {
-        return hn::RebindMask(du, hn::GatherIndex(df, b, hn::ShiftLeft<3>(hn::BitCast(di, id))) >= face);
+        const VF coordinate = hn::GatherIndex(df, b, hn::ShiftLeft<3>(hn::BitCast(di, id)));
+        const MF reaches = kLowSide ? coordinate <= face : coordinate >= face;
+        // Bounds are never NaN (the loader refuses such vertices): beyond is the comparison negated.
+        return hn::RebindMask(du, kReaching ? reaches : hn::Not(reaches));
     });
+}
+
+std::uint32_t PartitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
+                                       bool lowSide, float bound, std::uint32_t* scratch, FaceSide keep) {
+    const bool reaching = keep == FaceSide::Reaching;
+    if (lowSide)
+        return reaching ? partitionTrianglesOnFace<true, true>(bounds, ids, count, axis, bound, scratch)
+                        : partitionTrianglesOnFace<true, false>(bounds, ids, count, axis, bound, scratch);
+    return reaching ? partitionTrianglesOnFace<false, true>(bounds, ids, count, axis, bound, scratch)
+                    : partitionTrianglesOnFace<false, false>(bounds, ids, count, axis, bound, scratch);
 }
 
 HWY_INLINE bool triangleHasNoArea(const LeafTriangles& batch, std::size_t j) {
@@ -382,8 +392,8 @@ std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::u
 }
 
 std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
-                                       bool lowSide, float bound, std::uint32_t* scratch) {
-    return HWY_DYNAMIC_DISPATCH(PartitionTrianglesOnFace)(bounds, ids, count, axis, lowSide, bound, scratch);
+                                       bool lowSide, float bound, std::uint32_t* scratch, FaceSide keep) {
+    return HWY_DYNAMIC_DISPATCH(PartitionTrianglesOnFace)(bounds, ids, count, axis, lowSide, bound, scratch, keep);
 }
 
 void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds, std::uint32_t count,

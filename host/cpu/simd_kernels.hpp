@@ -36,8 +36,11 @@ std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::u
 // from this one only in one face, on `axis`: what shared::boundsOverlap with this cell
 // answers then is the one comparison that face adds, lo[axis] <= bound for a new high face
 // (lowSide) or hi[axis] >= bound for a new low face. One gather per id instead of six.
+// FaceSide::Beyond keeps the others first instead: the triangles wholly beyond the face.
+enum class FaceSide { Reaching, Beyond };
 std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
-                                       bool lowSide, float bound, std::uint32_t* scratch);
+                                       bool lowSide, float bound, std::uint32_t* scratch,
+                                       FaceSide keep = FaceSide::Reaching);
 
 // Up to kLeafBatch triangles of a leaf in structure-of-arrays form: coordinate c of vertex k
 // of triangle j is vertex[k][c][j]. Lanes past `count` are padding and never hit.

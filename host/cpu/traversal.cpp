@@ -94,6 +94,8 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       order_(g.order),
       orderPoint_(g.nearSide),
       anyHit_(g.query == HitQuery::Any),
+      triangleOrderFree_(options.split == SplitMethod::SpatialMedian && options.splitCost == SplitCost::Limits &&
+                         options.triangleFilter == TriangleFilter::Bounds),
       margin_(g.margin),
       options_(options.resolvedFor(Backend::Cpu)),
       hits_(buffers.hits),
@@ -181,6 +183,19 @@ std::uint32_t DacrtTraversal::filterTriangles(const Box& child, const Box& cell,
     return std::uint32_t(first - triIds_);
 }
 
+std::uint32_t DacrtTraversal::filterTrianglesAfterSibling(const Box& cell, std::uint32_t begin, std::uint32_t siblingEnd,
+                                                          int axis, bool lowChild) {
+    if (simd_)
+        return begin + simd::partitionTrianglesOnFace(triangleBounds_, triIds_ + begin, siblingEnd - begin, axis, lowChild,
+                                                      lowChild ? cell.hi[axis] : cell.lo[axis], scratch_,
+                                                      simd::FaceSide::Beyond);
+    std::uint32_t* first = std::partition(triIds_ + begin, triIds_ + siblingEnd, [&](std::uint32_t id) {
+        const Bounds& b = triangleBounds_[id];
+        return !shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
+    });
+    return std::uint32_t(first - triIds_);
+}
+
 float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const {
     const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
     if (options_.split == SplitMethod::SpatialMedian) return mid;
@@ -200,7 +215,8 @@ float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triB
 // The split both recursions share (node over rays, nodePackets over packets): the longest
 // axis at the split position (or, under SplitCost::RaySampling, the axis and position the
 // sampled estimate finds cheapest), then the children front to back, each with its items and
-// triangles filtered from the node's. With a common order (ChildOrder::NearSide) or
+// triangles filtered from the node's (a second of two children, its triangles from the first's:
+// filterTrianglesAfterSibling). With a common order (ChildOrder::NearSide) or
 // for any hit (where order changes no result) every item visits the near child, then the far
 // one; with ChildOrder::PerRay the rays moving up visit the low child, then all rays the high
 // one, then the rays moving down the low one, so that each ray meets its children in the
@@ -233,14 +249,24 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
         visits[1] = {&high, 0};
         visits[2] = {anyHit_ ? nullptr : &low, -1};
     }
+    // Where the triangles of the first child filtered end: a second child takes its triangles
+    // from the first's range (those reaching past the split) and from behind it (those the
+    // first child left), so it filters the first child's triangles only, not the node's.
+    std::uint32_t firstChildTris = triBegin;
+    const bool secondFromFirst = visits[2].child == nullptr && triangleOrderFree_;
     for (const Visit& visit : visits) {
         if (!visit.child) break;
         const Box cell = widen(*visit.child, margin_);
         const std::uint32_t childItems = filterItems(cell, itemBegin, itemEnd, axis, visit.moving);
         if (childItems == itemBegin) continue;
-        const std::uint32_t childTris = filterTriangles(*visit.child, cell, triBegin, triEnd, axis, visit.child == &low);
-        const bool stalled = childItems == itemEnd && childTris == triEnd;
-        descend(*visit.child, childItems, childTris, depth + 1, stalled ? stalls + 1 : 0);
+        const bool lowChild = visit.child == &low;
+        std::uint32_t childBegin = triBegin, childEnd = triEnd;
+        if (secondFromFirst && firstChildTris != triBegin)
+            childBegin = filterTrianglesAfterSibling(cell, triBegin, firstChildTris, axis, lowChild);
+        else
+            childEnd = firstChildTris = filterTriangles(*visit.child, cell, triBegin, triEnd, axis, lowChild);
+        const bool stalled = childItems == itemEnd && childBegin == triBegin && childEnd == triEnd;
+        descend(*visit.child, childItems, childBegin, childEnd, depth + 1, stalled ? stalls + 1 : 0);
     }
     return true;
 }
@@ -267,9 +293,8 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
         options_.splitCost == SplitCost::RaySampling, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving) {
             return filterRaysMoving(cell, begin, end, axis, moving);
         },
-        [&](const Box& child, std::uint32_t childRays, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
-            node(child, terminated, childRays, triBegin, childTris, d, s);
-        });
+        [&](const Box& child, std::uint32_t childRays, std::uint32_t childTriBegin, std::uint32_t childTriEnd,
+            std::uint32_t d, std::uint32_t s) { node(child, terminated, childRays, childTriBegin, childTriEnd, d, s); });
     if (!split) leaf(box, terminated, rayEnd, triBegin, triEnd);
 }
 
@@ -339,9 +364,8 @@ void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std:
     const bool split = splitNode(
         box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls, packetEnd - packetBegin < options_.packetFlush,
         false, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int) { return filterPackets(cell, begin, end); },
-        [&](const Box& child, std::uint32_t childPackets, std::uint32_t childTris, std::uint32_t d, std::uint32_t s) {
-            nodePackets(child, packetBegin, childPackets, triBegin, childTris, d, s);
-        });
+        [&](const Box& child, std::uint32_t childPackets, std::uint32_t childTriBegin, std::uint32_t childTriEnd,
+            std::uint32_t d, std::uint32_t s) { nodePackets(child, packetBegin, childPackets, childTriBegin, childTriEnd, d, s); });
     if (!split) flushPackets(box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls);
 }
 

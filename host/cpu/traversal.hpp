@@ -154,6 +154,14 @@ private:
     // widened cell, which the roots' do (scene bounds; region binning) and so every child's.
     std::uint32_t filterTriangles(const Box& child, const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
                                   bool lowChild);
+    // The second child's triangles, when the first child's subtree has left its own (those
+    // filterTriangles kept) at [begin, siblingEnd) and the ones it dropped behind them: the
+    // sibling's triangles that do not overlap cell move first, so that this child's are
+    // [returned, the node's end): the sibling's that reach past the split, then those only
+    // this child has (a triangle the sibling dropped lies beyond the sibling's face, so within
+    // this child's cell). Returns where they begin. Only where triangleOrderFree_.
+    std::uint32_t filterTrianglesAfterSibling(const Box& cell, std::uint32_t begin, std::uint32_t siblingEnd, int axis,
+                                              bool lowChild);
     float splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const;
 
     const Ray* rays_;
@@ -162,6 +170,10 @@ private:
     ChildOrder order_;
     glm::vec3 orderPoint_;  // FrameGeometry::nearSide
     bool anyHit_;           // HitQuery::Any: a ray ends at its first hit
+    // No split reads the order of a node's triangle ids (the spatial median, the leaf limits)
+    // and the filter is the bounds test: a second child may then take its triangles from its
+    // sibling's (filterTrianglesAfterSibling) in another order than a filter of the node's.
+    bool triangleOrderFree_;
     float margin_;
     DacrtOptions options_;
     Hit* hits_;

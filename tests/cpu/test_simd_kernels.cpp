@@ -137,7 +137,7 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
 }
 
 // Children of a cell the triangles overlap: the one-face test answers boundsOverlap.
-TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCell) {
+TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCellAndItsComplement) {
     forEachTarget([] {
         Random rng(14);
         PartitionTally tally;
@@ -158,13 +158,16 @@ TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCell) {
             const std::uint32_t count = std::uint32_t(rng.index(70));
             std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(bounds.size()), count);
             for (const Bounds& b : bounds) ASSERT_TRUE(shared::boundsOverlap(b.lo, b.hi, parent.lo, parent.hi));
+            // Beyond: the complement, as a second child filters its sibling's triangles.
+            const simd::FaceSide side = rng.uniform() < 0.5 ? simd::FaceSide::Reaching : simd::FaceSide::Beyond;
             std::uint32_t expectedKept = 0;
             const std::vector<std::uint32_t> expected = scalarPartition(ids, expectedKept, [&](std::uint32_t id) {
-                return shared::boundsOverlap(bounds[id].lo, bounds[id].hi, child.lo, child.hi);
+                return shared::boundsOverlap(bounds[id].lo, bounds[id].hi, child.lo, child.hi) ==
+                       (side == simd::FaceSide::Reaching);
             });
             std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
             const std::uint32_t kept =
-                simd::partitionTrianglesOnFace(bounds.data(), ids.data(), count, axis, lowSide, face, scratch.data());
+                simd::partitionTrianglesOnFace(bounds.data(), ids.data(), count, axis, lowSide, face, scratch.data(), side);
             ASSERT_TRUE(tally.check(kept, expectedKept, ids, expected)) << "trial " << trial;
         }
         EXPECT_GT(tally.kept, 1000u);
