@@ -105,6 +105,11 @@ const uint kSiblingWaits = 1u << 11u;
 const uint kSiblingNotFiltered = 0xFFFFFFFFu;
 const uint kStallsShift = 16u;
 
+// Where the triangles an entry filters end: its sibling's, where the sibling filtered first.
+uint filteredTriEnd(StackEntry e) {
+    return e.siblingTriEnd != kSiblingNotFiltered ? e.siblingTriEnd : e.triEnd;
+}
+
 StackEntry nodeEntry(vec3 lo, vec3 hi, uint rayEnd, uint rule, uint face, uint triBegin, uint triEnd, uint depth,
                      uint stalls) {
     StackEntry e;
@@ -292,8 +297,7 @@ uint popFarChild(ItemContext c, inout Slice s) {
     uint start = stageClock();
     workgroupSync();
     StackEntry far = sStack[s.stackSize - 1u];
-    uint filtered = far.siblingTriEnd != kSiblingNotFiltered ? far.siblingTriEnd : far.triEnd;
-    uint cost = partitionCost(far.rayEnd - s.terminated) + partitionCost(filtered - far.triBegin) + kStepOverhead;
+    uint cost = partitionCost(far.rayEnd - s.terminated) + partitionCost(filteredTriEnd(far) - far.triBegin) + kStepOverhead;
     if (overBudget(s.spent, cost + c.retireCost)) return kStepOutOfBudget;
     s.spent += cost;
     s.progressed = true;
@@ -328,8 +332,7 @@ void enterChild(ItemContext c, inout Slice s) {
     // that reach past the split (moved to the end of the sibling's range) and every one behind
     // it, which the sibling did not take: they lie beyond its face, inside this child's cell.
     bool afterSibling = !ownBox && hasRays && e.siblingTriEnd != kSiblingNotFiltered;
-    uint filterEnd = afterSibling ? e.siblingTriEnd : e.triEnd;
-    uint filtered = !ownBox && hasRays ? partitionTrianglesAtFace(e.triBegin, filterEnd, lo, hi, faceAxis, highChild, afterSibling)
+    uint filtered = !ownBox && hasRays ? partitionTrianglesAtFace(e.triBegin, filteredTriEnd(e), lo, hi, faceAxis, highChild, afterSibling)
                                        : e.triBegin;
     s.triBegin = afterSibling ? filtered : e.triBegin;
     s.triEnd = ownBox ? e.triEnd : (afterSibling ? e.triEnd : filtered);

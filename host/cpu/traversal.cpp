@@ -159,15 +159,7 @@ std::uint32_t DacrtTraversal::filterTriangles(const Box& child, const Box& cell,
     std::uint32_t* first = triIds_ + begin;
     switch (options_.triangleFilter) {
         case TriangleFilter::Bounds:
-            if (simd_)
-                return begin + simd::partitionTrianglesOnFace(triangleBounds_, triIds_ + begin, end - begin, axis,
-                                                              lowChild, lowChild ? cell.hi[axis] : cell.lo[axis],
-                                                              scratch_);
-            first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
-                const Bounds& b = triangleBounds_[id];
-                return shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
-            });
-            break;
+            return partitionTrianglesByBounds(cell, begin, end, axis, lowChild, simd::FaceSide::Reaching);
         case TriangleFilter::Sat:
             first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
                 return triangleOverlapsBoxSat(triangles_[id], triangleBounds_[id], cell.lo, cell.hi);
@@ -185,13 +177,18 @@ std::uint32_t DacrtTraversal::filterTriangles(const Box& child, const Box& cell,
 
 std::uint32_t DacrtTraversal::filterTrianglesAfterSibling(const Box& cell, std::uint32_t begin, std::uint32_t siblingEnd,
                                                           int axis, bool lowChild) {
+    return partitionTrianglesByBounds(cell, begin, siblingEnd, axis, lowChild, simd::FaceSide::Beyond);
+}
+
+std::uint32_t DacrtTraversal::partitionTrianglesByBounds(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
+                                                         bool lowChild, simd::FaceSide keep) {
     if (simd_)
-        return begin + simd::partitionTrianglesOnFace(triangleBounds_, triIds_ + begin, siblingEnd - begin, axis, lowChild,
-                                                      lowChild ? cell.hi[axis] : cell.lo[axis], scratch_,
-                                                      simd::FaceSide::Beyond);
-    std::uint32_t* first = std::partition(triIds_ + begin, triIds_ + siblingEnd, [&](std::uint32_t id) {
+        return begin + simd::partitionTrianglesOnFace(triangleBounds_, triIds_ + begin, end - begin, axis, lowChild,
+                                                      lowChild ? cell.hi[axis] : cell.lo[axis], scratch_, keep);
+    const bool reaching = keep == simd::FaceSide::Reaching;
+    std::uint32_t* first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {
         const Bounds& b = triangleBounds_[id];
-        return !shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi);
+        return shared::boundsOverlap(b.lo, b.hi, cell.lo, cell.hi) == reaching;
     });
     return std::uint32_t(first - triIds_);
 }

@@ -162,6 +162,10 @@ private:
     // this child's cell). Returns where they begin. Only where triangleOrderFree_.
     std::uint32_t filterTrianglesAfterSibling(const Box& cell, std::uint32_t begin, std::uint32_t siblingEnd, int axis,
                                               bool lowChild);
+    // The bounds filter of both: the triangles of [begin, end) that reach into cell (Reaching)
+    // or those wholly beyond its face on axis (Beyond) first.
+    std::uint32_t partitionTrianglesByBounds(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
+                                             bool lowChild, simd::FaceSide keep);
     float splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const;
 
     const Ray* rays_;
