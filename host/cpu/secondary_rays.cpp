@@ -48,17 +48,28 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
     SecondaryRays out;
     out.slotCount = secondarySlots(pass, primary.size());
     const std::uint32_t perHit = pass.raysPerHit;
-    // Chunks of primary rays made in parallel, each into the front of its own slots, then moved
-    // down in slot order: one allocation (fresh pages cost a fault each on a VM), no copies.
-    out.rays.resize(out.slotCount);
-    out.slots.resize(out.slotCount);
+    // Chunks of primary rays made in parallel, each into its own stretch of one allocation,
+    // then moved down in slot order. A stretch holds raysPerHit rays for each of the chunk's
+    // hits (a miss sends none), not one per slot: where few primary rays hit (the Dragon's 48k
+    // of 307k), the slots' size would be mostly untouched memory, zeroed and faulted in for
+    // every pass (fresh pages cost a fault each on a VM).
     const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(256, primary.size() / 1024 + 1));
-    std::vector<std::size_t> made(chunks, 0);
-    auto firstSlot = [&](std::size_t c) { return primary.size() * c / chunks * perHit; };
+    auto chunkBegin = [&](std::size_t c) { return primary.size() * c / chunks; };
+    std::vector<std::size_t> stretch(chunks + 1, 0);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        const std::size_t begin = primary.size() * c / chunks, end = primary.size() * (c + 1) / chunks;
+        std::size_t hits = 0;
+        for (std::size_t i = chunkBegin(c), end = chunkBegin(c + 1); i < end; ++i)
+            hits += primaryHits[i].prim != kMissPrim && primaryHits[i].prim != kNotTracedPrim;
+        stretch[c + 1] = hits * perHit;
+    });
+    for (std::size_t c = 0; c < chunks; ++c) stretch[c + 1] += stretch[c];
+    out.rays.resize(stretch[chunks]);
+    out.slots.resize(stretch[chunks]);
+    std::vector<std::size_t> made(chunks, 0);
+    auto firstSlot = [&](std::size_t c) { return stretch[c]; };
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
         std::size_t next = firstSlot(c);
-        for (std::size_t i = begin; i < end; ++i)
+        for (std::size_t i = chunkBegin(c), end = chunkBegin(c + 1); i < end; ++i)
             secondaryRaysOf(pass, std::uint32_t(i), primaryHits[i], [&]() -> const Ray& { return primary[i]; }, triangles,
                             [&](std::uint32_t slot, const Ray& ray) {
                                 out.rays[next] = ray;
