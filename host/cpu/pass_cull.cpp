@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace dacrt {
 namespace {
@@ -47,15 +49,25 @@ Interval clipped(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi) {
     return iv;
 }
 
-// A float no greater (no less) than x.
+// The float next to f towards -inf, as std::nextafter (-FLT_MAX steps to -inf, which the
+// grid's cellOf clamps to the cell FLT_MAX's direction would give).
+std::int32_t floatBitsStepDown(std::int32_t bits) {
+    bits = bits == 0 ? std::numeric_limits<std::int32_t>::min() : bits;  // +0 steps as -0 does
+    return bits + (bits < 0 ? 1 : -1);
+}
+
+// The float nearest to x, stepped once towards -inf where it is above x: no float is between
+// it and x. Without branches (a mask picks the step): the grid's marking asks for six a piece
+// of segment, and whether a step is needed is a coin toss that a branch predictor loses
+// (it cost the Dragon's shadow pass half of its marking time).
 float floatBelow(double x) {
     const float f = float(x);
-    return double(f) > x ? std::nextafter(f, -kNoHitT) : f;
+    const std::int32_t bits = std::bit_cast<std::int32_t>(f);
+    const std::int32_t step = -std::int32_t(double(f) > x);
+    return std::bit_cast<float>((floatBitsStepDown(bits) & step) | (bits & ~step));
 }
-float floatAbove(double x) {
-    const float f = float(x);
-    return double(f) < x ? std::nextafter(f, kNoHitT) : f;
-}
+// The same towards +inf: a float no less than x.
+float floatAbove(double x) { return -floatBelow(-x); }
 
 // What the cull learns from one pass over the rays.
 struct RaySurvey {
@@ -116,15 +128,19 @@ int RayGrid::cellOf(float x, int k) const {
 // Cells from..to of a row, as bits.
 std::uint64_t rowBits(int from, int to) { return (~0ull >> (63 - to)) & (~0ull << from); }
 
-void RayGrid::markBox(const glm::dvec3& lo, const glm::dvec3& hi) {
-    int from[3], to[3];
+RayGrid::CellSpan RayGrid::cellsNear(const glm::dvec3& p) const {
+    CellSpan span;
     for (int k = 0; k < 3; ++k) {
-        from[k] = cellOf(floatBelow(lo[axis_[k]] - grow_), k);
-        to[k] = cellOf(floatAbove(hi[axis_[k]] + grow_), k);
+        span.from[k] = cellOf(floatBelow(p[axis_[k]] - grow_), k);
+        span.to[k] = cellOf(floatAbove(p[axis_[k]] + grow_), k);
     }
-    const std::uint64_t bits = rowBits(from[0], to[0]);
-    for (int z = from[2]; z <= to[2]; ++z)
-        for (int y = from[1]; y <= to[1]; ++y) {
+    return span;
+}
+
+void RayGrid::markCells(const CellSpan& cells) {
+    const std::uint64_t bits = rowBits(cells.from[0], cells.to[0]);
+    for (int z = cells.from[2]; z <= cells.to[2]; ++z)
+        for (int y = cells.from[1]; y <= cells.to[1]; ++y) {
             std::atomic_ref<std::uint64_t> row(rows_[std::size_t(z) * n_[1] + y]);
             if ((row.load(std::memory_order_relaxed) & bits) != bits) row.fetch_or(bits, std::memory_order_relaxed);
         }
@@ -134,15 +150,22 @@ void RayGrid::markRay(const Ray& ray) {
     const Interval iv = clipped(ray, clipLo_, clipHi_);
     if (!(iv.t0 <= iv.t1)) return;  // the segment misses the scene box: it hits nothing
     const glm::dvec3 o(ray.origin), d(ray.dir);
-    // Pieces of at most one cell along every axis, each marked with its box.
+    // Pieces of at most one cell along every axis, each marked with the cells of its box grown
+    // by twice the margin. cellsNear is monotone in each coordinate, so a piece's cells are
+    // those of its two ends joined, and each end's are found once.
     double span = 0.0;
     for (int k = 0; k < 3; ++k) span = std::max(span, std::abs(d[axis_[k]]) * (iv.t1 - iv.t0) * double(scale_[k]));
     const int pieces = int(std::clamp(std::ceil(span), 1.0, double(4 * kMaxCells)));
-    glm::dvec3 from = o + iv.t0 * d;
+    CellSpan from = cellsNear(o + iv.t0 * d);
     for (int k = 1; k <= pieces; ++k) {
         const double t = k == pieces ? iv.t1 : iv.t0 + (iv.t1 - iv.t0) * double(k) / double(pieces);
-        const glm::dvec3 to = o + t * d;
-        markBox(glm::min(from, to), glm::max(from, to));
+        const CellSpan to = cellsNear(o + t * d);
+        CellSpan piece;
+        for (int a = 0; a < 3; ++a) {
+            piece.from[a] = std::min(from.from[a], to.from[a]);
+            piece.to[a] = std::max(from.to[a], to.to[a]);
+        }
+        markCells(piece);
         from = to;
     }
 }

@@ -35,9 +35,15 @@ public:
     unsigned cellsAlongLongest() const { return longest_; }
 
 private:
+    // Cells from[k]..to[k] along the grid's axis k, inclusive.
+    struct CellSpan {
+        int from[3], to[3];
+    };
     int cellOf(float x, int k) const;  // along the grid's axis k
+    // The cells of the box around p grown by twice the margin, each bound rounded outwards.
+    CellSpan cellsNear(const glm::dvec3& p) const;
+    void markCells(const CellSpan& cells);
     void markRay(const Ray& ray);
-    void markBox(const glm::dvec3& lo, const glm::dvec3& hi);
 
     unsigned longest_ = 1;
     // The grid's axes: axis_[0] the shortest side's (along a word), then the other two; n_,
