@@ -69,6 +69,17 @@ HWY_INLINE VU compressIds(VU v, hn::Mask<DU> m) {
 #endif
 }
 
+// The floats base[id * kStride + offset] of the ids in idLanes, a vector of them, with a plain
+// load per lane: on this project's AMD Zen 5 VM, AVX-512's gathers cost more than the loads
+// (Intel's Downfall mitigation slows gathers too); docs/cpu-reference.md, "Loads per lane".
+template <std::size_t kStride>
+HWY_INLINE VF loadPerLane(const float* base, const std::uint32_t* idLanes, std::size_t offset) {
+    const DF df;
+    alignas(64) float lanes[64];
+    for (std::size_t l = 0; l < hn::Lanes(df); ++l) lanes[l] = base[std::size_t(idLanes[l]) * kStride + offset];
+    return hn::Load(df, lanes);
+}
+
 // Ids that pass first (compressed in place: the write position never passes the read
 // position), the others through scratch behind them. Both keep their order. Each compressed
 // vector is stored whole: its lanes past the count land on ids already read, or on the
@@ -132,7 +143,6 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
     const float* ray = reinterpret_cast<const float*>(rays);
     const float* hit = reinterpret_cast<const float*>(hits);
     const DF df;
-    const DI di;
     const DU du;
     // Shared: every ray's origin and tmin are rays[0]'s bit for bit, so one broadcast gives
     // each lane the value a gather would.
@@ -140,9 +150,9 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
                                 hn::Set(df, rays[0].origin.z)};
     const VF sharedTmin = hn::Set(df, rays[0].tmin);
     return stablePartition(ids, count, scratch, [&](VU id) {
-        const auto index = hn::BitCast(di, id);
-        const auto base = hn::ShiftLeft<4>(index);
-        auto field = [&](int offset) { return hn::GatherIndex(df, ray, hn::Add(base, hn::Set(di, offset))); };
+        alignas(64) std::uint32_t idLanes[64];
+        hn::Store(id, du, idLanes);
+        auto field = [&](std::size_t offset) { return loadPerLane<16>(ray, idLanes, offset); };
         // shared::rayMayCrossCell: origin at floats 0-2 of a Ray, tmin at 3, invDir at 8-10;
         // the best t so far is float 0 of the Hit. The leaf then finds both lines in cache.
         VF xn, xf, yn, yf, zn, zf;
@@ -152,7 +162,7 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
         const VF tNear = maxLike(xn, maxLike(yn, zn));
         const VF tFar = minLike(xf, minLike(yf, zf));
         const VF tmin = kSharedStart ? sharedTmin : field(3);
-        const VF tmax = hn::GatherIndex(df, hit, hn::ShiftLeft<2>(index));
+        const VF tmax = loadPerLane<4>(hit, idLanes, 0);
         const MF m = hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
         return hn::RebindMask(du, m);
     });
@@ -169,11 +179,12 @@ HWY_INLINE std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uin
                                                   int axis, float bound, std::uint32_t* scratch) {
     const float* b = reinterpret_cast<const float*>(bounds) + (kLowSide ? 0 : 4) + axis;
     const DF df;
-    const DI di;
     const DU du;
     const VF face = hn::Set(df, bound);
     return stablePartition(ids, count, scratch, [&](VU id) {
-        const VF coordinate = hn::GatherIndex(df, b, hn::ShiftLeft<3>(hn::BitCast(di, id)));
+        alignas(64) std::uint32_t idLanes[64];
+        hn::Store(id, du, idLanes);
+        const VF coordinate = loadPerLane<8>(b, idLanes, 0);
         const MF reaches = kLowSide ? coordinate <= face : coordinate >= face;
         // Bounds are never NaN (the loader refuses such vertices): beyond is the comparison negated.
         return hn::RebindMask(du, kReaching ? reaches : hn::Not(reaches));
@@ -199,26 +210,22 @@ HWY_INLINE bool triangleHasNoArea(const LeafTriangles& batch, std::size_t j) {
 void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds, std::uint32_t count,
                          LeafTriangles& batch) {
     static_assert(sizeof(Triangle) == 12 * sizeof(float));
-    const float* tri = reinterpret_cast<const float*>(triangles);
-    const DF df;
-    const DI di;
+    static_assert(offsetof(Triangle, cullBackFace) == 3 * sizeof(float));
     const DU du;
     const std::size_t n = hn::Lanes(du);
     batch.count = count;
-    for (std::size_t j = 0; j < count; j += n) {
-        // Past count: the batch's first triangle again, whose extra lanes the tests never read
-        // as hits (FirstN).
-        alignas(64) std::uint32_t ids[64];
-        std::fill(ids, ids + 64, triIds[j]);
-        std::copy(triIds + j, triIds + std::min<std::size_t>(count, j + n), ids);
-        const VU id = hn::Load(du, ids);
-        hn::Store(id, du, &batch.prim[j]);
-        const auto base = hn::Mul(hn::BitCast(di, id), hn::Set(di, 12));
+    // Each triangle's fields copied into its lane with plain loads and stores, not ten gathers a
+    // vector of lanes (loadPerLane says why). Past count: the batch's first triangle again, whose extra lanes the tests never read as
+    // hits (FirstN).
+    const std::size_t lanes = (std::size_t(count) + n - 1) / n * n;
+    for (std::size_t j = 0; j < lanes; ++j) {
+        const std::uint32_t id = triIds[j < count ? j : 0];
+        const Triangle& t = triangles[id];
+        batch.prim[j] = id;
+        const glm::vec3* v[3] = {&t.v0, &t.v1, &t.v2};
         for (int k = 0; k < 3; ++k)
-            for (int c = 0; c < 3; ++c)
-                hn::Store(hn::GatherIndex(df, tri, hn::Add(base, hn::Set(di, 4 * k + c))), df, &batch.vertex[k][c][j]);
-        static_assert(offsetof(Triangle, cullBackFace) == 3 * sizeof(float));
-        hn::Store(hn::BitCast(du, hn::GatherIndex(df, tri, hn::Add(base, hn::Set(di, 3)))), du, &batch.cullBackFace[j]);
+            for (int c = 0; c < 3; ++c) batch.vertex[k][c][j] = (*v[k])[c];
+        batch.cullBackFace[j] = t.cullBackFace;
     }
 }
 
