@@ -289,6 +289,38 @@ TEST(SecondaryRays, ABatchOfSamplesMakesTheRaysTheWholePassWould) {
     EXPECT_EQ(compared, all.rays.size());
 }
 
+TEST(SecondaryRays, MadeInChunksAreEveryRayOfTheDefinitionInSlotOrder) {
+    // makeSecondaryRays makes the rays in chunks of 1,024 primary rays, each into room for its
+    // own hits: the result must be secondaryRaysOf's rays, primary ray by primary ray, whatever
+    // the chunks hit (here the scene fills part of the view, so some chunks hit nothing and
+    // the shadow pass leaves out the surfaces the light cannot reach).
+    CameraOptions o;
+    o.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(shapesScene(), 96, 72, o);
+    const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
+    std::size_t missing = 0;
+    for (const Hit& h : primary.hits) missing += h.prim == kMissPrim;
+    ASSERT_GT(missing, frame.rays.size() / 10);
+    ASSERT_LT(missing, frame.rays.size() - frame.rays.size() / 10);
+    ThreadPool pool(2);
+    for (const SecondaryPass& pass : {occlusionPass(3, 0.8f), pointShadowPass({0.3f, 1.6f, 0.4f})}) {
+        std::vector<Ray> rays;
+        std::vector<std::uint32_t> slots;
+        for (std::uint32_t i = 0; i < frame.rays.size(); ++i)
+            secondaryRaysOf(pass, i, primary.hits[i], [&]() -> const Ray& { return frame.rays[i]; },
+                            frame.scene.triangles, [&](std::uint32_t slot, const Ray& ray) {
+                                rays.push_back(ray);
+                                slots.push_back(slot);
+                            });
+        const SecondaryRays made = makeSecondaryRays(pass, frame.rays, primary.hits, frame.scene.triangles, pool);
+        EXPECT_EQ(made.slotCount, std::uint64_t(frame.rays.size()) * pass.raysPerHit) << pass.name;
+        ASSERT_GT(rays.size(), 1000u) << pass.name;
+        ASSERT_EQ(made.slots, slots) << pass.name;
+        ASSERT_EQ(made.rays.size(), rays.size()) << pass.name;
+        EXPECT_EQ(std::memcmp(made.rays.data(), rays.data(), rays.size() * sizeof(Ray)), 0) << pass.name;
+    }
+}
+
 TEST(SecondaryRays, GroupingByOctantIsAStablePermutationThatHitsPerSlotUndoes) {
     CameraOptions o;
     o.eye = glm::dvec3(0.5, 1.5, 4.0);
