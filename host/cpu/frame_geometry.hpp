@@ -44,7 +44,6 @@ struct FrameGeometry {
     HitQuery query = HitQuery::Closest;
     float margin = 0.0f;    // filter widening, see filterMargin()
     bool raysShareStart = false;  // see raysShareStart()
-    bool raysShareSegment = false;  // see raysShareSegment(); found for secondary passes' frames only
     std::uint32_t imageWidth = 0;  // rays are an image's pixels, row by row, this many a row (0: unknown)
     // Primary rays of one camera: the pyramid they lie in (the view-frustum skip needs it).
     std::optional<ViewFrustum> frustum;

@@ -106,7 +106,6 @@ FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles,
                              const std::vector<Bounds>& bounds, const std::vector<Ray>& rays, const Box& sceneBox) {
     FrameGeometry g = frameGeometry(triangles, bounds, rays, sceneBox);
     g.query = HitQuery::Any;
-    g.raysShareSegment = raysShareSegment(rays);
     return g;
 }
 

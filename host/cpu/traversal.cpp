@@ -20,13 +20,6 @@ int longestAxis(const Box& b) {
     return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
 }
 
-// What the ray filter may broadcast from the first ray (simd::SharedRayFields).
-simd::SharedRayFields sharedRayFieldsOf(const FrameGeometry& g) {
-    if (g.raysShareStart) return simd::SharedRayFields::Start;
-    if (g.query == HitQuery::Any && g.raysShareSegment) return simd::SharedRayFields::Segment;
-    return simd::SharedRayFields::None;
-}
-
 }  // namespace
 
 std::uint64_t packetTiles(const FrameGeometry& g) {
@@ -109,7 +102,7 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       rayIds_(buffers.rayIds),
       triIds_(buffers.triIds),
       scratch_(buffers.scratch),
-      sharedRayFields_(sharedRayFieldsOf(g)),
+      raysShareStart_(g.raysShareStart),
       simd_(scratch_ && usesSimd(g, options_)),
       packets_(simd_ && buffers.packets.packetRays && usesPackets(g, options_)),
       packet_(buffers.packets),
@@ -144,7 +137,7 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
 
 [[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
     counters_.rayBoxTests += end - begin;
-    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, hits_, rayIds_ + begin, end - begin, cell, sharedRayFields_,
+    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, hits_, rayIds_ + begin, end - begin, cell, raysShareStart_,
                                                             scratch_);
     std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
         return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);

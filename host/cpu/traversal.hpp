@@ -184,9 +184,7 @@ private:
     std::uint32_t* rayIds_;
     std::uint32_t* triIds_;
     std::uint32_t* scratch_;
-    // What the ray filter may broadcast from the first ray: the start of primary rays, or the
-    // segment of any-hit rays (whose live ones have no hit, so their best t is the segment's end).
-    simd::SharedRayFields sharedRayFields_;
+    bool raysShareStart_;
     bool simd_;
     bool packets_;
     PacketBuffers packet_;
