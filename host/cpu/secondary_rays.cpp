@@ -58,28 +58,26 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
     std::vector<std::size_t> stretch(chunks + 1, 0);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
         std::size_t hits = 0;
-        for (std::size_t i = chunkBegin(c), end = chunkBegin(c + 1); i < end; ++i)
-            hits += primaryHits[i].prim != kMissPrim && primaryHits[i].prim != kNotTracedPrim;
+        for (std::size_t i = chunkBegin(c), end = chunkBegin(c + 1); i < end; ++i) hits += hitSendsRays(primaryHits[i]);
         stretch[c + 1] = hits * perHit;
     });
     for (std::size_t c = 0; c < chunks; ++c) stretch[c + 1] += stretch[c];
     out.rays.resize(stretch[chunks]);
     out.slots.resize(stretch[chunks]);
     std::vector<std::size_t> made(chunks, 0);
-    auto firstSlot = [&](std::size_t c) { return stretch[c]; };
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        std::size_t next = firstSlot(c);
+        std::size_t next = stretch[c];
         for (std::size_t i = chunkBegin(c), end = chunkBegin(c + 1); i < end; ++i)
             secondaryRaysOf(pass, std::uint32_t(i), primaryHits[i], [&]() -> const Ray& { return primary[i]; }, triangles,
                             [&](std::uint32_t slot, const Ray& ray) {
                                 out.rays[next] = ray;
                                 out.slots[next++] = slot;
                             });
-        made[c] = next - firstSlot(c);
+        made[c] = next - stretch[c];
     });
     std::size_t total = 0;
     for (std::size_t c = 0; c < chunks; ++c) {
-        const std::size_t from = firstSlot(c);
+        const std::size_t from = stretch[c];
         if (from != total) {
             std::copy(out.rays.begin() + std::ptrdiff_t(from), out.rays.begin() + std::ptrdiff_t(from + made[c]),
                       out.rays.begin() + std::ptrdiff_t(total));

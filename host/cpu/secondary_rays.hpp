@@ -56,6 +56,9 @@ ShadowLight shadowLightOf(const Light& light);
 // that a pass split into batches of samples makes the rays the whole pass would.
 std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, std::uint32_t k);
 
+// Whether a primary ray's hit is a surface that may send secondary rays (not a miss, and traced).
+inline bool hitSendsRays(const Hit& hit) { return hit.prim != kMissPrim && hit.prim != kNotTracedPrim; }
+
 // The rays primary ray i sends in the pass, in slot order: emit(slot, ray) for each one made
 // (slot i * raysPerHit + k): none from a miss, a shadow ray only where the light can reach the
 // surface, the occlusion samples. primaryRay() returns ray i (a Ray), asked for only where it
@@ -63,7 +66,7 @@ std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, 
 template <typename PrimaryRay, typename Emit>
 void secondaryRaysOf(const SecondaryPass& pass, std::uint32_t i, const Hit& hit, PrimaryRay&& primaryRay,
                      const std::vector<Triangle>& triangles, Emit&& emit) {
-    if (hit.prim == kMissPrim || hit.prim == kNotTracedPrim) return;
+    if (!hitSendsRays(hit)) return;
     const shared::SurfaceSample surface = shared::surfaceOfHit(primaryRay(), hit, triangles[hit.prim]);
     for (std::uint32_t k = 0; k < pass.raysPerHit; ++k) {
         const shared::GeneratedRay g =

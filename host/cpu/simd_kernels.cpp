@@ -145,7 +145,7 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
     const DF df;
     const DU du;
     // Shared: every ray's origin and tmin are rays[0]'s bit for bit, so one broadcast gives
-    // each lane the value a gather would.
+    // each lane the value a load would.
     const VF sharedOrigin[3] = {hn::Set(df, rays[0].origin.x), hn::Set(df, rays[0].origin.y),
                                 hn::Set(df, rays[0].origin.z)};
     const VF sharedTmin = hn::Set(df, rays[0].tmin);
@@ -215,8 +215,8 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     const std::size_t n = hn::Lanes(du);
     batch.count = count;
     // Each triangle's fields copied into its lane with plain loads and stores, not ten gathers a
-    // vector of lanes (loadPerLane says why). Past count: the batch's first triangle again, whose extra lanes the tests never read as
-    // hits (FirstN).
+    // vector of lanes (loadPerLane says why). Past count: the batch's first triangle again,
+    // whose extra lanes the tests never read as hits (FirstN).
     const std::size_t lanes = (std::size_t(count) + n - 1) / n * n;
     for (std::size_t j = 0; j < lanes; ++j) {
         const std::uint32_t id = triIds[j < count ? j : 0];

@@ -28,7 +28,7 @@ bool usesVulkan(const std::vector<Backend>& backends) {
 bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryHits, std::size_t triangles,
                      const SkipSwitches& switches) {
     std::uint64_t surfaces = 0;
-    for (const Hit& h : primaryHits) surfaces += h.prim != kMissPrim && h.prim != kNotTracedPrim;
+    for (const Hit& h : primaryHits) surfaces += hitSendsRays(h);
     const bool oneDirection = pass.kind == shared::kPassShadow && pass.light.type == shared::kLightDirectional;
     return passCullMayDrop(surfaces * pass.raysPerHit, triangles, oneDirection, switches);
 }
