@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstring>
 #include <numeric>
 #include <optional>
 
@@ -21,10 +22,19 @@ void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
     plan.add("triangle bounds", std::uint64_t(g.triangles->size()) * sizeof(Bounds));
 }
 
-// Every ray's best hit starts at its segment's end (missHit).
-void startHits(const FrameGeometry& g, std::vector<Hit>& hits) {
-    hits.resize(g.rays->size());
-    for (std::size_t i = 0; i < hits.size(); ++i) hits[i] = missHit((*g.rays)[i]);
+// Every ray's best hit starts at its segment's end (missHit). Returns whether every ray has
+// the first one's segment, bit for bit (TraversalBuffers::raysShareSegment), found in the same
+// pass over the rays.
+bool startHits(const FrameGeometry& g, std::vector<Hit>& hits) {
+    const std::vector<Ray>& rays = *g.rays;
+    hits.resize(rays.size());
+    bool shareSegment = !rays.empty();
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+        hits[i] = missHit(rays[i]);
+        shareSegment &= std::memcmp(&rays[i].tmin, &rays[0].tmin, sizeof(float)) == 0 &&
+                        std::memcmp(&rays[i].tmax, &rays[0].tmax, sizeof(float)) == 0;
+    }
+    return shareSegment;
 }
 
 Box regionBox(const Region& r) {
@@ -73,7 +83,7 @@ public:
         };
         division_ = divideScene(g_, regions, axis, pool_, result_.memory, onPlan, planTracer);
         if (!division_.complete) return false;
-        startHits(g_, result_.hits);
+        raysShareSegment_ = startHits(g_, result_.hits);
         schedule_ = transferSchedule(division_);
         result_.phases.divide = msSince(start);
         result_.counters.raysCulled = division_.culledRays;
@@ -137,7 +147,7 @@ private:
         DacrtTraversal traversal(g_, options_.dacrt,
                                  {result_.hits.data(), division_.rayIds.data(), division_.triIds.data(),
                                   scratchIds_ ? scratch_.data() + worker * scratchIds_ : nullptr,
-                                  packets_->forWorker(worker)},
+                                  packets_->forWorker(worker), raysShareSegment_},
                                  perWorker_[worker]);
         const RetireRule retire{result_.axis, triRegion == rayRegion ? 0 : (triRegion > rayRegion ? 1 : -1)};
         traversal.trace(regionBox(tris), rays.terminated, rays.rayEnd, tris.triBegin, tris.triEnd, retire);
@@ -158,6 +168,7 @@ private:
     Division division_;
     std::vector<TransferRound> schedule_;
     std::uint64_t scratchIds_ = 0;
+    bool raysShareSegment_ = false;
     std::vector<Counters> perWorker_;
     std::vector<std::uint32_t> scratch_;
     std::optional<PacketStorage> packets_;
@@ -207,7 +218,7 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     planPacketBuffers(g, resolved, scratchIds, 1, result.memory);
     if (onPlan && !onPlan(result.memory)) return result;
 
-    startHits(g, result.hits);
+    const bool raysShareSegment = startHits(g, result.hits);
     std::vector<std::uint32_t> rayIds(rayCount), triIds(triCount);
     std::iota(rayIds.begin(), rayIds.end(), 0u);
     for (std::uint32_t i = 0; i < triCount; ++i) triIds[i] = g.tracedTriangle(i);
@@ -215,7 +226,8 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     PacketStorage packets(g, resolved, scratchIds, 1);
     DacrtTraversal traversal(
         g, options,
-        {result.hits.data(), rayIds.data(), triIds.data(), scratchIds ? scratch.data() : nullptr, packets.forWorker(0)},
+        {result.hits.data(), rayIds.data(), triIds.data(), scratchIds ? scratch.data() : nullptr, packets.forWorker(0),
+         raysShareSegment},
         result.counters);
     std::uint32_t finished = 0;  // the pivot: rays before it are finished
     const std::uint32_t crossing = traversal.trace(g.sceneBox, finished, rayCount, 0, triCount);

@@ -136,42 +136,50 @@ HWY_INLINE void slabInterval(VF origin, VF invDir, float lo, float hi, VF& tNear
     tFar = hn::IfThenElse(parallel, hn::IfThenElse(inside, none, all), maxLike(t0, t1));
 }
 
-template <bool kSharedStart>
+template <SharedRayFields kShared>
 HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
                                        const Box& cell, std::uint32_t* scratch) {
     static_assert(sizeof(Ray) == 16 * sizeof(float) && sizeof(Hit) == 4 * sizeof(float));
+    constexpr bool kSharedStart = kShared == SharedRayFields::Start;
+    constexpr bool kSharedSegment = kShared == SharedRayFields::Segment;
     const float* ray = reinterpret_cast<const float*>(rays);
     const float* hit = reinterpret_cast<const float*>(hits);
     const DF df;
     const DU du;
-    // Shared: every ray's origin and tmin are rays[0]'s bit for bit, so one broadcast gives
-    // each lane the value a load would.
+    // The fields every ray has of rays[0]'s (SharedRayFields), broadcast.
     const VF sharedOrigin[3] = {hn::Set(df, rays[0].origin.x), hn::Set(df, rays[0].origin.y),
                                 hn::Set(df, rays[0].origin.z)};
     const VF sharedTmin = hn::Set(df, rays[0].tmin);
+    const VF sharedBestT = hn::Set(df, rays[0].tmax);
     return stablePartition(ids, count, scratch, [&](VU id) {
         alignas(64) std::uint32_t idLanes[64];
         hn::Store(id, du, idLanes);
         auto field = [&](std::size_t offset) { return loadPerLane<16>(ray, idLanes, offset); };
         // shared::rayMayCrossCell: origin at floats 0-2 of a Ray, tmin at 3, invDir at 8-10;
-        // the best t so far is float 0 of the Hit. The leaf then finds both lines in cache.
+        // the best t so far is float 0 of the Hit (a second cache line per ray, which a
+        // shared segment spares).
         VF xn, xf, yn, yf, zn, zf;
         slabInterval(kSharedStart ? sharedOrigin[0] : field(0), field(8), cell.lo.x, cell.hi.x, xn, xf);
         slabInterval(kSharedStart ? sharedOrigin[1] : field(1), field(9), cell.lo.y, cell.hi.y, yn, yf);
         slabInterval(kSharedStart ? sharedOrigin[2] : field(2), field(10), cell.lo.z, cell.hi.z, zn, zf);
         const VF tNear = maxLike(xn, maxLike(yn, zn));
         const VF tFar = minLike(xf, minLike(yf, zf));
-        const VF tmin = kSharedStart ? sharedTmin : field(3);
-        const VF tmax = loadPerLane<4>(hit, idLanes, 0);
+        const VF tmin = kSharedStart || kSharedSegment ? sharedTmin : field(3);
+        const VF tmax = kSharedSegment ? sharedBestT : loadPerLane<4>(hit, idLanes, 0);
         const MF m = hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
         return hn::RebindMask(du, m);
     });
 }
 
 std::uint32_t PartitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
-                            const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
-    return raysShareStart ? partitionRays<true>(rays, hits, ids, count, cell, scratch)
-                          : partitionRays<false>(rays, hits, ids, count, cell, scratch);
+                            const Box& cell, SharedRayFields shared, std::uint32_t* scratch) {
+    switch (shared) {
+        case SharedRayFields::Start: return partitionRays<SharedRayFields::Start>(rays, hits, ids, count, cell, scratch);
+        case SharedRayFields::Segment:
+            return partitionRays<SharedRayFields::Segment>(rays, hits, ids, count, cell, scratch);
+        case SharedRayFields::None: break;
+    }
+    return partitionRays<SharedRayFields::None>(rays, hits, ids, count, cell, scratch);
 }
 
 template <bool kLowSide, bool kReaching>
@@ -394,8 +402,8 @@ void classifyFacing(const Triangle* triangles, std::uint32_t count, const glm::v
 }
 
 std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
-                                        const Box& cell, bool raysShareStart, std::uint32_t* scratch) {
-    return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, hits, ids, count, cell, raysShareStart, scratch);
+                                        const Box& cell, SharedRayFields shared, std::uint32_t* scratch) {
+    return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, hits, ids, count, cell, shared, scratch);
 }
 
 std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,

@@ -24,13 +24,20 @@ constexpr std::uint64_t kMaxTriangles = (std::uint64_t(1) << 31) / 16;
 // Room past the ids a partition may park in scratch, for whole-vector stores.
 constexpr std::uint32_t kScratchSlack = 64;
 
+// What every ray a partition reads has of rays[0]'s, bit for bit, so that one broadcast gives
+// each lane the value a load would:
+// - Start: the origin and tmin (raysShareStart() in frame_geometry.hpp: primary rays);
+// - Segment: tmin, and as the best hit so far rays[0].tmax, which every id's hits[id].t must
+//   then be (any-hit rays of one segment, raysShareSegment(): a live one has no hit yet, and
+//   its hit is missHit's, at the segment's end). The Hit records are not read.
+enum class SharedRayFields : std::uint8_t { None, Start, Segment };
+
 // Stable partition of ids[0, count): the ids whose ray may cross the (already widened) cell
 // before its best hit so far (shared::rayMayCrossCell with hits[id].t) first, in their order;
 // the others after them, in theirs. Returns how many pass. scratch holds count +
-// kScratchSlack ids. raysShareStart: every ray has rays[0]'s origin and tmin bit for bit
-// (raysShareStart() in frame_geometry.hpp).
+// kScratchSlack ids.
 std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
-                                        const Box& cell, bool raysShareStart, std::uint32_t* scratch);
+                                        const Box& cell, SharedRayFields shared, std::uint32_t* scratch);
 
 // The same partition for triangles whose bounds are known to overlap a cell that differs
 // from this one only in one face, on `axis`: what shared::boundsOverlap with this cell

@@ -20,6 +20,13 @@ int longestAxis(const Box& b) {
     return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
 }
 
+// What the ray filter may broadcast from the first ray (simd::SharedRayFields).
+simd::SharedRayFields sharedRayFieldsOf(const FrameGeometry& g, const TraversalBuffers& buffers) {
+    if (g.raysShareStart) return simd::SharedRayFields::Start;
+    if (g.query == HitQuery::Any && buffers.raysShareSegment) return simd::SharedRayFields::Segment;
+    return simd::SharedRayFields::None;
+}
+
 }  // namespace
 
 std::uint64_t packetTiles(const FrameGeometry& g) {
@@ -102,7 +109,7 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
       rayIds_(buffers.rayIds),
       triIds_(buffers.triIds),
       scratch_(buffers.scratch),
-      raysShareStart_(g.raysShareStart),
+      sharedRayFields_(sharedRayFieldsOf(g, buffers)),
       simd_(scratch_ && usesSimd(g, options_)),
       packets_(simd_ && buffers.packets.packetRays && usesPackets(g, options_)),
       packet_(buffers.packets),
@@ -137,7 +144,7 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
 
 [[gnu::flatten]] std::uint32_t DacrtTraversal::filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end) {
     counters_.rayBoxTests += end - begin;
-    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, hits_, rayIds_ + begin, end - begin, cell, raysShareStart_,
+    if (simd_) return begin + simd::partitionRaysMayCrossCell(rays_, hits_, rayIds_ + begin, end - begin, cell, sharedRayFields_,
                                                             scratch_);
     std::uint32_t* first = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
         return shared::rayMayCrossCell(rays_[id], cell.lo, cell.hi, hits_[id].t);

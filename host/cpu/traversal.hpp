@@ -104,6 +104,10 @@ struct TraversalBuffers {
     std::uint32_t* triIds = nullptr;
     std::uint32_t* scratch = nullptr;
     PacketBuffers packets;  // used when usesPackets()
+    // Every ray has the first one's tmin and tmax, bit for bit (raysShareSegment()), found
+    // where the hits start (a frame's rays may change after the frame is made); any-hit rays
+    // then share their best t while live.
+    bool raysShareSegment = false;
 };
 
 class DacrtTraversal {
@@ -184,7 +188,9 @@ private:
     std::uint32_t* rayIds_;
     std::uint32_t* triIds_;
     std::uint32_t* scratch_;
-    bool raysShareStart_;
+    // What the ray filter may broadcast from the first ray: the start of primary rays, or the
+    // segment of any-hit rays (whose live ones have no hit, so their best t is the segment's end).
+    simd::SharedRayFields sharedRayFields_;
     bool simd_;
     bool packets_;
     PacketBuffers packet_;

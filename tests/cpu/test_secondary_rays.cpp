@@ -242,6 +242,25 @@ TEST(BackendsAgree, OcclusionRaysClosestAndAnyHit) {
     }
 }
 
+TEST(BackendsAgree, AnyHitRaysOfDifferentLengthsAreTracedWithTheirOwn) {
+    // A pass's rays share their segment, and the ray filter then broadcasts the first one's
+    // (simd::SharedRayFields::Segment). Where one ray in three is shortened after the frame is
+    // made, that is found when the trace starts, and each ray's own segment is read.
+    CameraOptions o;
+    o.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(shapesScene(), 48, 36, o);
+    const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
+    PassFrame pass(frame, primary.hits, occlusionPass(4, 0.8f), HitQuery::Any);
+    ASSERT_TRUE(raysShareSegment(pass.rays.rays));
+    const std::size_t before = hitCount(pass.trace(Backend::Brute, 0, 2).hits);
+    for (std::size_t i = 0; i < pass.rays.rays.size(); i += 3) pass.rays.rays[i].tmax = 0.1f;
+    ASSERT_FALSE(raysShareSegment(pass.rays.rays));
+    const std::size_t after = hitCount(pass.trace(Backend::Brute, 0, 2).hits);
+    ASSERT_LT(after, before);  // the shortened rays are read: fewer of them reach a triangle
+    ASSERT_GT(after, 0u);
+    expectPassAgrees(pass, false);
+}
+
 TEST(BackendsAgree, ShadowRaysTowardsPointAndDirectionalLights) {
     CameraOptions o;
     o.eye = glm::dvec3(-1.0, 2.0, 4.0);

@@ -100,11 +100,15 @@ bool sameHit(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit
 
 }  // namespace
 
-// With their own starts, and sharing one (the broadcast path).
+// With their own starts, sharing one, and sharing a segment with no hit yet (the broadcast
+// paths).
 TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
     forEachTarget([] {
-      for (const bool shareStart : {false, true}) {
-        SCOPED_TRACE(shareStart ? "rays share their start" : "rays start apart");
+      for (const simd::SharedRayFields shared :
+           {simd::SharedRayFields::None, simd::SharedRayFields::Start, simd::SharedRayFields::Segment}) {
+        const bool shareStart = shared == simd::SharedRayFields::Start;
+        const bool shareSegment = shared == simd::SharedRayFields::Segment;
+        SCOPED_TRACE(shareStart ? "rays share their start" : shareSegment ? "rays share their segment" : "rays start apart");
         Random rng(11);
         PartitionTally tally;
         std::vector<Ray> rays(300);
@@ -115,7 +119,16 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
                 rays[i].origin = rays[0].origin;
                 rays[i].tmin = rays[0].tmin;
             }
-            if (rng.uniform() < 0.5) hits[i] = Hit{rng.uniform() < 0.2 ? 0.0f : rng.uniformFloat(0.0f, 4.0f), 1, 0, 0};
+            if (shareSegment) {  // live any-hit rays: the same segment, each with its miss hit
+                if (i == 0) rays[0].tmax = rng.uniformFloat(0.1f, 4.0f);  // so that the segment's end decides some
+                if (i > 0) {
+                    rays[i].tmin = rays[0].tmin;
+                    rays[i].tmax = rays[0].tmax;
+                }
+                hits[i] = missHit(rays[i]);
+            } else if (rng.uniform() < 0.5) {
+                hits[i] = Hit{rng.uniform() < 0.2 ? 0.0f : rng.uniformFloat(0.0f, 4.0f), 1, 0, 0};
+            }
         }
         for (int trial = 0; trial < 400; ++trial) {
             const Box cell = randomCell(rng);
@@ -127,7 +140,7 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
             });
             std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
             const std::uint32_t kept = simd::partitionRaysMayCrossCell(rays.data(), hits.data(), ids.data(), count, cell,
-                                                                       shareStart, scratch.data());
+                                                                       shared, scratch.data());
             ASSERT_TRUE(tally.check(kept, expectedKept, ids, expected)) << "trial " << trial;
         }
         EXPECT_GT(tally.kept, 400u);  // both answers are common, so both are compared
