@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/mapped_memory.hpp"
 
 namespace dacrt {
 namespace {
@@ -197,7 +198,7 @@ void primaryRayRow(const PixelRays& pixels, int width, int y, Ray* row) {
 }  // namespace
 
 std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::dvec2 offset) {
-    std::vector<Ray> rays(std::size_t(width) * std::size_t(height));
+    std::vector<Ray> rays = mappedArray<Ray>(std::size_t(width) * std::size_t(height));
     const PixelRays pixels(camera, width, height, offset);
     for (int y = 0; y < height; ++y) primaryRayRow(pixels, width, y, &rays[std::size_t(y) * std::size_t(width)]);
     return rays;
@@ -205,6 +206,7 @@ std::vector<Ray> primaryRays(const Camera& camera, int width, int height, glm::d
 
 void primaryRays(const Camera& camera, int width, int height, ThreadPool& pool, std::vector<Ray>& rays,
                  glm::dvec2 offset) {
+    reserveMapped(rays, std::size_t(width) * std::size_t(height));
     rays.resize(std::size_t(width) * std::size_t(height));
     const PixelRays pixels(camera, width, height, offset);
     std::exception_ptr failure;

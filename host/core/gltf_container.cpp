@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/mapped_memory.hpp"
+
 namespace dacrt::gltf {
 namespace {
 
@@ -46,7 +48,7 @@ std::vector<unsigned char> joinGlb(const std::string& jsonText, std::span<const 
     std::string padded = jsonText;
     while (padded.size() % 4) padded.push_back(' ');
     std::vector<unsigned char> out;
-    out.reserve(20 + padded.size() + rest.size());
+    reserveMapped(out, 20 + padded.size() + rest.size());
     out.insert(out.end(), {'g', 'l', 'T', 'F'});
     appendU32(out, 2);
     appendU32(out, std::uint32_t(20 + padded.size() + rest.size()));

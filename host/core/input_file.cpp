@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "core/errors.hpp"
+#include "core/mapped_memory.hpp"
 
 namespace dacrt {
 
@@ -43,7 +44,7 @@ std::vector<unsigned char> readRegularInput(const std::string& path, std::uint64
         ::close(fd);
         throw InputError(path + ": the file changed while it was opened");
     }
-    std::vector<unsigned char> bytes(size);
+    std::vector<unsigned char> bytes = mappedArray<unsigned char>(size);
     std::size_t done = 0;
     while (done < size) {
         const ssize_t n = ::read(fd, bytes.data() + done, size - done);

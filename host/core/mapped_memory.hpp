@@ -2,7 +2,9 @@
 // Large arrays' pages mapped ahead of their first write. On the project's VM a fresh page
 // costs a fault taken through the hypervisor: 512 MiB written into fresh memory takes about
 // 1.5 s, the same mapped at once as huge pages about 45 ms (docs/benchmarks.md). A frame's
-// set-up writes hundreds of MiB (the flattened triangles, their provenance, their bounds).
+// set-up writes hundreds of MiB (the flattened triangles, their provenance, their bounds), and
+// its trace tens to hundreds more (rays, hits, ids, secondary rays), which a one-frame render
+// maps fresh.
 #include <cstddef>
 #include <vector>
 
@@ -20,6 +22,14 @@ template <typename T>
 void reserveMapped(std::vector<T>& v, std::size_t n) {
     if (v.capacity() < n) v.reserve(n);
     mapForWriting(v.data(), n * sizeof(T));
+}
+
+// `v` resized to `n` elements (new ones value-initialized), its pages mapped first where it
+// grows (reserveMapped): for a per-frame array that a later frame reuses.
+template <typename T>
+void resizeMapped(std::vector<T>& v, std::size_t n) {
+    if (v.capacity() < n) reserveMapped(v, n);
+    v.resize(n);
 }
 
 // A new array of `n` copies of `value`, its pages mapped at once (reserveMapped).

@@ -9,6 +9,7 @@
 #include "cpu/backend_options.hpp"
 #include "cpu/traversal.hpp"
 #include "core/errors.hpp"
+#include "core/mapped_memory.hpp"
 #include "cpu/scene_division.hpp"
 #include "core/timing.hpp"
 
@@ -27,6 +28,7 @@ void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
 // pass over the rays.
 bool startHits(const FrameGeometry& g, std::vector<Hit>& hits) {
     const std::vector<Ray>& rays = *g.rays;
+    reserveMapped(hits, rays.size());
     hits.resize(rays.size());
     bool shareSegment = !rays.empty();
     for (std::size_t i = 0; i < hits.size(); ++i) {
@@ -88,7 +90,7 @@ public:
         result_.phases.divide = msSince(start);
         result_.counters.raysCulled = division_.culledRays;
         perWorker_.resize(pool_.size());
-        scratch_.resize(scratchIds_ * pool_.size());
+        resizeMapped(scratch_, scratchIds_ * pool_.size());
         packets_.emplace(g_, resolved_, scratchIds_, pool_.size());
         return true;
     }

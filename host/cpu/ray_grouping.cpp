@@ -4,6 +4,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/mapped_memory.hpp"
+
 namespace dacrt {
 
 std::uint32_t directionOctant(const Ray& ray) {
@@ -33,6 +35,8 @@ OctantStarts groupByOctant(SecondaryRays& rays, GroupingBuffers& buffers, Thread
     starts[kOctants] = next;
     std::vector<Ray>& grouped = buffers.rays;
     std::vector<std::uint32_t>& slots = buffers.slots;
+    reserveMapped(grouped, n);
+    reserveMapped(slots, n);
     grouped.resize(n);
     slots.resize(n);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {

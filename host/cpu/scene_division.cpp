@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "core/mapped_memory.hpp"
+
 namespace dacrt {
 namespace {
 
@@ -99,7 +101,7 @@ RayBins binRays(const FrameGeometry& g, const Slabs& s, int axis, ThreadPool& po
     const std::size_t n = s.wideLo.size();
     RayBins bins;
     bins.chunks = chunksFor(rays.size());
-    bins.region.resize(rays.size());
+    resizeMapped(bins.region, rays.size());
     bins.counts.assign(bins.chunks * n, 0);
     bins.low.assign(bins.chunks * n, 0);
     bins.high.assign(bins.chunks * n, 0);
@@ -152,8 +154,8 @@ TriangleBins binTriangles(const FrameGeometry& g, const Slabs& s, int axis, Thre
     TriangleBins bins;
     bins.chunks = chunksFor(traced);
     bins.counts.assign(bins.chunks * n, 0);
-    bins.first.resize(traced);
-    bins.last.resize(traced);
+    resizeMapped(bins.first, traced);
+    resizeMapped(bins.last, traced);
     pool.parallelFor(bins.chunks, [&](std::size_t c, unsigned) {
         const auto [begin, end] = chunkRange(c, traced, bins.chunks);
         std::vector<std::uint32_t> counts(n, 0);
@@ -221,8 +223,8 @@ Offsets placeRegions(Division& d, const RayBins& rays, const TriangleBins& trian
 void fillIds(const FrameGeometry& g, const RayBins& rays, const TriangleBins& triangles, const Offsets& o,
              ThreadPool& pool, Division& d) {
     const std::size_t n = d.regions.size();
-    d.rayIds.resize(o.rayTotal);
-    d.triIds.resize(o.triTotal);
+    resizeMapped(d.rayIds, o.rayTotal);
+    resizeMapped(d.triIds, o.triTotal);
     pool.parallelFor(rays.chunks, [&](std::size_t c, unsigned) {
         const auto [begin, end] = chunkRange(c, rays.region.size(), rays.chunks);
         std::vector<std::uint32_t> offset(o.ray.begin() + std::ptrdiff_t(c * n), o.ray.begin() + std::ptrdiff_t(c * n + n));

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "core/mapped_memory.hpp"
 
 namespace dacrt {
 
@@ -62,6 +63,8 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
         stretch[c + 1] = hits * perHit;
     });
     for (std::size_t c = 0; c < chunks; ++c) stretch[c + 1] += stretch[c];
+    reserveMapped(out.rays, stretch[chunks]);
+    reserveMapped(out.slots, stretch[chunks]);
     out.rays.resize(stretch[chunks]);
     out.slots.resize(stretch[chunks]);
     std::vector<std::size_t> made(chunks, 0);
@@ -95,7 +98,7 @@ std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& 
     if (traced.size() != rays.rays.size())
         throw InternalError("a secondary pass traced " + std::to_string(traced.size()) + " rays of " +
                             std::to_string(rays.rays.size()));
-    std::vector<Hit> slots(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f});
+    std::vector<Hit> slots = mappedArray(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f});
     for (std::size_t i = 0; i < traced.size(); ++i) slots[rays.slots[i]] = traced[i];
     return slots;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "core/mapped_memory.hpp"
 #include "cpu/option_predicates.hpp"
 
 namespace dacrt {
@@ -75,11 +76,12 @@ PacketStorage::PacketStorage(const FrameGeometry& g, const DacrtOptions& options
     : scratchIds(ids), tiles(packetArrayCounts(g, options, ids).packets) {
     if (!tiles) return;
     const PacketArrayCounts c = packetArrayCounts(g, options, ids);
-    packetRays.resize(c.rayIds * workers);
-    flushRays.resize(c.rayIds * workers);
-    packets.resize(c.packets * workers);
-    packetIds.resize(c.packets * workers);
-    tileCounts.resize(c.tileStarts * workers);
+    resizeMapped(packetRays, c.rayIds * workers);
+    resizeMapped(flushRays, c.rayIds * workers);
+    resizeMapped(packets, c.packets * workers);
+    resizeMapped(packetIds, c.packets * workers);
+    resizeMapped(tileCounts, c.tileStarts * workers);
+    if (rayDone.capacity() < g.rays->size()) reserveMapped(rayDone, g.rays->size());
     rayDone.assign(g.rays->size(), 0);
 }
 

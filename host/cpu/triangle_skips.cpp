@@ -1,5 +1,6 @@
 #include "cpu/triangle_skips.hpp"
 
+#include "core/mapped_memory.hpp"
 #include "cpu/simd_kernels.hpp"
 
 #include <algorithm>
@@ -146,7 +147,7 @@ std::uint64_t listTraced(const std::vector<SkipTally>& tallies, const std::uint8
     }
     s.applied = evenIfAllKept || total < triangles;
     if (!s.applied) return outside;
-    s.traced.resize(total);
+    resizeMapped(s.traced, total);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
         const auto [begin, end] = skipChunkRange(c, chunks, triangles);
         std::uint64_t k = offset[c];

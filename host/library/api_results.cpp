@@ -2,6 +2,7 @@
 
 #include <dacrt/plan_text.hpp>
 
+#include "core/mapped_memory.hpp"
 #include "cpu/phase_times.hpp"
 #include "gpu/stage_clocks.hpp"
 
@@ -52,7 +53,7 @@ TraceCounters countersOf(const TraceResult& result) {
 
 std::vector<RayHit> hitsOf(const std::vector<Hit>& hits, const std::vector<std::uint32_t>& callerIds) {
     std::vector<RayHit> out;
-    out.reserve(hits.size());
+    reserveMapped(out, hits.size());
     for (const Hit& h : hits) {
         const bool named = h.prim != kMissPrim && h.prim != kUnnamedHitPrim && h.prim != kNotTracedPrim;
         out.push_back(RayHit{named && !callerIds.empty() ? callerIds[h.prim] : h.prim, h.t, h.u, h.v});

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "core/errors.hpp"
+#include "core/mapped_memory.hpp"
 #include "core/timing.hpp"
 #include "cpu/backend_options.hpp"
 #include "cpu/cpu_tracers.hpp"
@@ -225,10 +226,16 @@ FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>&
 // One group's trace appended to the pass's: its hits after the earlier groups', its counters
 // summed, the transfer rounds of the same name together (the division and plan stay the first
 // group's).
-void addGroup(TraceResult& whole, TraceResult&& part) {
+void addGroup(TraceResult& whole, TraceResult&& part, std::size_t passRays) {
     if (whole.hits.empty()) {
         whole = std::move(part);
         return;
+    }
+    if (whole.hits.capacity() < passRays) {  // room for every group's hits at once, mapped ahead
+        std::vector<Hit> hits;
+        reserveMapped(hits, passRays);
+        hits.assign(whole.hits.begin(), whole.hits.end());
+        whole.hits.swap(hits);
     }
     whole.hits.insert(whole.hits.end(), part.hits.begin(), part.hits.end());
     Counters& c = whole.counters;
@@ -272,12 +279,13 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
     TraceResult whole;
     for (std::size_t k = 0; k + 1 < groups.size(); ++k) {
         if (groups[k] == groups[k + 1]) continue;
+        reserveMapped(grouping_.group, groups[k + 1] - groups[k]);
         grouping_.group.assign(rays.begin() + std::ptrdiff_t(groups[k]), rays.begin() + std::ptrdiff_t(groups[k + 1]));
         TraceResult part = traceAfterSkips(passGeometry(primary, grouping_.group), passCull_.skips, cullPlan, cullMs,
                                            request, onPlan, {});
         cullMs = 0.0;  // counted once, with the first group
         if (part.hits.empty()) return {};  // stopped at the plan
-        addGroup(whole, std::move(part));
+        addGroup(whole, std::move(part), rays.size());
     }
     return whole;
 }

@@ -14,6 +14,7 @@
 #include <dacrt/tracer.hpp>
 
 #include "app/exit_codes.hpp"
+#include "core/mapped_memory.hpp"
 #include "render/frame_pattern.hpp"
 #include "app/interrupt_cleanup.hpp"
 #include "app/output_paths.hpp"
@@ -285,7 +286,7 @@ struct TracedFrame {
 
 std::vector<Hit> shadingHits(const std::vector<RayHit>& hits) {
     std::vector<Hit> out;
-    out.reserve(hits.size());
+    reserveMapped(out, hits.size());
     for (const RayHit& h : hits) out.push_back(Hit{h.t, h.primitive, h.u, h.v});
     return out;
 }
