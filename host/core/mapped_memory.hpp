@@ -12,8 +12,9 @@ namespace dacrt {
 
 // Maps the pages of [data, data + bytes) for writing, as transparent huge pages where the
 // system allows (madvise MADV_HUGEPAGE, then MADV_POPULATE_WRITE). Leaves the memory's
-// contents as they are. Does nothing for ranges under a huge page, or where the system
-// refuses (the pages are then mapped by the first writes, as without it).
+// contents as they are. Does nothing for ranges under a huge page, for ranges whose pages are
+// mapped already (memory freed and allocated again; sampled at the start, middle and end), or
+// where the system refuses (the pages are then mapped by the first writes, as without it).
 void mapForWriting(void* data, std::size_t bytes);
 
 // Makes `v` hold room for `n` elements (its elements kept) with that room's pages mapped:
