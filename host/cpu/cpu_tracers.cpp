@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstring>
 #include <numeric>
 #include <optional>
 
@@ -33,8 +32,7 @@ bool startHits(const FrameGeometry& g, std::vector<Hit>& hits) {
     bool shareSegment = !rays.empty();
     for (std::size_t i = 0; i < hits.size(); ++i) {
         hits[i] = missHit(rays[i]);
-        shareSegment &= std::memcmp(&rays[i].tmin, &rays[0].tmin, sizeof(float)) == 0 &&
-                        std::memcmp(&rays[i].tmax, &rays[0].tmax, sizeof(float)) == 0;
+        shareSegment &= sameSegment(rays[i], rays[0]);
     }
     return shareSegment;
 }

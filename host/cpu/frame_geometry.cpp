@@ -25,10 +25,8 @@ bool raysShareStart(const std::vector<Ray>& rays) {
 }
 
 bool raysShareSegment(const std::vector<Ray>& rays) {
-    return !rays.empty() && std::all_of(rays.begin(), rays.end(), [&](const Ray& r) {
-        return std::memcmp(&r.tmin, &rays.front().tmin, sizeof(r.tmin)) == 0 &&
-               std::memcmp(&r.tmax, &rays.front().tmax, sizeof(r.tmax)) == 0;
-    });
+    return !rays.empty() &&
+           std::all_of(rays.begin(), rays.end(), [&](const Ray& r) { return sameSegment(r, rays.front()); });
 }
 
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,

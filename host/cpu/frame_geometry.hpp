@@ -1,6 +1,7 @@
 #pragma once
 // Everything a tracer reads, prepared once per frame and shared by every backend.
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <vector>
 
@@ -66,6 +67,10 @@ struct FrameGeometry {
 // kernels (SIMD filters, compute shaders) then take them once instead of loading them per
 // ray, with the per-ray arithmetic unchanged.
 bool raysShareStart(const std::vector<Ray>& rays);
+// Whether ray a has b's tmin and tmax, bit for bit (inline: startHits asks it of every ray).
+inline bool sameSegment(const Ray& a, const Ray& b) {
+    return std::memcmp(&a.tmin, &b.tmin, sizeof(a.tmin)) == 0 && std::memcmp(&a.tmax, &b.tmax, sizeof(a.tmax)) == 0;
+}
 // Whether every ray has the first one's tmin and tmax, bit for bit (false without rays).
 bool raysShareSegment(const std::vector<Ray>& rays);
 

@@ -231,12 +231,7 @@ void addGroup(TraceResult& whole, TraceResult&& part, std::size_t passRays) {
         whole = std::move(part);
         return;
     }
-    if (whole.hits.capacity() < passRays) {  // room for every group's hits at once, mapped ahead
-        std::vector<Hit> hits;
-        reserveMapped(hits, passRays);
-        hits.assign(whole.hits.begin(), whole.hits.end());
-        whole.hits.swap(hits);
-    }
+    if (whole.hits.capacity() < passRays) reserveMapped(whole.hits, passRays);  // every group's hits at once
     whole.hits.insert(whole.hits.end(), part.hits.begin(), part.hits.end());
     Counters& c = whole.counters;
     const Counters& o = part.counters;
