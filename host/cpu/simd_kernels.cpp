@@ -80,11 +80,48 @@ HWY_INLINE VF loadPerLane(const float* base, const std::uint32_t* idLanes, std::
     return hn::Load(df, lanes);
 }
 
+// Floats offset to offset + 3 of each lane's record of 16 floats (base[id * 16 + offset + k] in
+// fields[k]), with one 128-bit load per lane and a 4x4 transpose in each block, where a vector
+// holds whole blocks of four lanes: a quarter of the loads of loadPerLane, whose inserts were
+// most of the ray filter's instructions.
+template <std::size_t kOffset>
+HWY_INLINE void loadQuadPerLane(const float* base, const std::uint32_t* idLanes, VF fields[4]) {
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL || HWY_TARGET == HWY_AVX2
+    const DF df;
+    const hn::Repartition<double, DF> dd;
+    auto quad = [&](std::size_t lane) { return _mm_loadu_ps(base + std::size_t(idLanes[lane]) * 16 + kOffset); };
+    // blocks[j]'s block k holds lane 4k + j's four floats.
+    VF blocks[4];
+    for (std::size_t j = 0; j < 4; ++j) {
+#if HWY_TARGET == HWY_AVX2
+        blocks[j] = VF{_mm256_insertf128_ps(_mm256_castps128_ps256(quad(j)), quad(4 + j), 1)};
+#else
+        __m512 v = _mm512_castps128_ps512(quad(j));
+        v = _mm512_insertf32x4(v, quad(4 + j), 1);
+        v = _mm512_insertf32x4(v, quad(8 + j), 2);
+        blocks[j] = VF{_mm512_insertf32x4(v, quad(12 + j), 3)};
+#endif
+    }
+    const auto t0 = hn::BitCast(dd, hn::InterleaveLower(blocks[0], blocks[1]));
+    const auto t1 = hn::BitCast(dd, hn::InterleaveUpper(df, blocks[0], blocks[1]));
+    const auto t2 = hn::BitCast(dd, hn::InterleaveLower(blocks[2], blocks[3]));
+    const auto t3 = hn::BitCast(dd, hn::InterleaveUpper(df, blocks[2], blocks[3]));
+    fields[0] = hn::BitCast(df, hn::InterleaveLower(t0, t2));
+    fields[1] = hn::BitCast(df, hn::InterleaveUpper(dd, t0, t2));
+    fields[2] = hn::BitCast(df, hn::InterleaveLower(t1, t3));
+    fields[3] = hn::BitCast(df, hn::InterleaveUpper(dd, t1, t3));
+#else
+    for (std::size_t k = 0; k < 4; ++k) fields[k] = loadPerLane<16>(base, idLanes, kOffset + k);
+#endif
+}
+
 // Ids that pass first (compressed in place: the write position never passes the read
 // position), the others through scratch behind them. Both keep their order. Each compressed
 // vector is stored whole: its lanes past the count land on ids already read, or on the
 // scratch's slack, never past the range (blended stores would not, but AMD runs AVX2's
 // masked stores in microcode, and some Zen generations AVX-512's compressing stores).
+// passes(v, lanes) tests the ids of v, which lanes holds in memory too: loads per lane take
+// their index from there rather than extract it from the vector, lane by lane.
 template <class Passes>
 HWY_INLINE std::uint32_t stablePartition(std::uint32_t* ids, std::uint32_t count, std::uint32_t* scratch,
                                          const Passes& passes) {
@@ -93,7 +130,7 @@ HWY_INLINE std::uint32_t stablePartition(std::uint32_t* ids, std::uint32_t count
     std::size_t kept = 0, moved = 0, i = 0;
     for (; i + n <= count; i += n) {
         const VU v = hn::LoadU(du, ids + i);
-        const auto m = passes(v);
+        const auto m = passes(v, ids + i);
         const std::size_t passing = hn::CountTrue(du, m);
         hn::StoreU(compressIds(v, m), du, ids + kept);
         hn::StoreU(compressIds(v, hn::Not(m)), du, scratch + moved);
@@ -110,7 +147,7 @@ HWY_INLINE std::uint32_t stablePartition(std::uint32_t* ids, std::uint32_t count
         std::copy(ids + i, ids + count, tail);
         const VU v = hn::Load(du, tail);
         const auto valid = hn::FirstN(du, rest);
-        const auto m = hn::And(passes(v), valid);
+        const auto m = hn::And(passes(v, tail), valid);
         const std::size_t passing = hn::CountTrue(du, m);
         hn::Store(compressIds(v, m), du, pass);
         hn::Store(compressIds(v, hn::AndNot(m, valid)), du, fail);
@@ -151,20 +188,20 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
                                 hn::Set(df, rays[0].origin.z)};
     const VF sharedTmin = hn::Set(df, rays[0].tmin);
     const VF sharedBestT = hn::Set(df, rays[0].tmax);
-    return stablePartition(ids, count, scratch, [&](VU id) {
-        alignas(64) std::uint32_t idLanes[64];
-        hn::Store(id, du, idLanes);
-        auto field = [&](std::size_t offset) { return loadPerLane<16>(ray, idLanes, offset); };
+    return stablePartition(ids, count, scratch, [&](VU, const std::uint32_t* idLanes) {
         // shared::rayMayCrossCell: origin at floats 0-2 of a Ray, tmin at 3, invDir at 8-10;
         // the best t so far is float 0 of the Hit (a second cache line per ray, which a
         // shared segment spares).
+        VF start[4], invDir[4];
+        if constexpr (!kSharedStart) loadQuadPerLane<0>(ray, idLanes, start);
+        loadQuadPerLane<8>(ray, idLanes, invDir);
         VF xn, xf, yn, yf, zn, zf;
-        slabInterval(kSharedStart ? sharedOrigin[0] : field(0), field(8), cell.lo.x, cell.hi.x, xn, xf);
-        slabInterval(kSharedStart ? sharedOrigin[1] : field(1), field(9), cell.lo.y, cell.hi.y, yn, yf);
-        slabInterval(kSharedStart ? sharedOrigin[2] : field(2), field(10), cell.lo.z, cell.hi.z, zn, zf);
+        slabInterval(kSharedStart ? sharedOrigin[0] : start[0], invDir[0], cell.lo.x, cell.hi.x, xn, xf);
+        slabInterval(kSharedStart ? sharedOrigin[1] : start[1], invDir[1], cell.lo.y, cell.hi.y, yn, yf);
+        slabInterval(kSharedStart ? sharedOrigin[2] : start[2], invDir[2], cell.lo.z, cell.hi.z, zn, zf);
         const VF tNear = maxLike(xn, maxLike(yn, zn));
         const VF tFar = minLike(xf, minLike(yf, zf));
-        const VF tmin = kSharedStart || kSharedSegment ? sharedTmin : field(3);
+        const VF tmin = kSharedStart || kSharedSegment ? sharedTmin : start[3];
         const VF tmax = kSharedSegment ? sharedBestT : loadPerLane<4>(hit, idLanes, 0);
         const MF m = hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
         return hn::RebindMask(du, m);
@@ -189,9 +226,7 @@ HWY_INLINE std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uin
     const DF df;
     const DU du;
     const VF face = hn::Set(df, bound);
-    return stablePartition(ids, count, scratch, [&](VU id) {
-        alignas(64) std::uint32_t idLanes[64];
-        hn::Store(id, du, idLanes);
+    return stablePartition(ids, count, scratch, [&](VU, const std::uint32_t* idLanes) {
         const VF coordinate = loadPerLane<8>(b, idLanes, 0);
         const MF reaches = kLowSide ? coordinate <= face : coordinate >= face;
         // Bounds are never NaN (the loader refuses such vertices): beyond is the comparison negated.
@@ -237,10 +272,12 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     }
 }
 
-// shared::intersectWatertight for one ray and hn::Lanes triangles; the tie rule then runs
-// per hit lane in scalar code.
-void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                    const LeafTriangles& batch) {
+// shared::intersectWatertight for one ray and hn::Lanes triangles at a time; the tie rule then
+// runs per hit lane in scalar code. The ray's axes are template arguments, so that a[kx] and
+// the like name registers: indexed by a run-time axis, the vertex vectors went through the
+// stack on every batch of triangles.
+template <int kx, int ky, int kz>
+HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch) {
     const DF df;
     const DU du;
     const std::size_t n = hn::Lanes(df);
@@ -249,71 +286,87 @@ void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
     alignas(64) float tLane[64], uLane[64], vLane[64];
     static_assert(HWY_LANES(float) <= 16, "the hit lanes are read as 16 mask bits");
     std::uint8_t bits[8] = {};
+    const VF sx = hn::Set(df, ray.shear.x), sy = hn::Set(df, ray.shear.y), sz = hn::Set(df, ray.shear.z);
+    const VF origin[3] = {hn::Set(df, ray.origin.x), hn::Set(df, ray.origin.y), hn::Set(df, ray.origin.z)};
+    const VF tmin = hn::Set(df, ray.tmin);
+    for (std::size_t j = 0; j < batch.count; j += n) {
+        VF a[3], b[3], c[3];
+        for (int k = 0; k < 3; ++k) {
+            a[k] = hn::Sub(hn::Load(df, &batch.vertex[0][k][j]), origin[k]);
+            b[k] = hn::Sub(hn::Load(df, &batch.vertex[1][k][j]), origin[k]);
+            c[k] = hn::Sub(hn::Load(df, &batch.vertex[2][k][j]), origin[k]);
+        }
+        const VF ax = hn::Sub(a[kx], hn::Mul(sx, a[kz])), ay = hn::Sub(a[ky], hn::Mul(sy, a[kz]));
+        const VF bx = hn::Sub(b[kx], hn::Mul(sx, b[kz])), by = hn::Sub(b[ky], hn::Mul(sy, b[kz]));
+        const VF cx = hn::Sub(c[kx], hn::Mul(sx, c[kz])), cy = hn::Sub(c[ky], hn::Mul(sy, c[kz]));
+        const VF eu = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
+        const VF ev = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
+        const VF ew = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+        const MF anyNegative = hn::Or(hn::Or(eu < zero, ev < zero), ew < zero);
+        const MF anyPositive = hn::Or(hn::Or(eu > zero, ev > zero), ew > zero);
+        MF m = hn::AndNot(hn::And(anyNegative, anyPositive), hn::FirstN(df, batch.count - j));
+        const VF det = hn::Add(hn::Add(eu, ev), ew);
+        m = hn::AndNot(det == zero, m);
+        // shared::backFaceIsCulled.
+        const MF cullBackFace = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
+        m = hn::AndNot(hn::And(cullBackFace, det < zero), m);
+        // Most triangles of a batch fail the edge test: the rest of the conjunction only
+        // where one passes.
+        if (hn::AllFalse(df, m)) continue;
+        // Max and Min rather than maxLike and minLike here: reach is a maximum of absolute
+        // values (no -0, no NaN: the same value whichever equal operand wins), and the
+        // extremes of the projected vertices are only compared, where +0 equals -0.
+        const VF reach = hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
+                                 hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
+                                         hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
+        const VF slack = hn::Mul(reach, projectionSlack);
+        const VF negSlack = hn::Neg(slack);
+        const MF outside = hn::Or(hn::Or(hn::Min(ax, hn::Min(bx, cx)) > slack, hn::Max(ax, hn::Max(bx, cx)) < negSlack),
+                                  hn::Or(hn::Min(ay, hn::Min(by, cy)) > slack, hn::Max(ay, hn::Max(by, cy)) < negSlack));
+        m = hn::AndNot(outside, m);
+        if (hn::AllFalse(df, m)) continue;
+        const VF az = hn::Mul(sz, a[kz]), bz = hn::Mul(sz, b[kz]), cz = hn::Mul(sz, c[kz]);
+        const VF tScaled = hn::Add(hn::Add(hn::Mul(eu, az), hn::Mul(ev, bz)), hn::Mul(ew, cz));
+        const MF front = det > zero;
+        const MF behind = hn::Or(hn::And(front, tScaled <= zero), hn::AndNot(front, tScaled >= zero));
+        m = hn::AndNot(behind, m);
+        const VF t = hn::Div(tScaled, det);
+        m = hn::And(m, t > tmin);
+        if (hn::AllFalse(df, m)) continue;
+        hn::Store(t, df, tLane);
+        hn::Store(hn::Div(ev, det), df, uLane);
+        hn::Store(hn::Div(ew, det), df, vLane);
+        hn::StoreMaskBits(df, m, bits);
+        for (std::uint32_t lanes = std::uint32_t(bits[0]) | std::uint32_t(bits[1]) << 8; lanes; lanes &= lanes - 1) {
+            const std::size_t l = std::size_t(__builtin_ctz(lanes));
+            // The no-area rule, last of the conjunction, only where the rest says hit.
+            if (triangleHasNoArea(batch, j + l)) continue;
+            const std::uint32_t prim = batch.prim[j + l];
+            if (shared::hitPrecedes(tLane[l], prim, best.t, best.prim)) best = Hit{tLane[l], prim, uLane[l], vLane[l]};
+        }
+    }
+    return best;
+}
+
+// The axes as makeRay packs them (kx | ky << 2 | kz << 4): kz the largest component, kx and
+// ky the next two in cyclic order, swapped where the direction along kz is negative.
+constexpr std::uint32_t packedAxes(int kx, int ky, int kz) { return std::uint32_t(kx | ky << 2 | kz << 4); }
+
+void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                    const LeafTriangles& batch) {
     for (std::uint32_t r = 0; r < rayCount; ++r) {
         const std::uint32_t rayId = rayIds[r];
         const Ray& ray = rays[rayId];
-        Hit best = hits[rayId];
-        const int kx = int(ray.axes & 3u), ky = int((ray.axes >> 2) & 3u), kz = int((ray.axes >> 4) & 3u);
-        const VF sx = hn::Set(df, ray.shear.x), sy = hn::Set(df, ray.shear.y), sz = hn::Set(df, ray.shear.z);
-        const VF origin[3] = {hn::Set(df, ray.origin.x), hn::Set(df, ray.origin.y), hn::Set(df, ray.origin.z)};
-        const VF tmin = hn::Set(df, ray.tmin);
-        for (std::size_t j = 0; j < batch.count; j += n) {
-            VF a[3], b[3], c[3];
-            for (int k = 0; k < 3; ++k) {
-                a[k] = hn::Sub(hn::Load(df, &batch.vertex[0][k][j]), origin[k]);
-                b[k] = hn::Sub(hn::Load(df, &batch.vertex[1][k][j]), origin[k]);
-                c[k] = hn::Sub(hn::Load(df, &batch.vertex[2][k][j]), origin[k]);
-            }
-            const VF ax = hn::Sub(a[kx], hn::Mul(sx, a[kz])), ay = hn::Sub(a[ky], hn::Mul(sy, a[kz]));
-            const VF bx = hn::Sub(b[kx], hn::Mul(sx, b[kz])), by = hn::Sub(b[ky], hn::Mul(sy, b[kz]));
-            const VF cx = hn::Sub(c[kx], hn::Mul(sx, c[kz])), cy = hn::Sub(c[ky], hn::Mul(sy, c[kz]));
-            const VF eu = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
-            const VF ev = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
-            const VF ew = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
-            const MF anyNegative = hn::Or(hn::Or(eu < zero, ev < zero), ew < zero);
-            const MF anyPositive = hn::Or(hn::Or(eu > zero, ev > zero), ew > zero);
-            MF m = hn::AndNot(hn::And(anyNegative, anyPositive), hn::FirstN(df, batch.count - j));
-            const VF det = hn::Add(hn::Add(eu, ev), ew);
-            m = hn::AndNot(det == zero, m);
-            // shared::backFaceIsCulled.
-            const MF cullBackFace = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
-            m = hn::AndNot(hn::And(cullBackFace, det < zero), m);
-            // Most triangles of a batch fail the edge test: the rest of the conjunction only
-            // where one passes.
-            if (hn::AllFalse(df, m)) continue;
-            // Max and Min rather than maxLike and minLike here: reach is a maximum of absolute
-            // values (no -0, no NaN: the same value whichever equal operand wins), and the
-            // extremes of the projected vertices are only compared, where +0 equals -0.
-            const VF reach = hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
-                                     hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
-                                             hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
-            const VF slack = hn::Mul(reach, projectionSlack);
-            const VF negSlack = hn::Neg(slack);
-            const MF outside = hn::Or(hn::Or(hn::Min(ax, hn::Min(bx, cx)) > slack, hn::Max(ax, hn::Max(bx, cx)) < negSlack),
-                                      hn::Or(hn::Min(ay, hn::Min(by, cy)) > slack, hn::Max(ay, hn::Max(by, cy)) < negSlack));
-            m = hn::AndNot(outside, m);
-            if (hn::AllFalse(df, m)) continue;
-            const VF az = hn::Mul(sz, a[kz]), bz = hn::Mul(sz, b[kz]), cz = hn::Mul(sz, c[kz]);
-            const VF tScaled = hn::Add(hn::Add(hn::Mul(eu, az), hn::Mul(ev, bz)), hn::Mul(ew, cz));
-            const MF front = det > zero;
-            const MF behind = hn::Or(hn::And(front, tScaled <= zero), hn::AndNot(front, tScaled >= zero));
-            m = hn::AndNot(behind, m);
-            const VF t = hn::Div(tScaled, det);
-            m = hn::And(m, t > tmin);
-            if (hn::AllFalse(df, m)) continue;
-            hn::Store(t, df, tLane);
-            hn::Store(hn::Div(ev, det), df, uLane);
-            hn::Store(hn::Div(ew, det), df, vLane);
-            hn::StoreMaskBits(df, m, bits);
-            for (std::uint32_t lanes = std::uint32_t(bits[0]) | std::uint32_t(bits[1]) << 8; lanes; lanes &= lanes - 1) {
-                const std::size_t l = std::size_t(__builtin_ctz(lanes));
-                // The no-area rule, last of the conjunction, only where the rest says hit.
-                if (triangleHasNoArea(batch, j + l)) continue;
-                const std::uint32_t prim = batch.prim[j + l];
-                if (shared::hitPrecedes(tLane[l], prim, best.t, best.prim)) best = Hit{tLane[l], prim, uLane[l], vLane[l]};
-            }
+        const Hit best = hits[rayId];
+        switch (ray.axes) {
+            case packedAxes(1, 2, 0): hits[rayId] = intersectRay<1, 2, 0>(ray, best, batch); break;
+            case packedAxes(2, 1, 0): hits[rayId] = intersectRay<2, 1, 0>(ray, best, batch); break;
+            case packedAxes(2, 0, 1): hits[rayId] = intersectRay<2, 0, 1>(ray, best, batch); break;
+            case packedAxes(0, 2, 1): hits[rayId] = intersectRay<0, 2, 1>(ray, best, batch); break;
+            case packedAxes(0, 1, 2): hits[rayId] = intersectRay<0, 1, 2>(ray, best, batch); break;
+            case packedAxes(1, 0, 2): hits[rayId] = intersectRay<1, 0, 2>(ray, best, batch); break;
+            default: HWY_ABORT("ray axes %u: makeRay and segmentRay make only six", ray.axes);
         }
-        hits[rayId] = best;
     }
 }
 
