@@ -54,7 +54,8 @@ constexpr std::array<BackendOption, 21> kBackendOptions{{
      [](const RequestedOptions& r) { return r.trace.dacrt.packetFlush != 0; }},
     {"--ray-grouping", kCpuDacrt,
      "how a secondary pass's rays are traced: batches (as made, pixel by pixel, in traces of at most 65536 rays each, "
-     "or 8 per triangle of the scene where that is more), slots (as made, in one trace), octant (grouped by the signs "
+     "or 8 per triangle of the scene where that is more; on cpu without --regions, a multiple of the threads in number, "
+     "traced side by side, each on one thread), slots (as made, in one trace), octant (grouped by the signs "
      "of their directions) or octant-calls (each octant's group traced on its own)",
      "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.rayGrouping != DacrtOptions{}.rayGrouping; }},

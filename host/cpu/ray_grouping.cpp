@@ -51,8 +51,9 @@ OctantStarts groupByOctant(SecondaryRays& rays, GroupingBuffers& buffers, Thread
     return starts;
 }
 
-std::vector<std::size_t> rayBatches(std::size_t rays, std::size_t most) {
-    const std::size_t batches = std::max<std::size_t>(1, (rays + most - 1) / most);
+std::vector<std::size_t> rayBatches(std::size_t rays, std::size_t most, std::size_t multipleOf) {
+    const std::size_t share = std::max<std::size_t>(1, multipleOf);
+    const std::size_t batches = (std::max<std::size_t>(1, (rays + most - 1) / most) + share - 1) / share * share;
     std::vector<std::size_t> starts(batches + 1);
     for (std::size_t b = 0; b <= batches; ++b) starts[b] = rays * b / batches;
     return starts;

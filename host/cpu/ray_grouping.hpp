@@ -35,8 +35,9 @@ using OctantStarts = std::array<std::size_t, kOctants + 1>;
 OctantStarts groupByOctant(SecondaryRays& rays, GroupingBuffers& buffers, ThreadPool& pool);
 
 
-// Where each of the equal batches of `rays` rays begins, then `rays`: one batch where they
-// number at most `most`.
-std::vector<std::size_t> rayBatches(std::size_t rays, std::size_t most);
+// Where each of the equal batches of `rays` rays begins, then `rays`: as few batches of at
+// most `most` rays as a multiple of `multipleOf` allows (one batch where they number at most
+// `most` and multipleOf is 1).
+std::vector<std::size_t> rayBatches(std::size_t rays, std::size_t most, std::size_t multipleOf = 1);
 
 }  // namespace dacrt

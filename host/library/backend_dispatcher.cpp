@@ -18,6 +18,15 @@ namespace dacrt {
 
 namespace {
 
+// How many workers trace a cpu pass's groups side by side (traceGroupsSideBySide; 1: none).
+// The groups are independent frames: with more than one worker, each takes whole groups,
+// sequential DACRTs with no division, binning or transfer round between them, where the
+// parallel scheme would divide every group again and wait at each of its rounds. Regions asked
+// for (--regions) keep the parallel scheme.
+std::size_t sideBySideWorkers(const BackendRequest& request, std::size_t workers) {
+    return request.trace.backend == Backend::Cpu && request.trace.regions == 0 ? workers : 1;
+}
+
 // Whether any of `backends` opens the Vulkan device.
 bool usesVulkan(const std::vector<Backend>& backends) {
     return std::any_of(backends.begin(), backends.end(), runsOnVulkan);
@@ -183,7 +192,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     if (byOctant)  // kept for the next pass
         making.add("rays and slots grouped by octant (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
     if (grouping == RayGrouping::OctantCalls || grouping == RayGrouping::Batches)
-        making.add("one group's rays (at most)", slots * sizeof(Ray));
+        making.add("the rays of the groups being traced (at most)", slots * sizeof(Ray));  // one, or one a worker
     if (onPlan && !onPlan(making)) return out;
     const auto start = Clock::now();
     SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
@@ -201,7 +210,8 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
             if (grouping == RayGrouping::OctantCalls) groups.assign(octants.begin(), octants.end());
         } else if (grouping == RayGrouping::Batches) {
             const std::size_t perTriangle = std::size_t(kPassBatchRaysPerTriangle) * primary.triangles->size();
-            groups = rayBatches(rays.rays.size(), std::max<std::size_t>(kPassBatchRays, perTriangle));
+            groups = rayBatches(rays.rays.size(), std::max<std::size_t>(kPassBatchRays, perTriangle),
+                                sideBySideWorkers(request, threadPool.size()));
         }
         out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, request, onPlan)
                                        : tracePassRays(primary, rays.rays, request, onPlan);
@@ -261,6 +271,57 @@ TraceResult BackendDispatcher::tracePassRays(const FrameGeometry& primary, const
                                          : traceCulled(g, request, onPlan);
 }
 
+TraceResult BackendDispatcher::traceGroupsSideBySide(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                                                     const std::vector<std::size_t>& groups,
+                                                     const BackendRequest& request, const PlanHook& onPlan,
+                                                     const MemoryPlan& cullPlan, double cullMs) {
+    ThreadPool& threadPool = pool(threadsOf(request.trace));
+    std::vector<std::size_t> live;
+    std::size_t largest = 0;
+    for (std::size_t k = 0; k + 1 < groups.size(); ++k) {
+        if (groups[k] == groups[k + 1]) continue;
+        live.push_back(k);
+        if (groups[k + 1] - groups[k] > groups[largest + 1] - groups[largest]) largest = k;
+    }
+    const std::size_t workers = std::min<std::size_t>(threadPool.size(), live.size());
+    workerGroups_.resize(threadPool.size());
+    auto groupOf = [&](std::size_t k, std::vector<Ray>& into) {
+        reserveMapped(into, groups[k + 1] - groups[k]);
+        into.assign(rays.begin() + std::ptrdiff_t(groups[k]), rays.begin() + std::ptrdiff_t(groups[k + 1]));
+        return withSkips(passGeometry(primary, into), passCull_.skips);
+    };
+    // The plan: the largest group's sequential plan once a worker (a bound: the triangles' own
+    // arrays are shared), after the pass cull's lines.
+    const std::vector<WorkLine> lines{
+        {"ray groups side by side", live.size(),
+         "each a sequential DACRT on one of " + std::to_string(workers) + " workers: no division or transfer rounds"}};
+    MemoryPlan plan;
+    plan.work = cullPlan.work;
+    traceSequential(groupOf(largest, workerGroups_[0]), request.trace.dacrt, [&](const MemoryPlan& one) {
+        for (const auto& [name, bytes] : one.buffers)
+            plan.add(name + " (x" + std::to_string(workers) + " workers, at most)", bytes * workers);
+        plan.work.insert(plan.work.end(), one.work.begin(), one.work.end());
+        return false;
+    });
+    plan.work.insert(plan.work.end(), lines.begin(), lines.end());
+    if (onPlan && !onPlan(plan)) return {};
+    const auto start = Clock::now();
+    std::vector<TraceResult> parts(groups.size());
+    threadPool.parallelFor(live.size(), [&](std::size_t i, unsigned worker) {
+        parts[live[i]] = traceSequential(groupOf(live[i], workerGroups_[worker]), request.trace.dacrt);
+    });
+    const double traceMs = msSince(start);
+    TraceResult whole;
+    for (std::size_t k : live) addGroup(whole, std::move(parts[k]), rays.size());
+    whole.memory = std::move(plan);
+    whole.threads = unsigned(workers);
+    whole.regions = 1;
+    whole.phases = PhaseTimes{};
+    whole.phases.skips = cullMs;
+    whole.phases.step1 = traceMs;
+    return whole;
+}
+
 TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const std::vector<Ray>& rays,
                                            const std::vector<std::size_t>& groups, const BackendRequest& request,
                                            const PlanHook& onPlan) {
@@ -271,6 +332,11 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
     MemoryPlan cullPlan;
     planPassCull(all, request.trace.skips, passCull_, cullPlan);
     double cullMs = msSince(start);
+    std::size_t liveGroups = 0;
+    for (std::size_t k = 0; k + 1 < groups.size(); ++k) liveGroups += groups[k] < groups[k + 1];
+    if (sideBySideWorkers(request, pool(threadsOf(request.trace)).size()) > 1 && liveGroups > 1 &&
+        !(passCull_.skips.applied && passCull_.skips.traced.empty()))
+        return traceGroupsSideBySide(primary, rays, groups, request, onPlan, cullPlan, cullMs);
     TraceResult whole;
     for (std::size_t k = 0; k + 1 < groups.size(); ++k) {
         if (groups[k] == groups[k + 1]) continue;

@@ -118,6 +118,11 @@ private:
     TraceResult traceGroups(const FrameGeometry& primary, const std::vector<Ray>& rays,
                             const std::vector<std::size_t>& groups, const BackendRequest& request,
                             const PlanHook& onPlan);
+    // traceGroups on the cpu backend with more than one worker and group: the groups side by
+    // side, each a sequential DACRT on one worker (after traceGroups' pass cull).
+    TraceResult traceGroupsSideBySide(const FrameGeometry& primary, const std::vector<Ray>& rays,
+                                      const std::vector<std::size_t>& groups, const BackendRequest& request,
+                                      const PlanHook& onPlan, const MemoryPlan& cullPlan, double cullMs);
     // A secondary pass's rays on dacrt's backends, over the triangles the pass cull keeps.
     TraceResult traceCulled(const FrameGeometry& pass, const BackendRequest& request, const PlanHook& onPlan);
 
@@ -128,6 +133,7 @@ private:
     std::unique_ptr<gpu::ResidentTriangles> resident_;  // gpu: the triangles kept on the device
     std::unique_ptr<gpu::BufferArena> arena_;           // gpu: every other buffer, kept for the next frame
     GroupingBuffers grouping_;                          // cpu: a pass's rays grouped (--ray-grouping)
+    std::vector<std::vector<Ray>> workerGroups_;        // cpu: each worker's group (traceGroupsSideBySide)
     GpuPassSourcePtr passSource_;                       // gpu: the last frame kept for its secondary passes
     PeerScenes peers_;                                  // embree, rayquery: their structures
     PassCull passCull_;                                 // the last pass's cull, its buffers reused

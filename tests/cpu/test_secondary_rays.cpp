@@ -399,4 +399,11 @@ TEST(SecondaryRays, BatchesAreEqualRunsOfAtMostTheLimit) {
     const std::vector<std::size_t> room = rayBatches(1228800, kPassBatchRays);
     EXPECT_EQ(room.size(), 20u);  // 19 batches of 64,673 or 64,674 rays
     for (std::size_t b = 0; b + 1 < room.size(); ++b) EXPECT_LE(room[b + 1] - room[b], kPassBatchRays);
+    // Side by side on k workers: the fewest batches that k divides.
+    EXPECT_EQ(rayBatches(10, 4, 2), (std::vector<std::size_t>{0, 2, 5, 7, 10}));
+    EXPECT_EQ(rayBatches(3, 4, 2), (std::vector<std::size_t>{0, 1, 3}));
+    EXPECT_EQ(rayBatches(8, 4, 2), (std::vector<std::size_t>{0, 4, 8}));
+    EXPECT_EQ(rayBatches(0, 4, 2), (std::vector<std::size_t>{0, 0, 0}));
+    EXPECT_EQ(rayBatches(1228800, kPassBatchRays, 2).size(), 21u);
+    EXPECT_EQ(rayBatches(1228800, kPassBatchRays, 0), room);  // 0 reads as 1
 }

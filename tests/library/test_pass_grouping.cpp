@@ -3,6 +3,8 @@
 // visibility slot by slot.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "cpu/options.hpp"
 #include "library/backend_dispatcher.hpp"
 #include "support/frames.hpp"
@@ -38,6 +40,19 @@ void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
                     << toString(backend) << ", " << regions << " regions, grouping " << toString(grouping);
                 const bool sorts = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
                 EXPECT_EQ(t.result.phases.groupRays.has_value(), sorts);
+                // cpu's groups side by side, unless regions are asked for: the batches (as many
+                // as the workers here) and the octants (these rays take more than one).
+                const bool sideBySide = backend == Backend::Cpu && regions == 0 &&
+                                        (grouping == RayGrouping::Batches || grouping == RayGrouping::OctantCalls);
+                const auto line = std::find_if(t.result.memory.work.begin(), t.result.memory.work.end(),
+                                               [](const WorkLine& w) { return w.name == "ray groups side by side"; });
+                EXPECT_EQ(line != t.result.memory.work.end(), sideBySide)
+                    << toString(backend) << ", " << regions << " regions, grouping " << toString(grouping);
+                if (sideBySide && line != t.result.memory.work.end()) {
+                    if (grouping == RayGrouping::Batches) EXPECT_EQ(line->count, 2u);
+                    EXPECT_GE(line->count, 2u);
+                    EXPECT_EQ(t.result.threads, 2u);
+                }
             }
     }
 }
