@@ -1,6 +1,8 @@
 #include "library/backend_dispatcher.hpp"
 
 #include <algorithm>
+#include <exception>
+#include <mutex>
 #include <optional>
 #include <ostream>
 #include <thread>
@@ -307,9 +309,17 @@ TraceResult BackendDispatcher::traceGroupsSideBySide(const FrameGeometry& primar
     if (onPlan && !onPlan(plan)) return {};
     const auto start = Clock::now();
     std::vector<TraceResult> parts(groups.size());
+    std::exception_ptr failure;
+    std::mutex failureMutex;
     threadPool.parallelFor(live.size(), [&](std::size_t i, unsigned worker) {
-        parts[live[i]] = traceSequential(groupOf(live[i], workerGroups_[worker]), request.trace.dacrt);
+        try {
+            parts[live[i]] = traceSequential(groupOf(live[i], workerGroups_[worker]), request.trace.dacrt);
+        } catch (...) {  // the pool's threads must not throw: the first error is rethrown here
+            const std::lock_guard<std::mutex> lock(failureMutex);
+            if (!failure) failure = std::current_exception();
+        }
     });
+    if (failure) std::rethrow_exception(failure);
     const double traceMs = msSince(start);
     TraceResult whole;
     for (std::size_t k : live) addGroup(whole, std::move(parts[k]), rays.size());
