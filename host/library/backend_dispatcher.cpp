@@ -14,6 +14,7 @@
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/pass_cull.hpp"
 #include "cpu/triangle_skips.hpp"
+#include "gpu/device_defaults.hpp"
 #include "library/triangle_batches.hpp"
 
 namespace dacrt {
@@ -177,9 +178,13 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     checkBackendRequest(request);
     ThreadPool& threadPool = pool(threadsOf(request.trace));
     // On gpu the rays are made where the primary pass left its hits, unless the pass cull may
-    // drop triangles: the host makes them then, as for the other backends. A frame the skips
+    // drop triangles, or the device takes a CPU's defaults (lavapipe): the host makes them then,
+    // as for the other backends. On a CPU device the host's division and square root are
+    // instructions where the kernel builds them from integer operations (exact_math.glsl), for
+    // the same bits (docs/gpu.md, "Rays made on the host for a CPU device"). A frame the skips
     // left empty (no triangle: every primary ray misses) kept nothing on the device.
     if (request.trace.backend == Backend::Gpu && passSource_ &&
+        !gpu::takesCpuDefaults(gpu_->info(), request.gpuTuning.profile) &&
         !culledOnTheHost(pass, primaryHits, primary.triangles->size(), request.trace.skips))
         return traceMadeOnDevice(primary, pass, request, onPlan);
     PassTrace out;
