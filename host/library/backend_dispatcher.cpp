@@ -280,16 +280,13 @@ TraceResult BackendDispatcher::tracePassRays(const FrameGeometry& primary, const
 
 TraceResult BackendDispatcher::traceGroupsSideBySide(const FrameGeometry& primary, const std::vector<Ray>& rays,
                                                      const std::vector<std::size_t>& groups,
+                                                     const std::vector<std::size_t>& live,
                                                      const BackendRequest& request, const PlanHook& onPlan,
                                                      const MemoryPlan& cullPlan, double cullMs) {
     ThreadPool& threadPool = pool(threadsOf(request.trace));
-    std::vector<std::size_t> live;
-    std::size_t largest = 0;
-    for (std::size_t k = 0; k + 1 < groups.size(); ++k) {
-        if (groups[k] == groups[k + 1]) continue;
-        live.push_back(k);
-        if (groups[k + 1] - groups[k] > groups[largest + 1] - groups[largest]) largest = k;
-    }
+    const std::size_t largest = *std::max_element(live.begin(), live.end(), [&](std::size_t a, std::size_t b) {
+        return groups[a + 1] - groups[a] < groups[b + 1] - groups[b];
+    });
     const std::size_t workers = std::min<std::size_t>(threadPool.size(), live.size());
     workerGroups_.resize(threadPool.size());
     auto groupOf = [&](std::size_t k, std::vector<Ray>& into) {
@@ -347,11 +344,12 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
     MemoryPlan cullPlan;
     planPassCull(all, request.trace.skips, passCull_, cullPlan);
     double cullMs = msSince(start);
-    std::size_t liveGroups = 0;
-    for (std::size_t k = 0; k + 1 < groups.size(); ++k) liveGroups += groups[k] < groups[k + 1];
-    if (sideBySideWorkers(request, pool(threadsOf(request.trace)).size()) > 1 && liveGroups > 1 &&
+    std::vector<std::size_t> live;  // the groups with rays
+    for (std::size_t k = 0; k + 1 < groups.size(); ++k)
+        if (groups[k] < groups[k + 1]) live.push_back(k);
+    if (sideBySideWorkers(request, pool(threadsOf(request.trace)).size()) > 1 && live.size() > 1 &&
         !(passCull_.skips.applied && passCull_.skips.traced.empty()))
-        return traceGroupsSideBySide(primary, rays, groups, request, onPlan, cullPlan, cullMs);
+        return traceGroupsSideBySide(primary, rays, groups, live, request, onPlan, cullPlan, cullMs);
     TraceResult whole;
     for (std::size_t k = 0; k + 1 < groups.size(); ++k) {
         if (groups[k] == groups[k + 1]) continue;

@@ -119,9 +119,11 @@ private:
                             const std::vector<std::size_t>& groups, const BackendRequest& request,
                             const PlanHook& onPlan);
     // traceGroups on the cpu backend with more than one worker and group: the groups side by
-    // side, each a sequential DACRT on one worker (after traceGroups' pass cull).
+    // side (`live`: those with rays), each a sequential DACRT on one worker (after traceGroups'
+    // pass cull).
     TraceResult traceGroupsSideBySide(const FrameGeometry& primary, const std::vector<Ray>& rays,
-                                      const std::vector<std::size_t>& groups, const BackendRequest& request,
+                                      const std::vector<std::size_t>& groups,
+                                      const std::vector<std::size_t>& live, const BackendRequest& request,
                                       const PlanHook& onPlan, const MemoryPlan& cullPlan, double cullMs);
     // A secondary pass's rays on dacrt's backends, over the triangles the pass cull keeps.
     TraceResult traceCulled(const FrameGeometry& pass, const BackendRequest& request, const PlanHook& onPlan);
