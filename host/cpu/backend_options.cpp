@@ -22,7 +22,7 @@ static_assert(kPassBatchRays == 65536 && kPassBatchRaysPerTriangle == 8, "--ray-
 
 // The order is the help's, and the order in which a refusal names the options.
 constexpr std::array<BackendOption, 21> kBackendOptions{{
-    {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device, 64 on a GPU",
+    {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device (a secondary pass's rays there: one, with --ray-groups as the cpu backend's batches), 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.axis != DivisionAxis::Best; }},
@@ -62,7 +62,7 @@ constexpr std::array<BackendOption, 21> kBackendOptions{{
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,
      [](const RequestedOptions& r) { return r.workgroupSize != 0; }},
     {"--ray-groups", kGpu, "work items per region, each a band of its rays with its own copy of the region's triangle ids",
-     "default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1; the discrete profile shares 2048 in all (given: G times the regions) out among the regions by estimated cost",
+     "default: 2 on a CPU device with a loop limiter, such as lavapipe before Mesa 25, else 1, and where neither this nor --regions is given a secondary pass's rays on a CPU device are one region's groups, as many as --ray-grouping's batches; the discrete profile shares 2048 in all (given: G times the regions) out among the regions by estimated cost",
      kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.rayGroups != 0; }},
     {"--leaf-balance", kGpu,
      "a node is also a leaf where its ray/triangle tests number fewer than N per id a split would partition "

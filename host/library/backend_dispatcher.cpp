@@ -46,6 +46,25 @@ bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryH
     return passCullMayDrop(surfaces * pass.raysPerHit, triangles, oneDirection, switches);
 }
 
+// A gpu pass's request on a device that takes a CPU's defaults (lavapipe), where neither the
+// regions nor the ray groups were asked for: one region, its rays in the cpu backend's
+// batches, each batch a ray group (a work item of Step 1 with the whole scene's triangles).
+// Secondary rays cross every region, so regions would pass each ray through transfer rounds;
+// the groups are the cpu's side-by-side batches on the device's threads (docs/gpu.md, "A
+// pass's rays as ray groups"). Elsewhere the request as given.
+BackendRequest gpuPassRequest(const BackendRequest& request, const gpu::DeviceInfo& device, std::size_t rays,
+                              std::size_t triangles) {
+    if (request.trace.regions != 0 || request.gpuTuning.rayGroups != 0 ||
+        !gpu::takesCpuDefaults(device, request.gpuTuning.profile))
+        return request;
+    const std::size_t most = std::max<std::size_t>(kPassBatchRays, std::size_t(kPassBatchRaysPerTriangle) * triangles);
+    const std::size_t batches = rayBatches(rays, most, gpu::defaultGpuRegions(device, request.gpuTuning.profile)).size() - 1;
+    BackendRequest pass = request;
+    pass.trace.regions = 1;
+    pass.gpuTuning.rayGroups = std::uint32_t(std::min<std::size_t>(batches, gpu::kMostDefaultRayGroups));
+    return pass;
+}
+
 }  // namespace
 
 void checkBackendRequest(const BackendRequest& r) {
@@ -220,8 +239,12 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
             groups = rayBatches(rays.rays.size(), std::max<std::size_t>(kPassBatchRays, perTriangle),
                                 sideBySideWorkers(request, threadPool.size()));
         }
-        out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, request, onPlan)
-                                       : tracePassRays(primary, rays.rays, request, onPlan);
+        const BackendRequest passRequest =
+            request.trace.backend == Backend::Gpu
+                ? gpuPassRequest(request, gpu_->info(), rays.rays.size(), primary.triangles->size())
+                : request;
+        out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, passRequest, onPlan)
+                                       : tracePassRays(primary, rays.rays, passRequest, onPlan);
         if (out.result.hits.empty()) return out;  // stopped at the plan
         out.result.hits = hitsPerSlot(rays, out.result.hits);
         out.result.phases.groupRays = groupMs;

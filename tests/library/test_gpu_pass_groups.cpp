@@ -1,0 +1,82 @@
+// A gpu pass through the dispatcher, as every frame's passes go: on a device that takes a CPU's
+// defaults (lavapipe) its rays are one region's ray groups, the cpu backend's batches; with
+// regions or ray groups asked for, they are what was asked. Brute force's visibility either
+// way, under the validation layers. Skipped without a Vulkan device.
+#include <gtest/gtest.h>
+
+#include <exception>
+#include <functional>
+#include <memory>
+
+#include "gpu/device_defaults.hpp"
+#include "library/backend_dispatcher.hpp"
+#include "support/frames.hpp"
+#include "support/gpu_support.hpp"
+
+namespace dacrt {
+namespace {
+
+using namespace test;
+
+struct Shape {
+    unsigned regions;
+    std::uint32_t rayGroups;
+};
+
+// Each pass of the set on brute force, then on gpu with each requested shape: `expect` gives
+// the shape the trace must report for the shape asked for.
+void expectPassShapes(const SecondaryPassSet& set, BackendDispatcher& dispatcher,
+                      const std::function<Shape(Shape)>& expect) {
+    const FrameGeometry primary =
+        frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays, sceneBounds(set.frame.scene.triangles));
+    for (const auto& [name, pass] : set.passes) {
+        SCOPED_TRACE(set.name + ", " + name);
+        BackendRequest request;
+        request.trace.threads = 2;
+        request.trace.backend = Backend::Brute;
+        const BackendDispatcher::PassTrace reference = dispatcher.traceSecondary(primary, set.primary.hits, pass, request);
+        ASSERT_GT(reference.rays, 500u);
+        for (Shape asked : {Shape{0, 0}, Shape{3, 0}, Shape{0, 3}, Shape{1, 1}}) {
+            request.trace.backend = Backend::Gpu;
+            request.trace.regions = asked.regions;
+            request.gpuTuning.rayGroups = asked.rayGroups;
+            const BackendDispatcher::PassTrace t = dispatcher.traceSecondary(primary, set.primary.hits, pass, request);
+            const std::string shape = std::to_string(asked.regions) + " regions, " + std::to_string(asked.rayGroups) +
+                                      " ray groups asked for";
+            EXPECT_EQ(t.rays, reference.rays) << shape;
+            EXPECT_TRUE(identicalVisibility(reference.result.hits, t.result.hits)) << shape;
+            ASSERT_TRUE(t.result.gpu.has_value()) << shape;
+            const Shape want = expect(asked);
+            if (want.regions) {
+                EXPECT_EQ(t.result.regions, want.regions) << shape;
+            }
+            if (want.rayGroups) {
+                EXPECT_EQ(t.result.gpu->rayGroups, want.rayGroups) << shape;
+            }
+        }
+    }
+    EXPECT_EQ(dispatcher.validationErrors(), 0u);
+}
+
+TEST(GpuPassGroups, OnACpuDeviceAPassIsOneRegionsRayGroupsUnlessAskedOtherwise) {
+    DACRT_REQUIRE_GPU(context);
+    std::unique_ptr<BackendDispatcher> dispatcher;
+    try {
+        dispatcher = std::make_unique<BackendDispatcher>(DeviceChoice{"", true}, std::vector<Backend>{Backend::Gpu});
+    } catch (const std::exception& e) {
+        GTEST_SKIP() << "no Vulkan device: " << e.what();
+    }
+    const gpu::DeviceInfo& device = context->info();
+    const bool cpuDevice = gpu::takesCpuDefaults(device, GpuProfile::Auto);
+    // These passes make a few thousand rays: one batch, then as many as the device's threads.
+    const std::uint32_t batches = gpu::defaultGpuRegions(device, GpuProfile::Auto);
+    const auto expect = [&](Shape asked) {
+        if (asked.regions == 0 && asked.rayGroups == 0) return cpuDevice ? Shape{1, batches} : Shape{0, 0};
+        return asked;
+    };
+    expectPassShapes(shapesSecondaryPasses(), *dispatcher, expect);
+    expectPassShapes(shapesUnderACeilingPasses(), *dispatcher, expect);
+}
+
+}  // namespace
+}  // namespace dacrt
