@@ -1,6 +1,8 @@
 #include "core/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <exception>
 #include <mutex>
 #include <sstream>
@@ -131,10 +133,21 @@ namespace {
 // makeRay's checks and direction: normalized in double, rounded to float, components below
 // 2^-64 flushed to zero (so 1/dir <= 2^64).
 glm::vec3 checkedUnitDirection(const glm::vec3& origin, const glm::dvec3& direction) {
-    if (!finite(glm::dvec3(origin)) || !finite(direction) || glm::length(direction) == 0.0)
+    if (!finite(glm::dvec3(origin)) || !finite(direction) || direction == glm::dvec3(0.0))
         throw InputError("ray: origin " + str(glm::dvec3(origin)) + " and direction " + str(direction) +
                          " must be finite and the direction non-zero");
-    glm::vec3 d = glm::vec3(glm::normalize(direction));
+    // glm::normalize's arithmetic, v (1 / sqrt(v . v)), whose squares overflow beyond about
+    // 2^511 (a zero direction would follow) and lose bits below about 2^-511: such a direction is
+    // first scaled by a power of two (exactly), which gives the result of unbounded exponents.
+    // pixel_ray_rows.cpp leaves the same directions to this function.
+    glm::dvec3 v = direction;
+    double squared = glm::dot(v, v);
+    if (!(squared >= std::numeric_limits<double>::min() && squared <= std::numeric_limits<double>::max())) {
+        const int exponent = std::ilogb(std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}));
+        v = glm::dvec3(std::ldexp(v.x, -exponent), std::ldexp(v.y, -exponent), std::ldexp(v.z, -exponent));
+        squared = glm::dot(v, v);
+    }
+    glm::vec3 d = glm::vec3(v * (1.0 / std::sqrt(squared)));
     for (int a = 0; a < 3; ++a)
         if (std::abs(d[a]) < 0x1p-64f) d[a] = 0.0f;  // keeps every slab bound finite (predicates.glsl)
     return d;
@@ -169,7 +182,8 @@ PixelRays::PixelRays(const Camera& camera, int width, int height, glm::dvec2 off
       aspect_(double(width) / double(height)),
       halfHeight_(camera.projection == Projection::Orthographic ? camera.ymag : std::tan(0.5 * camera.yfovRadians)),
       orthographic_(camera.projection == Projection::Orthographic),
-      origin_(glm::vec3(camera.eye)) {}
+      origin_(glm::vec3(camera.eye)),
+      simd_(simdPixels()) {}
 
 std::pair<glm::vec3, glm::dvec3> PixelRays::unrounded(int x, int y) const {
     const double sx = (2.0 * (x + offset_.x) / width_ - 1.0) * halfHeight_ * aspect_;
@@ -184,15 +198,27 @@ Ray PixelRays::ray(int x, int y) const {
     return makeRay(origin, direction);
 }
 
-PixelRays::OriginAndDirection PixelRays::originAndDirection(int x, int y) const {
-    const auto [origin, direction] = unrounded(x, y);
-    return {origin, checkedUnitDirection(origin, direction)};
+// The perspective camera the SIMD rays are made from (pixel_ray_rows.hpp); none for an
+// orthographic one or an origin makeRay refuses, whose rays go one at a time.
+std::optional<PerspectivePixels> PixelRays::simdPixels() const {
+    if (orthographic_ || !finite(glm::dvec3(origin_))) return std::nullopt;
+    return PerspectivePixels{.offset = offset_, .width = double(width_), .height = double(height_),
+                             .halfHeight = halfHeight_, .aspect = aspect_, .right = right_,
+                             .forward = camera_.forward, .up = camera_.up, .origin = origin_};
+}
+
+int PixelRays::rowRays(int y, int x0, int count, Ray* out) const {
+    return simd_ ? perspectiveRowRays(*simd_, y, x0, count, out) : 0;
+}
+
+int PixelRays::tileDirections(int x0, int y0, Ray* out) const {
+    return simd_ ? perspectiveTileDirections(*simd_, x0, y0, out) : 0;
 }
 
 namespace {
 
 void primaryRayRow(const PixelRays& pixels, int width, int y, Ray* row) {
-    for (int x = 0; x < width; ++x) row[x] = pixels.ray(x, y);
+    for (int x = pixels.rowRays(y, 0, width, row); x < width; ++x) row[x] = pixels.ray(x, y);
 }
 
 }  // namespace

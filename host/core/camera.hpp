@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/pixel_ray_rows.hpp"
 #include "core/scene.hpp"
 
 namespace dacrt {
@@ -53,10 +54,10 @@ std::optional<ViewFrustum> viewFrustum(const Camera& camera, int width, int heig
 // non-finite direction or origin.
 Ray makeRay(const glm::vec3& origin, const glm::dvec3& direction, float tmin = 0.0f);
 
-// primaryRays' arithmetic one pixel at a time, for a tracer that makes each ray where it traces
-// it (the Embree peer's packets, peers/embree_in_loop.hpp), never storing a frame of rays:
-// ray(x, y) is primaryRays' ray of pixel (x, y) bit for bit, and origin and direction are its
-// fields of the same names alone, without the reciprocals and shear that only dacrt reads.
+// primaryRays' arithmetic a pixel or a row's span at a time, for primaryRays itself and for a
+// tracer that makes each ray where it traces it (the Embree peer's packets,
+// peers/embree_in_loop.hpp), never storing a frame of rays: ray(x, y) is primaryRays' ray of
+// pixel (x, y) bit for bit.
 class PixelRays {
 public:
     PixelRays(const Camera& camera, int width, int height, glm::dvec2 offset = {0.5, 0.5});
@@ -66,13 +67,18 @@ public:
 
     Ray ray(int x, int y) const;
 
-    struct OriginAndDirection {
-        glm::vec3 origin;
-        glm::vec3 direction;  // unit up to rounding
-    };
-    OriginAndDirection originAndDirection(int x, int y) const;
+    // The rays of pixels x0 .. x0 + count - 1 of row y into out[0 ..], several pixels per
+    // instruction (pixel_ray_rows.hpp), each ray(x, y) bit for bit: returns how many it made
+    // from the left (all, or 0 for an orthographic camera, or those before a pixel left to
+    // makeRay); ray(x, y) makes the rest.
+    int rowRays(int y, int x0, int count, Ray* out) const;
+    // The 4x4 tile's rays from pixel (x0, y0), lane l the pixel (x0 + l % 4, y0 + l / 4), their
+    // origin and dir alone, ray(x, y)'s bit for bit (no other field is made): returns how many
+    // it made, as rowRays.
+    int tileDirections(int x0, int y0, Ray* out) const;
 
 private:
+    std::optional<PerspectivePixels> simdPixels() const;
     // The ray's float32 origin and its direction before makeRay rounds it.
     std::pair<glm::vec3, glm::dvec3> unrounded(int x, int y) const;
 
@@ -83,6 +89,7 @@ private:
     double aspect_ = 1.0, halfHeight_ = 0.0;
     bool orthographic_ = false;
     glm::vec3 origin_;
+    std::optional<PerspectivePixels> simd_;
 };
 
 // One ray per pixel through the point `offset` of the pixel (in pixel units from its top-left

@@ -60,9 +60,13 @@ void traceCameraInLoop(const EmbreeScene& scene, const PixelRays& pixels, Thread
     embree::traceTiles(
         width, hits.size(), pool,
         [&](const embree::Tile& tile) {
+            // The tile's rays as primaryRays makes them, 16 lanes in SIMD (their origin and dir;
+            // the reciprocals and shear are dacrt's alone), one at a time where it cannot.
+            Ray rays[16];
+            for (int l = pixels.tileDirections(int(tile.x0), int(tile.y0), rays); l < 16; ++l)
+                if (tile.inside[l]) rays[l] = pixels.ray(int(tile.x0) + l % 4, int(tile.y0) + l / 4);
             const auto rayOfLane = [&](int l) {
-                const PixelRays::OriginAndDirection r = pixels.originAndDirection(int(tile.x0) + l % 4, int(tile.y0) + l / 4);
-                return embree::LaneRay{r.origin, 0.0f, r.direction, kNoHitT};  // makeRay's segment
+                return embree::LaneRay{rays[l].origin, 0.0f, rays[l].dir, kNoHitT};  // makeRay's segment
             };
             embree::traceTile(scene.handle(), tile, HitQuery::Closest, rayOfLane, hits.data());
         },
