@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "core/pixel_ray_rows.hpp"
+#include "core/ray_fields-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace dacrt::rows {
@@ -27,7 +28,6 @@ template <bool kTile>
 HWY_INLINE int PerspectiveRays(const PerspectivePixels& pixels, int x0, int y0, int count, Ray* out) {
     const hn::ScalableTag<double> dd;
     const hn::Rebind<float, decltype(dd)> df;
-    const hn::Rebind<std::uint32_t, decltype(dd)> du;
     const int lanes = int(hn::Lanes(dd));
     using VD = hn::Vec<decltype(dd)>;
     using VF = hn::Vec<decltype(df)>;
@@ -45,15 +45,14 @@ HWY_INLINE int PerspectiveRays(const PerspectivePixels& pixels, int x0, int y0, 
     const double rowSy = (1.0 - 2.0 * (y0 + pixels.offset.y) / pixels.height) * pixels.halfHeight;
     const VD rowUp[3] = {hn::Set(dd, rowSy * pixels.up.x), hn::Set(dd, rowSy * pixels.up.y),
                          hn::Set(dd, rowSy * pixels.up.z)};
-    const VF zero = hn::Zero(df), oneF = hn::Set(df, 1.0f), tiny = hn::Set(df, 0x1p-64f);
+    const VF zero = hn::Zero(df), noHit = hn::Set(df, kNoHitT);
     const VF origin[3] = {hn::Set(df, pixels.origin.x), hn::Set(df, pixels.origin.y), hn::Set(df, pixels.origin.z)};
-    const VF noHit = hn::Set(df, kNoHitT);
-    const auto u0 = hn::Zero(du), u1 = hn::Set(du, 1u), u2 = hn::Set(du, 2u);
 
     // The ray's four 16-byte quarters, lane by lane (Ray: origin tmin, dir axes, invDir tmax,
     // shear pad).
     constexpr std::size_t kMost = hn::MaxLanes(df);
-    HWY_ALIGN float quarters[4][4 * kMost];
+    HWY_ALIGN float storage[4][4 * kMost];
+    float* const quarters[4] = {storage[0], storage[1], storage[2], storage[3]};
     for (int i = 0; i < count; i += lanes) {
         const int valid = std::min(lanes, count - i);
         // sx = (2 (x + offset) / width - 1) halfHeight aspect; direction = forward + (sx right + sy up).
@@ -84,44 +83,15 @@ HWY_INLINE int PerspectiveRays(const PerspectivePixels& pixels, int x0, int y0, 
         if (made == 0) return i;
         const VD inverseLength = hn::Div(one, hn::Sqrt(dot));
         VF d[3];
-        for (int a = 0; a < 3; ++a) {
-            d[a] = hn::DemoteTo(df, hn::Mul(direction[a], inverseLength));
-            d[a] = hn::IfThenZeroElse(hn::Lt(hn::Abs(d[a]), tiny), d[a]);  // makeRay's flush below 2^-64
-        }
-        hn::StoreInterleaved4(origin[0], origin[1], origin[2], zero, df, quarters[0]);
+        for (int a = 0; a < 3; ++a)
+            d[a] = ray_fields::HWY_NAMESPACE::FlushSmall(df, hn::DemoteTo(df, hn::Mul(direction[a], inverseLength)));
         if constexpr (kTile) {
+            hn::StoreInterleaved4(origin[0], origin[1], origin[2], zero, df, quarters[0]);
             hn::StoreInterleaved4(d[0], d[1], d[2], zero, df, quarters[1]);
         } else {
-            // makeRay's axes: kz the largest |d| (the first of equals), (kx, ky) following it,
-            // swapped where d[kz] < 0.
-            const VF absD[3] = {hn::Abs(d[0]), hn::Abs(d[1]), hn::Abs(d[2])};
-            const auto over0 = hn::Gt(absD[1], absD[0]);
-            const auto over1 = hn::Gt(absD[2], hn::IfThenElse(over0, absD[1], absD[0]));
-            const VF dz = hn::IfThenElse(over1, d[2], hn::IfThenElse(over0, d[1], d[0]));
-            const VF dxUnswapped = hn::IfThenElse(over1, d[0], hn::IfThenElse(over0, d[2], d[1]));
-            const VF dyUnswapped = hn::IfThenElse(over1, d[1], hn::IfThenElse(over0, d[0], d[2]));
-            const auto negative = hn::Lt(dz, zero);
-            const VF dx = hn::IfThenElse(negative, dyUnswapped, dxUnswapped);
-            const VF dy = hn::IfThenElse(negative, dxUnswapped, dyUnswapped);
-            const auto over0U = hn::RebindMask(du, over0), over1U = hn::RebindMask(du, over1);
-            const auto negativeU = hn::RebindMask(du, negative);
-            const auto kz = hn::IfThenElse(over1U, u2, hn::IfThenElse(over0U, u1, u0));
-            const auto kxUnswapped = hn::IfThenElse(over1U, u0, hn::IfThenElse(over0U, u2, u1));
-            const auto kyUnswapped = hn::IfThenElse(over1U, u1, hn::IfThenElse(over0U, u0, u2));
-            const auto kx = hn::IfThenElse(negativeU, kyUnswapped, kxUnswapped);
-            const auto ky = hn::IfThenElse(negativeU, kxUnswapped, kyUnswapped);
-            const auto axes = hn::Or(kx, hn::Or(hn::ShiftLeft<2>(ky), hn::ShiftLeft<4>(kz)));
-            VF inverse[3];
-            for (int a = 0; a < 3; ++a) inverse[a] = hn::IfThenZeroElse(hn::Eq(d[a], zero), hn::Div(oneF, d[a]));
-            hn::StoreInterleaved4(d[0], d[1], d[2], hn::BitCast(df, axes), df, quarters[1]);
-            hn::StoreInterleaved4(inverse[0], inverse[1], inverse[2], noHit, df, quarters[2]);
-            hn::StoreInterleaved4(hn::Div(dx, dz), hn::Div(dy, dz), hn::Div(oneF, dz), zero, df, quarters[3]);
+            ray_fields::HWY_NAMESPACE::StoreRayQuarters(df, origin, zero, d, noHit, quarters);
         }
-        constexpr int kQuarters = kTile ? 2 : 4;
-        for (int l = 0; l < made; ++l) {
-            auto* ray = reinterpret_cast<unsigned char*>(&out[i + l]);
-            for (int q = 0; q < kQuarters; ++q) std::memcpy(ray + 16 * q, &quarters[q][4 * l], 16);
-        }
+        ray_fields::HWY_NAMESPACE::CopyRayQuarters(quarters, made, kTile ? 2 : 4, out + i);
         if (made < valid) return i + made;
     }
     return count;

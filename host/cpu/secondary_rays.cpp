@@ -70,12 +70,12 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
     std::vector<std::size_t> made(chunks, 0);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
         std::size_t next = stretch[c];
-        for (std::size_t i = chunkBegin(c), end = chunkBegin(c + 1); i < end; ++i)
-            secondaryRaysOf(pass, std::uint32_t(i), primaryHits[i], [&]() -> const Ray& { return primary[i]; }, triangles,
-                            [&](std::uint32_t slot, const Ray& ray) {
-                                out.rays[next] = ray;
-                                out.slots[next++] = slot;
-                            });
+        secondaryRaysOfRange(pass, chunkBegin(c), chunkBegin(c + 1), primaryHits.data(),
+                             [&](std::size_t i) -> const Ray& { return primary[i]; }, triangles,
+                             [&](std::uint32_t slot, const Ray& ray) {
+                                 out.rays[next] = ray;
+                                 out.slots[next++] = slot;
+                             });
         made[c] = next - stretch[c];
     });
     std::size_t total = 0;

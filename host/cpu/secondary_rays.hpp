@@ -11,6 +11,7 @@
 #include "core/scene.hpp"
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
+#include "cpu/occlusion_ray_rows.hpp"
 #include "cpu/predicates.hpp"
 
 namespace dacrt::shared {
@@ -75,6 +76,45 @@ void secondaryRaysOf(const SecondaryPass& pass, std::uint32_t i, const Hit& hit,
                 : shared::occlusionRay(surface, occlusionStream(pass, i, k), pass.sampleSeed, pass.occlusionDistance);
         if (g.traced) emit(i * pass.raysPerHit + k, g.ray);
     }
+}
+
+// The rays primary rays first .. end - 1 send in the pass, in slot order, as secondaryRaysOf
+// makes them one primary ray at a time (the same rays, emitted in the same order): an occlusion
+// pass's are made in batches, several at a time (occlusion_ray_rows.hpp). primaryRayOf(i)
+// returns ray i, asked for only where it hit.
+template <typename PrimaryRayOf, typename Emit>
+void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::size_t end, const Hit* hits,
+                          PrimaryRayOf&& primaryRayOf, const std::vector<Triangle>& triangles, Emit&& emit) {
+    if (pass.kind != shared::kPassOcclusion) {
+        for (std::size_t i = first; i < end; ++i)
+            secondaryRaysOf(pass, std::uint32_t(i), hits[i], [&]() -> decltype(auto) { return primaryRayOf(i); },
+                            triangles, emit);
+        return;
+    }
+    OcclusionBatch batch;
+    std::uint32_t slots[OcclusionBatch::kRays];
+    Ray rays[OcclusionBatch::kRays];
+    const auto flush = [&] {
+        makeOcclusionRays(batch, pass.sampleSeed, pass.occlusionDistance, rays);
+        for (int j = 0; j < batch.count; ++j) emit(slots[j], rays[j]);
+        batch.count = 0;
+    };
+    for (std::size_t i = first; i < end; ++i) {
+        if (!hitSendsRays(hits[i])) continue;
+        const shared::SurfaceSample surface = shared::surfaceOfHit(primaryRayOf(i), hits[i], triangles[hits[i].prim]);
+        if (!surface.valid) continue;  // occlusionRay makes none
+        for (std::uint32_t k = 0; k < pass.raysPerHit; ++k) {
+            if (batch.count == OcclusionBatch::kRays) flush();
+            const int j = batch.count++;
+            batch.stream[j] = occlusionStream(pass, std::uint32_t(i), k);
+            for (int c = 0; c < 3; ++c) {
+                batch.normal[c][j] = surface.normal[c];
+                batch.origin[c][j] = surface.origin[c];
+            }
+            slots[j] = std::uint32_t(i) * pass.raysPerHit + k;
+        }
+    }
+    if (batch.count > 0) flush();
 }
 
 // The rays of a pass: one slot per primary ray and sample (slot = primary index * raysPerHit

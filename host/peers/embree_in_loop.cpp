@@ -89,13 +89,15 @@ std::uint64_t occludeSecondaryInLoop(const EmbreeScene& scene, const SecondaryPa
         const embree::FlushDenormals ftz;
         try {
             OcclusionPackets packets(scene.handle(), slots.data());
-            const std::size_t end = std::min(primaryHits.size(), (run + 1) * kPixelsPerRun);
-            for (std::size_t i = run * kPixelsPerRun; i < end; ++i) {
-                std::fill_n(slots.begin() + std::ptrdiff_t(i * pass.raysPerHit), pass.raysPerHit, notTraced);
-                const auto primaryRay = [&] { return pixels.ray(int(i % width), int(i / width)); };
-                secondaryRaysOf(pass, std::uint32_t(i), primaryHits[i], primaryRay, triangles,
-                                [&](std::uint32_t slot, const Ray& ray) { packets.add(slot, ray); });
-            }
+            const std::size_t first = run * kPixelsPerRun, end = std::min(primaryHits.size(), first + kPixelsPerRun);
+            std::fill(slots.begin() + std::ptrdiff_t(first * pass.raysPerHit),
+                      slots.begin() + std::ptrdiff_t(end * pass.raysPerHit), notTraced);
+            // The rays as dacrt's passes make them (occlusion rays several at a time), each
+            // packet's 16 in the order they are made.
+            secondaryRaysOfRange(
+                pass, first, end, primaryHits.data(),
+                [&](std::size_t i) { return pixels.ray(int(i % width), int(i / width)); }, triangles,
+                [&](std::uint32_t slot, const Ray& ray) { packets.add(slot, ray); });
             packets.flush();
             made[worker] += packets.traced();
         } catch (...) {

@@ -11,6 +11,7 @@
 #include "core/random.hpp"
 #include "cpu/ray_grouping.hpp"
 #include "cpu/secondary_rays.hpp"
+#include "cpu/simd_kernels.hpp"
 #include "support/frames.hpp"
 
 using namespace dacrt;
@@ -322,7 +323,13 @@ TEST(SecondaryRays, MadeInChunksAreEveryRayOfTheDefinitionInSlotOrder) {
     ASSERT_GT(missing, frame.rays.size() / 10);
     ASSERT_LT(missing, frame.rays.size() - frame.rays.size() / 10);
     ThreadPool pool(2);
-    for (const SecondaryPass& pass : {occlusionPass(3, 0.8f), pointShadowPass({0.3f, 1.6f, 0.4f})}) {
+    // Occlusion rays are made in batches of 256 several at a time (occlusion_ray_rows.hpp), on
+    // every SIMD target: 300 samples a hit span batches.
+    for (const std::string& target : simd::availableTargets())
+    for (const SecondaryPass& pass : {occlusionPass(3, 0.8f), occlusionPass(300, kNoHitT, 12345),
+                                      pointShadowPass({0.3f, 1.6f, 0.4f})}) {
+        SCOPED_TRACE("target " + target);
+        simd::forceTarget(target);
         std::vector<Ray> rays;
         std::vector<std::uint32_t> slots;
         for (std::uint32_t i = 0; i < frame.rays.size(); ++i)
@@ -338,6 +345,7 @@ TEST(SecondaryRays, MadeInChunksAreEveryRayOfTheDefinitionInSlotOrder) {
         ASSERT_EQ(made.rays.size(), rays.size()) << pass.name;
         EXPECT_EQ(std::memcmp(made.rays.data(), rays.data(), rays.size() * sizeof(Ray)), 0) << pass.name;
     }
+    simd::forceTarget("");
 }
 
 TEST(SecondaryRays, GroupingByOctantIsAStablePermutationThatHitsPerSlotUndoes) {
