@@ -9,8 +9,7 @@
 #include <memory>
 
 #include "gpu/device_defaults.hpp"
-#include "library/backend_dispatcher.hpp"
-#include "support/frames.hpp"
+#include "support/dispatcher_passes.hpp"
 #include "support/gpu_support.hpp"
 
 namespace dacrt {
@@ -27,17 +26,12 @@ struct Shape {
 // the shape the trace must report for the shape asked for.
 void expectPassShapes(const SecondaryPassSet& set, BackendDispatcher& dispatcher,
                       const std::function<Shape(Shape)>& expect) {
-    const FrameGeometry primary =
-        frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays, sceneBounds(set.frame.scene.triangles));
-    for (const auto& [name, pass] : set.passes) {
-        SCOPED_TRACE(set.name + ", " + name);
+    forEachPassAgainstBruteForce(set, dispatcher, [&](const FrameGeometry& primary, const SecondaryPass& pass,
+                                                      const BackendDispatcher::PassTrace& reference) {
         BackendRequest request;
         request.trace.threads = 2;
-        request.trace.backend = Backend::Brute;
-        const BackendDispatcher::PassTrace reference = dispatcher.traceSecondary(primary, set.primary.hits, pass, request);
-        ASSERT_GT(reference.rays, 500u);
+        request.trace.backend = Backend::Gpu;
         for (Shape asked : {Shape{0, 0}, Shape{3, 0}, Shape{0, 3}, Shape{1, 1}}) {
-            request.trace.backend = Backend::Gpu;
             request.trace.regions = asked.regions;
             request.gpuTuning.rayGroups = asked.rayGroups;
             const BackendDispatcher::PassTrace t = dispatcher.traceSecondary(primary, set.primary.hits, pass, request);
@@ -54,7 +48,7 @@ void expectPassShapes(const SecondaryPassSet& set, BackendDispatcher& dispatcher
                 EXPECT_EQ(t.result.gpu->rayGroups, want.rayGroups) << shape;
             }
         }
-    }
+    });
     EXPECT_EQ(dispatcher.validationErrors(), 0u);
 }
 

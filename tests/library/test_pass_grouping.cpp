@@ -7,7 +7,7 @@
 
 #include "cpu/options.hpp"
 #include "library/backend_dispatcher.hpp"
-#include "support/frames.hpp"
+#include "support/dispatcher_passes.hpp"
 
 namespace dacrt {
 namespace {
@@ -17,16 +17,10 @@ using namespace test;
 // Each pass of the set on brute force, then on cpu-seq and cpu (one region per thread, and
 // three) under every grouping, through one dispatcher, as a frame's passes are traced.
 void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
-    const FrameGeometry primary =
-        frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays, sceneBounds(set.frame.scene.triangles));
     BackendDispatcher dispatcher({}, {Backend::Cpu});
-    for (const auto& [name, pass] : set.passes) {
-        SCOPED_TRACE(set.name + ", " + name);
+    forEachPassAgainstBruteForce(set, dispatcher, [&](const FrameGeometry& primary, const SecondaryPass& pass,
+                                                      const BackendDispatcher::PassTrace& reference) {
         BackendRequest request;
-        request.trace.threads = 2;
-        request.trace.backend = Backend::Brute;
-        const BackendDispatcher::PassTrace reference = dispatcher.traceSecondary(primary, set.primary.hits, pass, request);
-        ASSERT_GT(reference.rays, 500u);
         for (RayGrouping grouping :
              {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls, RayGrouping::Batches})
             for (auto [backend, regions] : {std::pair{Backend::CpuSeq, 0u}, {Backend::Cpu, 0u}, {Backend::Cpu, 3u}}) {
@@ -49,12 +43,14 @@ void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
                 EXPECT_EQ(line != t.result.memory.work.end(), sideBySide)
                     << toString(backend) << ", " << regions << " regions, grouping " << toString(grouping);
                 if (sideBySide && line != t.result.memory.work.end()) {
-                    if (grouping == RayGrouping::Batches) EXPECT_EQ(line->count, 2u);
+                    if (grouping == RayGrouping::Batches) {
+                        EXPECT_EQ(line->count, 2u);
+                    }
                     EXPECT_GE(line->count, 2u);
                     EXPECT_EQ(t.result.threads, 2u);
                 }
             }
-    }
+    });
 }
 
 TEST(PassGrouping, EveryGroupingGivesBruteForcesVisibility) {
