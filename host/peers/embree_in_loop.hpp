@@ -3,7 +3,7 @@
 // at once, never a frame of rays stored. Primary rays are made per 4x4 pixel tile (PixelRays:
 // core's primaryRays arithmetic, so the rays, and the hits, are those of EmbreeScene::trace on
 // the stored rays, bit for bit), shadow and occlusion rays per 16-wide packet from the primary
-// hits (secondaryRaysOf: makeSecondaryRays' rays). Work goes to the pool's threads in rows of
+// hits (secondaryRaysOfRange: makeSecondaryRays' rays). Work goes to the pool's threads in rows of
 // tiles or runs of pixels, with FTZ/DAZ on (restored afterwards).
 #include <cstdint>
 #include <vector>
