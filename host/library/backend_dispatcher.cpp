@@ -51,7 +51,7 @@ bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryH
 // batches, each batch a ray group (a work item of Step 1 with the whole scene's triangles).
 // Secondary rays cross every region, so regions would pass each ray through transfer rounds;
 // the groups are the cpu's side-by-side batches on the device's threads (docs/gpu.md, "A
-// pass's rays as ray groups"). Elsewhere the request as given.
+// pass's rays as one region's ray groups on a CPU device"). Elsewhere the request as given.
 BackendRequest gpuPassRequest(const BackendRequest& request, const gpu::DeviceInfo& device, std::size_t rays,
                               std::size_t triangles) {
     if (request.trace.regions != 0 || request.gpuTuning.rayGroups != 0 ||
@@ -240,7 +240,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
                                 sideBySideWorkers(request, threadPool.size()));
         }
         const BackendRequest passRequest =
-            request.trace.backend == Backend::Gpu
+            request.trace.backend == Backend::Gpu && gpu_
                 ? gpuPassRequest(request, gpu_->info(), rays.rays.size(), primary.triangles->size())
                 : request;
         out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, passRequest, onPlan)
