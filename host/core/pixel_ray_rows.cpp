@@ -86,8 +86,7 @@ HWY_INLINE int PerspectiveRays(const PerspectivePixels& pixels, int x0, int y0, 
         for (int a = 0; a < 3; ++a)
             d[a] = ray_fields::HWY_NAMESPACE::FlushSmall(df, hn::DemoteTo(df, hn::Mul(direction[a], inverseLength)));
         if constexpr (kTile) {
-            hn::StoreInterleaved4(origin[0], origin[1], origin[2], zero, df, quarters[0]);
-            hn::StoreInterleaved4(d[0], d[1], d[2], zero, df, quarters[1]);
+            ray_fields::HWY_NAMESPACE::StoreOriginAndDirection(df, origin, zero, d, zero, quarters);
         } else {
             ray_fields::HWY_NAMESPACE::StoreRayQuarters(df, origin, zero, d, noHit, quarters);
         }

@@ -27,6 +27,16 @@ HWY_INLINE hn::Vec<DF> FlushSmall(DF df, hn::Vec<DF> d) {
     return hn::IfThenZeroElse(hn::Lt(hn::Abs(d), hn::Set(df, 0x1p-64f)), d);
 }
 
+// The rays' first two 16-byte quarters, lane by lane, into quarters[0] and quarters[1]
+// (origin tmin, dir and the 32 bits after it: the axes, or anything for a tracer that reads
+// the origin and direction alone).
+template <class DF>
+HWY_INLINE void StoreOriginAndDirection(DF df, const hn::Vec<DF> origin[3], hn::Vec<DF> tmin, const hn::Vec<DF> d[3],
+                                        hn::Vec<DF> afterDir, float* const quarters[4]) {
+    hn::StoreInterleaved4(origin[0], origin[1], origin[2], tmin, df, quarters[0]);
+    hn::StoreInterleaved4(d[0], d[1], d[2], afterDir, df, quarters[1]);
+}
+
 // The rays' four 16-byte quarters, lane by lane, into quarters[q][4 * lane ..] (Ray: origin
 // tmin, dir axes, invDir tmax, shear pad), from their origin, segment and flushed direction d:
 // the reciprocals (0 where d is 0), the watertight test's axes (kz the largest |d|, the first
@@ -57,8 +67,7 @@ HWY_INLINE void StoreRayQuarters(DF df, const hn::Vec<DF> origin[3], hn::Vec<DF>
     const auto axes = hn::Or(kx, hn::Or(hn::ShiftLeft<2>(ky), hn::ShiftLeft<4>(kz)));
     VF inverse[3];
     for (int a = 0; a < 3; ++a) inverse[a] = hn::IfThenZeroElse(hn::Eq(d[a], zero), hn::Div(one, d[a]));
-    hn::StoreInterleaved4(origin[0], origin[1], origin[2], tmin, df, quarters[0]);
-    hn::StoreInterleaved4(d[0], d[1], d[2], hn::BitCast(df, axes), df, quarters[1]);
+    StoreOriginAndDirection(df, origin, tmin, d, hn::BitCast(df, axes), quarters);
     hn::StoreInterleaved4(inverse[0], inverse[1], inverse[2], tmax, df, quarters[2]);
     hn::StoreInterleaved4(hn::Div(dx, dz), hn::Div(dy, dz), hn::Div(one, dz), zero, df, quarters[3]);
 }

@@ -46,6 +46,13 @@ bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryH
     return passCullMayDrop(surfaces * pass.raysPerHit, triangles, oneDirection, switches);
 }
 
+// The most rays a batch of a pass's rays holds (--ray-grouping batches, and a gpu pass's ray
+// groups on a CPU device): kPassBatchRays, or kPassBatchRaysPerTriangle per triangle where that
+// is more.
+std::size_t passBatchRays(std::size_t triangles) {
+    return std::max<std::size_t>(kPassBatchRays, std::size_t(kPassBatchRaysPerTriangle) * triangles);
+}
+
 // A gpu pass's request on a device that takes a CPU's defaults (lavapipe), where neither the
 // regions nor the ray groups were asked for: one region, its rays in the cpu backend's
 // batches, each batch a ray group (a work item of Step 1 with the whole scene's triangles).
@@ -57,8 +64,8 @@ BackendRequest gpuPassRequest(const BackendRequest& request, const gpu::DeviceIn
     if (request.trace.regions != 0 || request.gpuTuning.rayGroups != 0 ||
         !gpu::takesCpuDefaults(device, request.gpuTuning.profile))
         return request;
-    const std::size_t most = std::max<std::size_t>(kPassBatchRays, std::size_t(kPassBatchRaysPerTriangle) * triangles);
-    const std::size_t batches = rayBatches(rays, most, gpu::defaultGpuRegions(device, request.gpuTuning.profile)).size() - 1;
+    const std::size_t batches =
+        rayBatches(rays, passBatchRays(triangles), gpu::defaultGpuRegions(device, request.gpuTuning.profile)).size() - 1;
     BackendRequest pass = request;
     pass.trace.regions = 1;
     pass.gpuTuning.rayGroups = std::uint32_t(std::min<std::size_t>(batches, gpu::kMostDefaultRayGroups));
@@ -235,8 +242,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
             groupMs = msSince(groupStart);
             if (grouping == RayGrouping::OctantCalls) groups.assign(octants.begin(), octants.end());
         } else if (grouping == RayGrouping::Batches) {
-            const std::size_t perTriangle = std::size_t(kPassBatchRaysPerTriangle) * primary.triangles->size();
-            groups = rayBatches(rays.rays.size(), std::max<std::size_t>(kPassBatchRays, perTriangle),
+            groups = rayBatches(rays.rays.size(), passBatchRays(primary.triangles->size()),
                                 sideBySideWorkers(request, threadPool.size()));
         }
         const BackendRequest passRequest =
