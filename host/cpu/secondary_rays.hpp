@@ -85,10 +85,21 @@ void secondaryRaysOf(const SecondaryPass& pass, std::uint32_t i, const Hit& hit,
 template <typename PrimaryRayOf, typename Emit>
 void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::size_t end, const Hit* hits,
                           PrimaryRayOf&& primaryRayOf, const std::vector<Triangle>& triangles, Emit&& emit) {
+    // The hit triangles lie anywhere in the scene's array: each asked for a few hits ahead.
+    constexpr std::size_t kHitsAhead = 8;
+    const auto prefetchAhead = [&](std::size_t i) {
+        if (i + kHitsAhead < end && hitSendsRays(hits[i + kHitsAhead])) {
+            const char* t = reinterpret_cast<const char*>(&triangles[hits[i + kHitsAhead].prim]);
+            __builtin_prefetch(t);
+            __builtin_prefetch(t + sizeof(Triangle) - 1);
+        }
+    };
     if (pass.kind != shared::kPassOcclusion) {
-        for (std::size_t i = first; i < end; ++i)
+        for (std::size_t i = first; i < end; ++i) {
+            prefetchAhead(i);
             secondaryRaysOf(pass, std::uint32_t(i), hits[i], [&]() -> decltype(auto) { return primaryRayOf(i); },
                             triangles, emit);
+        }
         return;
     }
     OcclusionBatch batch;
@@ -100,6 +111,7 @@ void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::siz
         batch.count = 0;
     };
     for (std::size_t i = first; i < end; ++i) {
+        prefetchAhead(i);
         if (!hitSendsRays(hits[i])) continue;
         const shared::SurfaceSample surface = shared::surfaceOfHit(primaryRayOf(i), hits[i], triangles[hits[i].prim]);
         if (!surface.valid) continue;  // occlusionRay makes none
