@@ -7,11 +7,12 @@
 #include <numeric>
 
 #include "core/mapped_memory.hpp"
+#include "cpu/simd_kernels.hpp"
 
 namespace dacrt {
 namespace {
 
-constexpr std::uint32_t kCulled = 0xFFFFFFFFu;
+constexpr std::uint32_t kCulled = simd::kNoRegion;
 
 // Where rays enter the scene box (a sample of them), as (entry point, entry face axis or -1
 // for rays that start inside).
@@ -97,8 +98,14 @@ struct RayBins {
 
 RayBins binRays(const FrameGeometry& g, const Slabs& s, int axis, ThreadPool& pool) {
     const std::vector<Ray>& rays = *g.rays;
-    const Box& box = g.sceneBox;
     const std::size_t n = s.wideLo.size();
+    const simd::RegionSlabs slabs{.axis = axis,
+                                  .count = std::uint32_t(n),
+                                  .boundary = s.boundary.data(),
+                                  .wideLo = s.wideLo.data(),
+                                  .wideHi = s.wideHi.data(),
+                                  .sceneLo = s.sceneLo,
+                                  .sceneHi = s.sceneHi};
     RayBins bins;
     bins.chunks = chunksFor(rays.size());
     resizeMapped(bins.region, rays.size());
@@ -107,30 +114,17 @@ RayBins binRays(const FrameGeometry& g, const Slabs& s, int axis, ThreadPool& po
     bins.high.assign(bins.chunks * n, 0);
     pool.parallelFor(bins.chunks, [&](std::size_t c, unsigned) {
         const auto [begin, end] = chunkRange(c, rays.size(), bins.chunks);
+        simd::firstRegionsOfRays(rays.data() + begin, end - begin, slabs, bins.region.data() + begin);
         // Counted locally: neighbouring chunks' counters share cache lines.
         std::vector<std::uint32_t> counts(n, 0);
         std::vector<std::uint8_t> low(n, 0), high(n, 0);
         for (std::size_t i = begin; i < end; ++i) {
-            const Ray& ray = rays[i];
-            bins.region[i] = kCulled;
-            if (!shared::rayMayCrossCell(ray, s.sceneLo, s.sceneHi, kNoHitT)) continue;
-            const float o = ray.origin[axis], dir = ray.dir[axis];
-            const int step = dir < 0.0f ? -1 : 1;
-            // Start one slab behind the origin's so that rounding in the guess never skips
-            // the true first region; walk in the travel direction to the first one crossed.
-            int k = slabOf(o, s.boundary) - step;
-            if (dir > 0.0f && o < box.lo[axis]) k = 0;
-            if (dir < 0.0f && o > box.hi[axis]) k = int(n) - 1;
-            k = std::clamp(k, 0, int(n) - 1);
-            for (; k >= 0 && k < int(n); k += step) {
-                if (shared::rayMayCrossCell(ray, s.wideLo[std::size_t(k)], s.wideHi[std::size_t(k)], kNoHitT)) {
-                    bins.region[i] = std::uint32_t(k);
-                    ++counts[std::size_t(k)];
-                    low[std::size_t(k)] |= dir < 0.0f;
-                    high[std::size_t(k)] |= dir > 0.0f;
-                    break;
-                }
-            }
+            const std::uint32_t k = bins.region[i];
+            if (k == kCulled) continue;
+            const float dir = rays[i].dir[axis];
+            ++counts[k];
+            low[k] |= dir < 0.0f;
+            high[k] |= dir > 0.0f;
         }
         std::copy(counts.begin(), counts.end(), bins.counts.begin() + std::ptrdiff_t(c * n));
         std::copy(low.begin(), low.end(), bins.low.begin() + std::ptrdiff_t(c * n));

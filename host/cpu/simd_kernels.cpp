@@ -33,6 +33,21 @@ alignas(64) static constexpr CompressTable kCompressTable = makeCompressTable();
 }  // namespace dacrt::simd
 #endif
 
+#ifndef DACRT_SIMD_REGION_WALK
+#define DACRT_SIMD_REGION_WALK
+namespace dacrt::simd {
+// Where firstRegionOfRay's walk starts: one slab behind the origin's in the travel direction,
+// or the first (last) slab for a ray that starts below (above) the box moving up (down).
+inline std::uint32_t walkStart(float origin, float dir, const RegionSlabs& s) {
+    const std::uint32_t last = s.count - 1;
+    const bool down = dir < 0.0f;
+    if (dir > 0.0f && origin < s.boundary[0]) return 0;
+    if (down && origin > s.boundary[s.count]) return last;
+    const std::int64_t behind = std::int64_t(slabOf(origin, s)) + (down ? 1 : -1);
+    return std::uint32_t(std::clamp<std::int64_t>(behind, 0, last));
+}
+}  // namespace dacrt::simd
+#endif
 HWY_BEFORE_NAMESPACE();
 namespace dacrt::simd {
 namespace HWY_NAMESPACE {
@@ -387,6 +402,63 @@ void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
     }
 }
 
+// firstRegionOfRay lanes at a time, walk and all: each lane's start (walkStart), then every
+// region's test in ascending order, a lane moving up keeping the first region at or after its
+// start that its ray crosses, a lane moving down the last one at or before it.
+void FirstRegions(const Ray* rays, std::size_t count, const RegionSlabs& s, std::uint32_t* region) {
+    const DF df;
+    const DI di;
+    const std::size_t n = hn::Lanes(df);
+    const float* base = reinterpret_cast<const float*>(rays);
+    const VF noHit = hn::Set(df, kNoHitT);
+    const auto last = hn::Set(di, std::int32_t(s.count) - 1);
+    const auto none = hn::Set(di, std::int32_t(kNoRegion));
+    alignas(64) std::uint32_t ids[64], tail[64];
+    for (std::size_t i = 0; i < count; i += n) {
+        const std::size_t lanes = std::min(n, count - i);
+        for (std::size_t l = 0; l < n; ++l) ids[l] = std::uint32_t(i + std::min(l, lanes - 1));
+        VF start[4], dir[4], invDir[4];
+        loadQuadPerLane<0>(base, ids, start);
+        loadQuadPerLane<4>(base, ids, dir);
+        loadQuadPerLane<8>(base, ids, invDir);
+        // shared::rayMayCrossCell(ray, lo, hi, kNoHitT).
+        const auto crosses = [&](const glm::vec3& lo, const glm::vec3& hi) {
+            VF xn, xf, yn, yf, zn, zf;
+            slabInterval(start[0], invDir[0], lo.x, hi.x, xn, xf);
+            slabInterval(start[1], invDir[1], lo.y, hi.y, yn, yf);
+            slabInterval(start[2], invDir[2], lo.z, hi.z, zn, zf);
+            const VF tNear = maxLike(xn, maxLike(yn, zn));
+            const VF tFar = minLike(xf, minLike(yf, zf));
+            return hn::RebindMask(di, hn::And(hn::And(tNear <= tFar, tFar >= start[3]), tNear <= noHit));
+        };
+        const VF origin = start[s.axis], d = dir[s.axis];
+        const auto down = hn::RebindMask(di, d < hn::Zero(df));
+        // walkStart: slabOf (the boundaries 1 .. count - 1 at or below the origin), one behind.
+        auto slab = hn::Zero(di);
+        for (std::uint32_t k = 1; k < s.count; ++k)
+            slab = hn::Sub(slab, hn::VecFromMask(di, hn::RebindMask(di, hn::Set(df, s.boundary[k]) <= origin)));
+        auto walk = hn::IfThenElse(down, hn::Add(slab, hn::Set(di, 1)), hn::Sub(slab, hn::Set(di, 1)));
+        walk = hn::Min(hn::Max(walk, hn::Zero(di)), last);
+        walk = hn::IfThenZeroElse(hn::RebindMask(di, hn::And(d > hn::Zero(df), origin < hn::Set(df, s.boundary[0]))), walk);
+        walk = hn::IfThenElse(hn::And(down, hn::RebindMask(di, origin > hn::Set(df, s.boundary[s.count]))), last, walk);
+        auto found = none;
+        for (std::uint32_t k = 0; k < s.count; ++k) {
+            const auto vk = hn::Set(di, std::int32_t(k));
+            const auto crossed = crosses(s.wideLo[k], s.wideHi[k]);
+            const auto up = hn::AndNot(down, hn::AndNot(vk < walk, found == none));
+            const auto back = hn::AndNot(vk > walk, down);
+            found = hn::IfThenElse(hn::And(crossed, hn::Or(up, back)), vk, found);
+        }
+        found = hn::IfThenElse(crosses(s.sceneLo, s.sceneHi), found, none);
+        if (lanes == n) {
+            hn::StoreU(hn::BitCast(hn::RebindToUnsigned<DI>(), found), hn::RebindToUnsigned<DI>(), region + i);
+        } else {
+            hn::Store(hn::BitCast(hn::RebindToUnsigned<DI>(), found), hn::RebindToUnsigned<DI>(), tail);
+            std::copy(tail, tail + lanes, region + i);
+        }
+    }
+}
+
 // facesAwayFrom in float32 with a bound on its rounding (docs/correctness.md, "Skips"):
 // side = ((v1 - v0) x (v2 - v0)) . (v0 - o) is within 10 u |e1|_1 |e2|_1 |a|_1 of the float64
 // value, taken as 32 u; q > 480 u L + 200 u^2 R is certified with a factor 1.001 for the
@@ -466,6 +538,31 @@ HWY_EXPORT(IntersectBatch);
 HWY_EXPORT(GatherLeafTriangles);
 HWY_EXPORT(CompiledTarget);
 HWY_EXPORT(ClassifyFacing);
+HWY_EXPORT(FirstRegions);
+
+std::uint32_t slabOf(float x, const RegionSlabs& s) {
+    const float* first = s.boundary + 1;
+    const float* last = s.boundary + s.count;  // boundary[count] itself is not searched
+    const std::int64_t k = std::upper_bound(first, last, x) - first;
+    return std::uint32_t(std::clamp<std::int64_t>(k, 0, std::int64_t(s.count) - 1));
+}
+
+std::uint32_t firstRegionOfRay(const Ray& ray, const RegionSlabs& s) {
+    if (!shared::rayMayCrossCell(ray, s.sceneLo, s.sceneHi, kNoHitT)) return kNoRegion;
+    const float dir = ray.dir[s.axis];
+    const int step = dir < 0.0f ? -1 : 1;
+    for (std::int64_t k = walkStart(ray.origin[s.axis], dir, s); k >= 0 && k < std::int64_t(s.count); k += step)
+        if (shared::rayMayCrossCell(ray, s.wideLo[k], s.wideHi[k], kNoHitT)) return std::uint32_t(k);
+    return kNoRegion;
+}
+
+void firstRegionsOfRays(const Ray* rays, std::size_t count, const RegionSlabs& s, std::uint32_t* region) {
+    if (s.count > kMostRegionsInLanes || count > kMaxRays) {
+        for (std::size_t i = 0; i < count; ++i) region[i] = firstRegionOfRay(rays[i], s);
+        return;
+    }
+    HWY_DYNAMIC_DISPATCH(FirstRegions)(rays, count, s, region);
+}
 
 void classifyFacing(const Triangle* triangles, std::uint32_t count, const glm::vec3& origin, std::uint8_t* verdict) {
     HWY_DYNAMIC_DISPATCH(ClassifyFacing)(triangles, count, origin, verdict);

@@ -70,6 +70,33 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                     const LeafTriangles& batch);
 
+// The regions of a scene division as the ray binning reads them (scene_division.cpp): `count`
+// equal slabs along `axis` between boundary[0] and boundary[count] (the scene box's faces on
+// that axis), their boxes widened by the filter margin, and the widened scene box.
+struct RegionSlabs {
+    int axis = 0;
+    std::uint32_t count = 0;
+    const float* boundary = nullptr;  // count + 1
+    const glm::vec3* wideLo = nullptr;
+    const glm::vec3* wideHi = nullptr;
+    glm::vec3 sceneLo{}, sceneHi{};
+};
+constexpr std::uint32_t kNoRegion = 0xFFFFFFFFu;
+// Regions the SIMD binning tests at once (one bit each); more go ray by ray.
+constexpr std::uint32_t kMostRegionsInLanes = 32;
+
+// The slab holding x: boundary[1 .. count - 1] searched, clamped to [0, count).
+std::uint32_t slabOf(float x, const RegionSlabs& s);
+// The region a ray meets first in its travel direction (kNoRegion: it meets the widened scene
+// box or no region): the walk starts one slab behind the origin's (so that rounding in that
+// guess never skips the true first region; at the first or last slab for an origin outside
+// the box on the side the ray comes from) and tests shared::rayMayCrossCell (unbounded) region
+// by region. The rule, ray by ray.
+std::uint32_t firstRegionOfRay(const Ray& ray, const RegionSlabs& s);
+// firstRegionOfRay of rays[0, count) into region[0, count): the regions' tests lanes at a
+// time (kMostRegionsInLanes at most; more, ray by ray), the same answers.
+void firstRegionsOfRays(const Ray* rays, std::size_t count, const RegionSlabs& s, std::uint32_t* region);
+
 // The back-face skip's verdict on triangles[0, count) seen from origin, certified in float32
 // lanes: kKeep where facesAwayFrom (triangle_skips.hpp, float64) is false (front-facing, or not
 // single-sided), kDrop where it is true, kUndecided where float32 cannot tell within its

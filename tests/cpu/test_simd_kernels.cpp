@@ -188,6 +188,59 @@ TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCellAndItsCom
     });
 }
 
+// The division's ray binning: slabs as the division makes them (equal widths, widened boxes),
+// rays starting inside, outside and on the slabs' faces, parallel to the axis or not. The
+// walk over each lane's bits answers as the walk region by region; 33 and more regions take
+// the ray-by-ray path.
+TEST_F(EveryTarget, RayBinningFindsTheWalksFirstRegion) {
+    forEachTarget([] {
+        Random rng(15);
+        std::uint32_t binned = 0, none = 0, multi = 0;
+        for (int trial = 0; trial < 300; ++trial) {
+            const Box box = randomCell(rng);
+            const int axis = int(rng.index(3));
+            const std::uint32_t count = trial % 50 == 0 ? 33 + std::uint32_t(rng.index(8))
+                                                        : 1 + std::uint32_t(rng.index(simd::kMostRegionsInLanes));
+            const float margin = rng.uniform() < 0.5 ? 0.0f : 1e-3f;
+            std::vector<float> boundary(count + 1);
+            for (std::uint32_t k = 0; k <= count; ++k)
+                boundary[k] = float(double(box.lo[axis]) + (double(box.hi[axis]) - double(box.lo[axis])) * k / count);
+            boundary[0] = box.lo[axis];
+            boundary[count] = box.hi[axis];
+            std::vector<glm::vec3> wideLo(count), wideHi(count);
+            for (std::uint32_t k = 0; k < count; ++k) {
+                wideLo[k] = box.lo - glm::vec3(margin);
+                wideHi[k] = box.hi + glm::vec3(margin);
+                wideLo[k][axis] = boundary[k] - margin;
+                wideHi[k][axis] = boundary[k + 1] + margin;
+            }
+            const simd::RegionSlabs slabs{.axis = axis,
+                                          .count = count,
+                                          .boundary = boundary.data(),
+                                          .wideLo = wideLo.data(),
+                                          .wideHi = wideHi.data(),
+                                          .sceneLo = box.lo - glm::vec3(margin),
+                                          .sceneHi = box.hi + glm::vec3(margin)};
+            std::vector<Ray> rays(1 + rng.index(70));
+            for (Ray& r : rays) {
+                r = randomRay(rng);
+                if (rng.uniform() < 0.3) r.origin[axis] = boundary[rng.index(count + 1)];  // on a face
+            }
+            std::vector<std::uint32_t> region(rays.size(), 7u);
+            simd::firstRegionsOfRays(rays.data(), rays.size(), slabs, region.data());
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                const std::uint32_t expected = simd::firstRegionOfRay(rays[i], slabs);
+                ASSERT_EQ(region[i], expected) << "trial " << trial << ", ray " << i << " of " << rays.size();
+                ++(expected == simd::kNoRegion ? none : binned);
+                multi += expected != simd::kNoRegion && expected > 0;
+            }
+        }
+        EXPECT_GT(binned, 1000u);
+        EXPECT_GT(none, 1000u);
+        EXPECT_GT(multi, 300u);
+    });
+}
+
 // Rays aimed at vertices and edges shared by neighbouring triangles, duplicated triangles
 // (equal t: the tie rule decides), degenerate ones, far offsets and grazing directions.
 TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
