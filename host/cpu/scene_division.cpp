@@ -50,9 +50,7 @@ std::vector<float> slabBoundaries(const Box& box, int axis, unsigned n) {
 
 // The slab holding x (clamped to the ends); callers correct by walking.
 int slabOf(float x, const std::vector<float>& boundary) {
-    const int n = int(boundary.size()) - 1;
-    const int k = int(std::upper_bound(boundary.begin() + 1, boundary.end() - 1, x) - (boundary.begin() + 1));
-    return std::clamp(k, 0, n - 1);
+    return int(simd::slabOf(x, boundary.data(), std::uint32_t(boundary.size() - 1)));
 }
 
 // The regions (equal slabs along the axis) and their boxes widened by the margin.

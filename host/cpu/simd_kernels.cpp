@@ -43,7 +43,7 @@ inline std::uint32_t walkStart(float origin, float dir, const RegionSlabs& s) {
     const bool down = dir < 0.0f;
     if (dir > 0.0f && origin < s.boundary[0]) return 0;
     if (down && origin > s.boundary[s.count]) return last;
-    const std::int64_t behind = std::int64_t(slabOf(origin, s)) + (down ? 1 : -1);
+    const std::int64_t behind = std::int64_t(slabOf(origin, s.boundary, s.count)) + (down ? 1 : -1);
     return std::uint32_t(std::clamp<std::int64_t>(behind, 0, last));
 }
 }  // namespace dacrt::simd
@@ -540,11 +540,11 @@ HWY_EXPORT(CompiledTarget);
 HWY_EXPORT(ClassifyFacing);
 HWY_EXPORT(FirstRegions);
 
-std::uint32_t slabOf(float x, const RegionSlabs& s) {
-    const float* first = s.boundary + 1;
-    const float* last = s.boundary + s.count;  // boundary[count] itself is not searched
+std::uint32_t slabOf(float x, const float* boundary, std::uint32_t count) {
+    const float* first = boundary + 1;
+    const float* last = boundary + count;  // boundary[count] itself is not searched
     const std::int64_t k = std::upper_bound(first, last, x) - first;
-    return std::uint32_t(std::clamp<std::int64_t>(k, 0, std::int64_t(s.count) - 1));
+    return std::uint32_t(std::clamp<std::int64_t>(k, 0, std::int64_t(count) - 1));
 }
 
 std::uint32_t firstRegionOfRay(const Ray& ray, const RegionSlabs& s) {

@@ -82,16 +82,18 @@ struct RegionSlabs {
     glm::vec3 sceneLo{}, sceneHi{};
 };
 constexpr std::uint32_t kNoRegion = 0xFFFFFFFFu;
-// Regions the SIMD binning tests at once (one bit each); more go ray by ray.
+// The SIMD binning tests every region for each vector of rays, where the walk ray by ray
+// tests one or two: beyond this many regions the rays go one by one.
 constexpr std::uint32_t kMostRegionsInLanes = 32;
 
-// The slab holding x: boundary[1 .. count - 1] searched, clamped to [0, count).
-std::uint32_t slabOf(float x, const RegionSlabs& s);
-// The region a ray meets first in its travel direction (kNoRegion: it meets the widened scene
-// box or no region): the walk starts one slab behind the origin's (so that rounding in that
-// guess never skips the true first region; at the first or last slab for an origin outside
-// the box on the side the ray comes from) and tests shared::rayMayCrossCell (unbounded) region
-// by region. The rule, ray by ray.
+// The slab of `count` (boundary[0 .. count]) holding x: boundary[1 .. count - 1] searched,
+// clamped to [0, count).
+std::uint32_t slabOf(float x, const float* boundary, std::uint32_t count);
+// The region a ray meets first in its travel direction (kNoRegion: it misses the widened
+// scene box, or crosses no region): the walk starts one slab behind the origin's (so that
+// rounding in that guess never skips the true first region; at the first or last slab for an
+// origin outside the box on the side the ray comes from) and tests shared::rayMayCrossCell
+// (unbounded) region by region. The rule, ray by ray.
 std::uint32_t firstRegionOfRay(const Ray& ray, const RegionSlabs& s);
 // firstRegionOfRay of rays[0, count) into region[0, count): the regions' tests lanes at a
 // time (kMostRegionsInLanes at most; more, ray by ray), the same answers.
