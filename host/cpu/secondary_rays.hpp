@@ -13,6 +13,7 @@
 #include "cpu/frame_geometry.hpp"
 #include "cpu/occlusion_ray_rows.hpp"
 #include "cpu/predicates.hpp"
+#include "cpu/simd_kernels.hpp"
 
 namespace dacrt::shared {
 inline uint floatBitsToUint(float x) { return std::bit_cast<uint>(x); }
@@ -88,11 +89,8 @@ void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::siz
     // The hit triangles lie anywhere in the scene's array: each asked for a few hits ahead.
     constexpr std::size_t kHitsAhead = 8;
     const auto prefetchAhead = [&](std::size_t i) {
-        if (i + kHitsAhead < end && hitSendsRays(hits[i + kHitsAhead])) {
-            const char* t = reinterpret_cast<const char*>(&triangles[hits[i + kHitsAhead].prim]);
-            __builtin_prefetch(t);
-            __builtin_prefetch(t + sizeof(Triangle) - 1);
-        }
+        if (i + kHitsAhead < end && hitSendsRays(hits[i + kHitsAhead]))
+            simd::prefetchTriangle(triangles[hits[i + kHitsAhead].prim]);
     };
     if (pass.kind != shared::kPassOcclusion) {
         for (std::size_t i = first; i < end; ++i) {

@@ -33,21 +33,6 @@ alignas(64) static constexpr CompressTable kCompressTable = makeCompressTable();
 }  // namespace dacrt::simd
 #endif
 
-#ifndef DACRT_SIMD_REGION_WALK
-#define DACRT_SIMD_REGION_WALK
-namespace dacrt::simd {
-// Where firstRegionOfRay's walk starts: one slab behind the origin's in the travel direction,
-// or the first (last) slab for a ray that starts below (above) the box moving up (down).
-inline std::uint32_t walkStart(float origin, float dir, const RegionSlabs& s) {
-    const std::uint32_t last = s.count - 1;
-    const bool down = dir < 0.0f;
-    if (dir > 0.0f && origin < s.boundary[0]) return 0;
-    if (down && origin > s.boundary[s.count]) return last;
-    const std::int64_t behind = std::int64_t(slabOf(origin, s.boundary, s.count)) + (down ? 1 : -1);
-    return std::uint32_t(std::clamp<std::int64_t>(behind, 0, last));
-}
-}  // namespace dacrt::simd
-#endif
 HWY_BEFORE_NAMESPACE();
 namespace dacrt::simd {
 namespace HWY_NAMESPACE {
@@ -188,6 +173,19 @@ HWY_INLINE void slabInterval(VF origin, VF invDir, float lo, float hi, VF& tNear
     tFar = hn::IfThenElse(parallel, hn::IfThenElse(inside, none, all), maxLike(t0, t1));
 }
 
+// shared::rayMayCrossCell lane by lane: the ray may meet the (widened) cell at some t in
+// [tmin, tmax].
+HWY_INLINE MF mayCrossCell(const VF origin[3], const VF invDir[3], VF tmin, VF tmax, const glm::vec3& lo,
+                           const glm::vec3& hi) {
+    VF xn, xf, yn, yf, zn, zf;
+    slabInterval(origin[0], invDir[0], lo.x, hi.x, xn, xf);
+    slabInterval(origin[1], invDir[1], lo.y, hi.y, yn, yf);
+    slabInterval(origin[2], invDir[2], lo.z, hi.z, zn, zf);
+    const VF tNear = maxLike(xn, maxLike(yn, zn));
+    const VF tFar = minLike(xf, minLike(yf, zf));
+    return hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
+}
+
 template <SharedRayFields kShared>
 HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
                                        const Box& cell, std::uint32_t* scratch) {
@@ -210,16 +208,9 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
         VF start[4], invDir[4];
         if constexpr (!kSharedStart) loadQuadPerLane<0>(ray, idLanes, start);
         loadQuadPerLane<8>(ray, idLanes, invDir);
-        VF xn, xf, yn, yf, zn, zf;
-        slabInterval(kSharedStart ? sharedOrigin[0] : start[0], invDir[0], cell.lo.x, cell.hi.x, xn, xf);
-        slabInterval(kSharedStart ? sharedOrigin[1] : start[1], invDir[1], cell.lo.y, cell.hi.y, yn, yf);
-        slabInterval(kSharedStart ? sharedOrigin[2] : start[2], invDir[2], cell.lo.z, cell.hi.z, zn, zf);
-        const VF tNear = maxLike(xn, maxLike(yn, zn));
-        const VF tFar = minLike(xf, minLike(yf, zf));
         const VF tmin = kSharedStart || kSharedSegment ? sharedTmin : start[3];
         const VF tmax = kSharedSegment ? sharedBestT : loadPerLane<4>(hit, idLanes, 0);
-        const MF m = hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
-        return hn::RebindMask(du, m);
+        return hn::RebindMask(du, mayCrossCell(kSharedStart ? sharedOrigin : start, invDir, tmin, tmax, cell.lo, cell.hi));
     });
 }
 
@@ -264,14 +255,7 @@ HWY_INLINE bool triangleHasNoArea(const LeafTriangles& batch, std::size_t j) {
     return shared::triangleHasNoArea(vertex(0), vertex(1), vertex(2));
 }
 
-// Both cache lines a 48-byte triangle may straddle.
-HWY_INLINE void prefetchTriangle(const Triangle* t) {
-    const char* bytes = reinterpret_cast<const char*>(t);
-    __builtin_prefetch(bytes);
-    __builtin_prefetch(bytes + sizeof(Triangle) - 1);
-}
-
-// Copies the triangles' vertices into the batch's lanes, a vector of triangles per gather.
+// Copies the triangles' vertices into the batch's lanes.
 void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds, std::uint32_t count,
                          LeafTriangles& batch) {
     static_assert(sizeof(Triangle) == 12 * sizeof(float));
@@ -286,7 +270,7 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     // The batch's triangles are scattered over the scene's array (a large scene's exceeds the
     // caches): every one asked for before the first is copied, so that their misses overlap
     // instead of each copy waiting on its own (docs/benchmarks.md, "Prefetched leaves").
-    for (std::size_t j = 0; j < count; ++j) prefetchTriangle(triangles + triIds[j]);
+    for (std::size_t j = 0; j < count; ++j) prefetchTriangle(triangles[triIds[j]]);
     for (std::size_t j = 0; j < lanes; ++j) {
         const std::uint32_t id = triIds[j < count ? j : 0];
         const Triangle& t = triangles[id];
@@ -402,58 +386,54 @@ void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
     }
 }
 
-// firstRegionOfRay lanes at a time, walk and all: each lane's start (walkStart), then every
-// region's test in ascending order, a lane moving up keeping the first region at or after its
-// start that its ray crosses, a lane moving down the last one at or before it.
+// firstRegionOfRay lanes at a time: each lane's walk start, then every region's test in
+// ascending order, a lane moving up keeping the first region at or after its start that its
+// ray crosses, a lane moving down the last one at or before it. The walk's clamp of its start
+// and its starts for origins outside the box are left out: with every region tested they
+// change no answer (a start of -1 or count selects as 0 or count - 1 does, and an origin below
+// boundary[0] or above boundary[count] already gets slab 0 or count - 1). A region's box lies
+// inside the scene box, so a lane that misses the scene box crosses no region either; the
+// scene box is still asked, as the walk asks it.
 void FirstRegions(const Ray* rays, std::size_t count, const RegionSlabs& s, std::uint32_t* region) {
     const DF df;
     const DI di;
+    const hn::RebindToUnsigned<DI> du;
     const std::size_t n = hn::Lanes(df);
     const float* base = reinterpret_cast<const float*>(rays);
     const VF noHit = hn::Set(df, kNoHitT);
-    const auto last = hn::Set(di, std::int32_t(s.count) - 1);
     const auto none = hn::Set(di, std::int32_t(kNoRegion));
     alignas(64) std::uint32_t ids[64], tail[64];
     for (std::size_t i = 0; i < count; i += n) {
         const std::size_t lanes = std::min(n, count - i);
         for (std::size_t l = 0; l < n; ++l) ids[l] = std::uint32_t(i + std::min(l, lanes - 1));
-        VF start[4], dir[4], invDir[4];
-        loadQuadPerLane<0>(base, ids, start);
+        // Floats 0-3 of a Ray: origin and tmin; 4-6 the direction; 8-10 its reciprocals.
+        VF originAndTmin[4], dir[4], invDir[4];
+        loadQuadPerLane<0>(base, ids, originAndTmin);
         loadQuadPerLane<4>(base, ids, dir);
         loadQuadPerLane<8>(base, ids, invDir);
-        // shared::rayMayCrossCell(ray, lo, hi, kNoHitT).
-        const auto crosses = [&](const glm::vec3& lo, const glm::vec3& hi) {
-            VF xn, xf, yn, yf, zn, zf;
-            slabInterval(start[0], invDir[0], lo.x, hi.x, xn, xf);
-            slabInterval(start[1], invDir[1], lo.y, hi.y, yn, yf);
-            slabInterval(start[2], invDir[2], lo.z, hi.z, zn, zf);
-            const VF tNear = maxLike(xn, maxLike(yn, zn));
-            const VF tFar = minLike(xf, minLike(yf, zf));
-            return hn::RebindMask(di, hn::And(hn::And(tNear <= tFar, tFar >= start[3]), tNear <= noHit));
-        };
-        const VF origin = start[s.axis], d = dir[s.axis];
+        const VF tmin = originAndTmin[3];
+        const VF origin = originAndTmin[s.axis], d = dir[s.axis];
         const auto down = hn::RebindMask(di, d < hn::Zero(df));
-        // walkStart: slabOf (the boundaries 1 .. count - 1 at or below the origin), one behind.
+        // slabOf (the boundaries 1 .. count - 1 at or below the origin), then one slab behind.
         auto slab = hn::Zero(di);
         for (std::uint32_t k = 1; k < s.count; ++k)
             slab = hn::Sub(slab, hn::VecFromMask(di, hn::RebindMask(di, hn::Set(df, s.boundary[k]) <= origin)));
-        auto walk = hn::IfThenElse(down, hn::Add(slab, hn::Set(di, 1)), hn::Sub(slab, hn::Set(di, 1)));
-        walk = hn::Min(hn::Max(walk, hn::Zero(di)), last);
-        walk = hn::IfThenZeroElse(hn::RebindMask(di, hn::And(d > hn::Zero(df), origin < hn::Set(df, s.boundary[0]))), walk);
-        walk = hn::IfThenElse(hn::And(down, hn::RebindMask(di, origin > hn::Set(df, s.boundary[s.count]))), last, walk);
+        const auto walk = hn::IfThenElse(down, hn::Add(slab, hn::Set(di, 1)), hn::Sub(slab, hn::Set(di, 1)));
         auto found = none;
         for (std::uint32_t k = 0; k < s.count; ++k) {
             const auto vk = hn::Set(di, std::int32_t(k));
-            const auto crossed = crosses(s.wideLo[k], s.wideHi[k]);
-            const auto up = hn::AndNot(down, hn::AndNot(vk < walk, found == none));
-            const auto back = hn::AndNot(vk > walk, down);
-            found = hn::IfThenElse(hn::And(crossed, hn::Or(up, back)), vk, found);
+            const auto crossed =
+                hn::RebindMask(di, mayCrossCell(originAndTmin, invDir, tmin, noHit, s.wideLo[k], s.wideHi[k]));
+            const auto keepMovingUp = hn::AndNot(down, hn::AndNot(vk < walk, found == none));
+            const auto keepMovingDown = hn::AndNot(vk > walk, down);
+            found = hn::IfThenElse(hn::And(crossed, hn::Or(keepMovingUp, keepMovingDown)), vk, found);
         }
-        found = hn::IfThenElse(crosses(s.sceneLo, s.sceneHi), found, none);
+        const auto inScene = hn::RebindMask(di, mayCrossCell(originAndTmin, invDir, tmin, noHit, s.sceneLo, s.sceneHi));
+        found = hn::IfThenElse(inScene, found, none);
         if (lanes == n) {
-            hn::StoreU(hn::BitCast(hn::RebindToUnsigned<DI>(), found), hn::RebindToUnsigned<DI>(), region + i);
+            hn::StoreU(hn::BitCast(du, found), du, region + i);
         } else {
-            hn::Store(hn::BitCast(hn::RebindToUnsigned<DI>(), found), hn::RebindToUnsigned<DI>(), tail);
+            hn::Store(hn::BitCast(du, found), du, tail);
             std::copy(tail, tail + lanes, region + i);
         }
     }
@@ -546,6 +526,19 @@ std::uint32_t slabOf(float x, const float* boundary, std::uint32_t count) {
     const std::int64_t k = std::upper_bound(first, last, x) - first;
     return std::uint32_t(std::clamp<std::int64_t>(k, 0, std::int64_t(count) - 1));
 }
+
+namespace {
+// Where firstRegionOfRay's walk starts: one slab behind the origin's in the travel direction,
+// or the first (last) slab for a ray that starts below (above) the box moving up (down).
+std::uint32_t walkStart(float origin, float dir, const RegionSlabs& s) {
+    const std::uint32_t last = s.count - 1;
+    const bool down = dir < 0.0f;
+    if (dir > 0.0f && origin < s.boundary[0]) return 0;
+    if (down && origin > s.boundary[s.count]) return last;
+    const std::int64_t behind = std::int64_t(slabOf(origin, s.boundary, s.count)) + (down ? 1 : -1);
+    return std::uint32_t(std::clamp<std::int64_t>(behind, 0, last));
+}
+}  // namespace
 
 std::uint32_t firstRegionOfRay(const Ray& ray, const RegionSlabs& s) {
     if (!shared::rayMayCrossCell(ray, s.sceneLo, s.sceneHi, kNoHitT)) return kNoRegion;

@@ -71,8 +71,9 @@ void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
                     const LeafTriangles& batch);
 
 // The regions of a scene division as the ray binning reads them (scene_division.cpp): `count`
-// equal slabs along `axis` between boundary[0] and boundary[count] (the scene box's faces on
-// that axis), their boxes widened by the filter margin, and the widened scene box.
+// (at least 1) slabs along `axis` between ascending boundaries boundary[0] .. boundary[count]
+// (the scene box's faces on that axis at the ends), their boxes widened by the filter margin,
+// and the widened scene box, which holds every region's box.
 struct RegionSlabs {
     int axis = 0;
     std::uint32_t count = 0;
@@ -96,8 +97,17 @@ std::uint32_t slabOf(float x, const float* boundary, std::uint32_t count);
 // (unbounded) region by region. The rule, ray by ray.
 std::uint32_t firstRegionOfRay(const Ray& ray, const RegionSlabs& s);
 // firstRegionOfRay of rays[0, count) into region[0, count): the regions' tests lanes at a
-// time (kMostRegionsInLanes at most; more, ray by ray), the same answers.
+// time, the same answers for rays of finite origins (every ray a batch or a maker gives);
+// ray by ray beyond kMostRegionsInLanes regions or kMaxRays rays.
 void firstRegionsOfRays(const Ray* rays, std::size_t count, const RegionSlabs& s, std::uint32_t* region);
+
+// Asks for both cache lines a 48-byte triangle may straddle, before it is read: the leaves'
+// and the secondary rays' triangles lie anywhere in a scene's array.
+inline void prefetchTriangle(const Triangle& t) {
+    const char* bytes = reinterpret_cast<const char*>(&t);
+    __builtin_prefetch(bytes);
+    __builtin_prefetch(bytes + sizeof(Triangle) - 1);
+}
 
 // The back-face skip's verdict on triangles[0, count) seen from origin, certified in float32
 // lanes: kKeep where facesAwayFrom (triangle_skips.hpp, float64) is false (front-facing, or not

@@ -189,13 +189,14 @@ TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCellAndItsCom
 }
 
 // The division's ray binning: slabs as the division makes them (equal widths, widened boxes),
-// rays starting inside, outside and on the slabs' faces, parallel to the axis or not. The
-// walk over each lane's bits answers as the walk region by region; 33 and more regions take
-// the ray-by-ray path.
+// rays starting inside, outside and on the slabs' faces, parallel to the axis or not, counts
+// that leave a vector's tail. Every region tested in lanes answers as the walk region by
+// region; past the last ray nothing is written. (33 and more regions go ray by ray: those
+// trials check that the fallback is taken and answers.)
 TEST_F(EveryTarget, RayBinningFindsTheWalksFirstRegion) {
     forEachTarget([] {
         Random rng(15);
-        std::uint32_t binned = 0, none = 0, multi = 0;
+        std::uint32_t binned = 0, none = 0, pastTheFirstRegion = 0, alongNoAxisBinned = 0;
         for (int trial = 0; trial < 300; ++trial) {
             const Box box = randomCell(rng);
             const int axis = int(rng.index(3));
@@ -226,18 +227,23 @@ TEST_F(EveryTarget, RayBinningFindsTheWalksFirstRegion) {
                 r = randomRay(rng);
                 if (rng.uniform() < 0.3) r.origin[axis] = boundary[rng.index(count + 1)];  // on a face
             }
-            std::vector<std::uint32_t> region(rays.size(), 7u);
+            constexpr std::uint32_t kUnwritten = 0xDEADBEEFu;
+            constexpr std::size_t kGuard = 16;
+            std::vector<std::uint32_t> region(rays.size() + kGuard, kUnwritten);
             simd::firstRegionsOfRays(rays.data(), rays.size(), slabs, region.data());
             for (std::size_t i = 0; i < rays.size(); ++i) {
                 const std::uint32_t expected = simd::firstRegionOfRay(rays[i], slabs);
                 ASSERT_EQ(region[i], expected) << "trial " << trial << ", ray " << i << " of " << rays.size();
                 ++(expected == simd::kNoRegion ? none : binned);
-                multi += expected != simd::kNoRegion && expected > 0;
+                pastTheFirstRegion += expected != simd::kNoRegion && expected > 0;
+                alongNoAxisBinned += expected != simd::kNoRegion && rays[i].dir[axis] == 0.0f;
             }
+            for (std::size_t i = rays.size(); i < region.size(); ++i) ASSERT_EQ(region[i], kUnwritten) << "trial " << trial;
         }
         EXPECT_GT(binned, 1000u);
         EXPECT_GT(none, 1000u);
-        EXPECT_GT(multi, 300u);
+        EXPECT_GT(pastTheFirstRegion, 300u);
+        EXPECT_GT(alongNoAxisBinned, 50u);
     });
 }
 
