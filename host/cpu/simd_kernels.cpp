@@ -391,9 +391,11 @@ void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
 // ray crosses, a lane moving down the last one at or before it. The walk's clamp of its start
 // and its starts for origins outside the box are left out: with every region tested they
 // change no answer (a start of -1 or count selects as 0 or count - 1 does, and an origin below
-// boundary[0] or above boundary[count] already gets slab 0 or count - 1). A region's box lies
-// inside the scene box, so a lane that misses the scene box crosses no region either; the
-// scene box is still asked, as the walk asks it.
+// boundary[0] or above boundary[count] already gets slab 0 or count - 1). So is the walk's
+// first test, of the scene box: a region's widened box lies inside the widened scene box, bit
+// for bit (the same bounds but on the axis, where its boundaries do), and the lane test is
+// monotone in the box, so a lane that misses the scene box crosses no region either and keeps
+// kNoRegion.
 void FirstRegions(const Ray* rays, std::size_t count, const RegionSlabs& s, std::uint32_t* region) {
     const DF df;
     const DI di;
@@ -428,8 +430,6 @@ void FirstRegions(const Ray* rays, std::size_t count, const RegionSlabs& s, std:
             const auto keepMovingDown = hn::AndNot(vk > walk, down);
             found = hn::IfThenElse(hn::And(crossed, hn::Or(keepMovingUp, keepMovingDown)), vk, found);
         }
-        const auto inScene = hn::RebindMask(di, mayCrossCell(originAndTmin, invDir, tmin, noHit, s.sceneLo, s.sceneHi));
-        found = hn::IfThenElse(inScene, found, none);
         if (lanes == n) {
             hn::StoreU(hn::BitCast(du, found), du, region + i);
         } else {
