@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -27,7 +26,7 @@ constexpr std::size_t kTrianglesPerRayForTheGrid = 8;
 bool gridPaysFor(std::uint64_t rays, std::size_t triangles) { return rays * kTrianglesPerRayForTheGrid < triangles; }
 
 // Rays whose segments' lengths the grid's resolution is chosen from.
-constexpr std::size_t kSurveySamples = 4096;
+constexpr std::size_t kSpanSamples = 4096;
 
 // The parameters [t0, t1] of the ray's segment inside [lo, hi], in float64 (empty: t0 > t1).
 struct Interval {
@@ -49,124 +48,144 @@ Interval clipped(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi) {
     return iv;
 }
 
-// The float next to f towards -inf, as std::nextafter (-FLT_MAX steps to -inf, which the
-// grid's cellOf clamps to the cell FLT_MAX's direction would give).
-std::int32_t floatBitsStepDown(std::int32_t bits) {
-    bits = bits == 0 ? std::numeric_limits<std::int32_t>::min() : bits;  // +0 steps as -0 does
-    return bits + (bits < 0 ? 1 : -1);
-}
+// Chunks of a pass over the rays: up to 64, of at least 4096 rays.
+std::size_t rayChunks(std::size_t rays) { return std::max<std::size_t>(1, std::min<std::size_t>(64, rays / 4096 + 1)); }
 
-// The float nearest to x, stepped once towards -inf where it is above x: no float is between
-// it and x. Without branches (a mask picks the step): the grid's marking asks for six a piece
-// of segment, and whether a step is needed is a coin toss that a branch predictor loses
-// (it cost the Dragon's shadow pass half of its marking time).
-float floatBelow(double x) {
-    const float f = float(x);
-    const std::int32_t bits = std::bit_cast<std::int32_t>(f);
-    const std::int32_t step = -std::int32_t(double(f) > x);
-    return std::bit_cast<float>((floatBitsStepDown(bits) & step) | (bits & ~step));
-}
-// The same towards +inf: a float no less than x.
-float floatAbove(double x) { return -floatBelow(-x); }
-
-// What the cull learns from one pass over the rays.
-struct RaySurvey {
-    double cellSpans = 0.0;       // the clipped segments' lengths, in the box's longest side (estimated)
-    glm::dvec3 originLo{kNoHitT}, originHi{-kNoHitT};
-    bool directionShared = true;
-};
-
-// The origins' box and whether the directions agree, over every ray (the back-face test's
-// exactness rests on both), in parallel; the segments' lengths from a sample of the rays.
-RaySurvey surveyRays(const FrameGeometry& g, const glm::dvec3& clipLo, const glm::dvec3& clipHi, ThreadPool& pool) {
-    const std::vector<Ray>& rays = *g.rays;
-    const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(64, rays.size() / 4096 + 1));
-    std::vector<RaySurvey> parts(chunks);
+// Whether every ray has the first one's direction, bit for bit (the back-face test's exactness
+// rests on it), in parallel: a chunk stops at its first other direction, and the others at
+// their next ray, so a pass of scattered directions (occlusion rays) reads a few rays only.
+bool raysShareDirection(const std::vector<Ray>& rays, ThreadPool& pool) {
+    const std::size_t chunks = rayChunks(rays.size());
+    std::atomic<bool> shared{true};
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        RaySurvey s;
-        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks; i < end; ++i) {
-            s.originLo = glm::min(s.originLo, glm::dvec3(rays[i].origin));
-            s.originHi = glm::max(s.originHi, glm::dvec3(rays[i].origin));
-            s.directionShared = s.directionShared && std::memcmp(&rays[i].dir, &rays.front().dir, sizeof(Ray::dir)) == 0;
-        }
-        parts[c] = s;
+        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks;
+             i < end && shared.load(std::memory_order_relaxed); ++i)
+            if (std::memcmp(&rays[i].dir, &rays.front().dir, sizeof(Ray::dir)) != 0) shared.store(false, std::memory_order_relaxed);
     });
-    RaySurvey s;
-    for (const RaySurvey& p : parts) {
-        s.originLo = glm::min(s.originLo, p.originLo);
-        s.originHi = glm::max(s.originHi, p.originHi);
-        s.directionShared = s.directionShared && p.directionShared;
+    return shared.load();
+}
+
+// Where every ray's segment ends, origin + tmax dir, as a box: where every ray has the same
+// finite tmax and the ends lie within kEndSpread of the scene's diagonal of one another along
+// every axis (a point or spot light's shadow rays end at the light, within rounding), in
+// parallel; a chunk stops at its first end too far from its first. The box holds the exact
+// ends: each end is one rounding of exact terms (tmax dir is exact in float64), so a step
+// outwards covers it.
+constexpr double kEndSpread = 0x1p-10;
+struct EndBox {
+    bool shared = false;
+    glm::dvec3 lo{0.0}, hi{0.0};
+};
+EndBox raysShareEnd(const std::vector<Ray>& rays, const Box& sceneBox, ThreadPool& pool) {
+    EndBox box;
+    const float tmax = rays.front().tmax;
+    if (!(tmax < kNoHitT)) return box;
+    const double spread = kEndSpread * glm::length(glm::dvec3(sceneBox.hi) - glm::dvec3(sceneBox.lo));
+    auto endOf = [&](const Ray& r) { return glm::dvec3(r.origin) + double(tmax) * glm::dvec3(r.dir); };
+    const glm::dvec3 first = endOf(rays.front());
+    const std::size_t chunks = rayChunks(rays.size());
+    std::vector<EndBox> parts(chunks);
+    std::atomic<bool> shared{true};
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        // Each chunk's box in locals, written once: neighbouring chunks' boxes share lines.
+        glm::dvec3 lo = first, hi = first;
+        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks;
+             i < end && shared.load(std::memory_order_relaxed); ++i) {
+            const glm::dvec3 e = endOf(rays[i]);
+            lo = glm::min(lo, e);
+            hi = glm::max(hi, e);
+            const glm::dvec3 extent = hi - lo;
+            if (rays[i].tmax != tmax || !(std::max({extent.x, extent.y, extent.z}) <= spread))
+                shared.store(false, std::memory_order_relaxed);
+        }
+        parts[c] = EndBox{true, lo, hi};
+    });
+    if (!shared.load()) return box;
+    box = parts[0];
+    for (const EndBox& p : parts) {
+        box.lo = glm::min(box.lo, p.lo);
+        box.hi = glm::max(box.hi, p.hi);
     }
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) box.lo[a] = std::nextafter(box.lo[a], -inf), box.hi[a] = std::nextafter(box.hi[a], inf);
+    return box;
+}
+
+// The largest distance between a ray's origin, a point of the scene and a point of `also`:
+// the origins' box over every ray (the back-face tests' exactness rests on it), in parallel,
+// joined to the scene's and to `also`.
+double farthestReach(const std::vector<Ray>& rays, const Box& sceneBox, const EndBox& also, ThreadPool& pool) {
+    const std::size_t chunks = rayChunks(rays.size());
+    glm::dvec3 sceneLo(sceneBox.lo), sceneHi(sceneBox.hi);
+    if (also.shared) sceneLo = glm::min(sceneLo, also.lo), sceneHi = glm::max(sceneHi, also.hi);
+    std::vector<EndBox> parts(chunks);
+    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
+        glm::dvec3 lo = sceneLo, hi = sceneHi;  // in locals, as raysShareEnd's
+        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks; i < end; ++i) {
+            lo = glm::min(lo, glm::dvec3(rays[i].origin));
+            hi = glm::max(hi, glm::dvec3(rays[i].origin));
+        }
+        parts[c] = EndBox{true, lo, hi};
+    });
+    for (const EndBox& p : parts) {
+        sceneLo = glm::min(sceneLo, p.lo);
+        sceneHi = glm::max(sceneHi, p.hi);
+    }
+    return glm::length(sceneHi - sceneLo);
+}
+
+// The clipped segments' lengths, in the box's longest side, estimated from a sample of the
+// rays: what the grid's resolution is chosen from.
+double segmentSpans(const std::vector<Ray>& rays, const glm::dvec3& clipLo, const glm::dvec3& clipHi) {
     const double longest = std::max({clipHi.x - clipLo.x, clipHi.y - clipLo.y, clipHi.z - clipLo.z});
-    const std::size_t stride = std::max<std::size_t>(1, rays.size() / kSurveySamples);
+    const std::size_t stride = std::max<std::size_t>(1, rays.size() / kSpanSamples);
+    double spans = 0.0;
     for (std::size_t i = 0; i < rays.size(); i += stride) {
         const Interval iv = clipped(rays[i], clipLo, clipHi);
         if (iv.t0 <= iv.t1)
-            s.cellSpans += double(stride) * ((iv.t1 - iv.t0) * glm::length(glm::dvec3(rays[i].dir)) / longest +
-                                             1.0 / RayGrid::kMaxCells);
+            spans += double(stride) * ((iv.t1 - iv.t0) * glm::length(glm::dvec3(rays[i].dir)) / longest +
+                                       1.0 / RayGrid::kMaxCells);
     }
-    return s;
-}
-
-// The largest distance from a ray's origin to a point of the scene.
-double farthestReach(const RaySurvey& s, const Box& sceneBox) {
-    const glm::dvec3 lo = glm::min(s.originLo, glm::dvec3(sceneBox.lo)), hi = glm::max(s.originHi, glm::dvec3(sceneBox.hi));
-    return glm::length(hi - lo);
+    return spans;
 }
 
 enum Verdict : std::uint8_t { kTraced = kTracedVerdict, kOutsideRays, kBackFacing };
 
 }  // namespace
 
-int RayGrid::cellOf(float x, int k) const {
-    // Monotone in x (each rounding and the clamp are), so boxes that overlap get cell ranges
-    // that overlap. Branch-free: the triangles' pass calls it six times a triangle. std::max
-    // with 0 first: an infinite x on a flat axis (scale 0) gives NaN, which it turns into 0.
-    return int(std::min(std::max(0.0f, (x - lo_[k]) * scale_[k]), float(n_[k] - 1)));
-}
-
 // Cells from..to of a row, as bits.
 std::uint64_t rowBits(int from, int to) { return (~0ull >> (63 - to)) & (~0ull << from); }
-
-RayGrid::CellSpan RayGrid::cellsNear(const glm::dvec3& p) const {
-    CellSpan span;
-    for (int k = 0; k < 3; ++k) {
-        span.from[k] = cellOf(floatBelow(p[axis_[k]] - grow_), k);
-        span.to[k] = cellOf(floatAbove(p[axis_[k]] + grow_), k);
-    }
-    return span;
-}
 
 void RayGrid::markCells(const CellSpan& cells) {
     const std::uint64_t bits = rowBits(cells.from[0], cells.to[0]);
     for (int z = cells.from[2]; z <= cells.to[2]; ++z)
         for (int y = cells.from[1]; y <= cells.to[1]; ++y) {
-            std::atomic_ref<std::uint64_t> row(rows_[std::size_t(z) * n_[1] + y]);
+            std::atomic_ref<std::uint64_t> row(rows_[std::size_t(z) * axes_.count[1] + y]);
             if ((row.load(std::memory_order_relaxed) & bits) != bits) row.fetch_or(bits, std::memory_order_relaxed);
         }
 }
 
-void RayGrid::markRay(const Ray& ray) {
+void RayGrid::markRay(const Ray& ray, simd::PieceEndCells& ends) {
     const Interval iv = clipped(ray, clipLo_, clipHi_);
     if (!(iv.t0 <= iv.t1)) return;  // the segment misses the scene box: it hits nothing
     const glm::dvec3 o(ray.origin), d(ray.dir);
     // Pieces of at most one cell along every axis, each marked with the cells of its box grown
-    // by twice the margin. cellsNear is monotone in each coordinate, so a piece's cells are
-    // those of its two ends joined, and each end's are found once.
+    // by twice the margin. The cells near a point are monotone in each coordinate, so a
+    // piece's cells are those of its two ends joined, and each end's are found once, all of
+    // them in SIMD lanes.
     double span = 0.0;
-    for (int k = 0; k < 3; ++k) span = std::max(span, std::abs(d[axis_[k]]) * (iv.t1 - iv.t0) * double(scale_[k]));
+    for (int k = 0; k < 3; ++k)
+        span = std::max(span, std::abs(d[axes_.axis[k]]) * (iv.t1 - iv.t0) * double(axes_.scale[k]));
+    static_assert(4 * kMaxCells <= unsigned(simd::kMostPieces));
     const int pieces = int(std::clamp(std::ceil(span), 1.0, double(4 * kMaxCells)));
-    CellSpan from = cellsNear(o + iv.t0 * d);
+    simd::cellsNearPieceEnds(o, d, iv.t0, iv.t1, pieces, grow_, axes_, ends);
     for (int k = 1; k <= pieces; ++k) {
-        const double t = k == pieces ? iv.t1 : iv.t0 + (iv.t1 - iv.t0) * double(k) / double(pieces);
-        const CellSpan to = cellsNear(o + t * d);
         CellSpan piece;
         for (int a = 0; a < 3; ++a) {
-            piece.from[a] = std::min(from.from[a], to.from[a]);
-            piece.to[a] = std::max(from.to[a], to.to[a]);
+            piece.from[a] = std::min(ends.from[a][k - 1], ends.from[a][k]);
+            piece.to[a] = std::max(ends.to[a][k - 1], ends.to[a][k]);
         }
         markCells(piece);
-        from = to;
     }
 }
 
@@ -174,36 +193,40 @@ void RayGrid::mark(const FrameGeometry& g, unsigned cellsAlongLongest, std::vect
     const Box& box = g.sceneBox;
     const glm::vec3 extent = box.extent();
     const int shortest = int(std::min_element(&extent[0], &extent[0] + 3) - &extent[0]);
-    axis_[0] = shortest, axis_[1] = (shortest + 1) % 3, axis_[2] = (shortest + 2) % 3;
+    int* axis = axes_.axis;
+    axis[0] = shortest, axis[1] = (shortest + 1) % 3, axis[2] = (shortest + 2) % 3;
     const double longest = std::max({extent.x, extent.y, extent.z});
     // Cubic cells, cellsAlongLongest along the longest side, no more than kWordCells along the
     // shortest (larger cells where it would take more).
     const double cell = std::max(longest / std::clamp(cellsAlongLongest, 1u, kMaxCells), double(extent[shortest]) / kWordCells);
     longest_ = 1;
     for (int k = 0; k < 3; ++k) {
-        const int a = axis_[k];
-        n_[k] = cell > 0.0 ? std::clamp(int(std::ceil(double(extent[a]) / cell)), 1, int(k == 0 ? kWordCells : kMaxCells)) : 1;
-        lo_[k] = box.lo[a];
-        scale_[k] = extent[a] > 0.0f ? float(n_[k]) / extent[a] : 0.0f;
-        longest_ = std::max(longest_, unsigned(n_[k]));
+        const int a = axis[k];
+        int& n = axes_.count[k];
+        n = cell > 0.0 ? std::clamp(int(std::ceil(double(extent[a]) / cell)), 1, int(k == 0 ? kWordCells : kMaxCells)) : 1;
+        axes_.lo[k] = box.lo[a];
+        axes_.scale[k] = extent[a] > 0.0f ? float(n) / extent[a] : 0.0f;
+        longest_ = std::max(longest_, unsigned(n));
     }
     grow_ = 2.0 * double(g.margin);
     clipLo_ = glm::dvec3(box.lo) - grow_;
     clipHi_ = glm::dvec3(box.hi) + grow_;
-    rows.assign(std::size_t(n_[1]) * std::size_t(n_[2]), 0);
+    rows.assign(std::size_t(axes_.count[1]) * std::size_t(axes_.count[2]), 0);
     rows_ = rows.data();
     const std::vector<Ray>& rays = *g.rays;
     const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(64, rays.size() / 1024 + 1));
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks; i < end; ++i) markRay(rays[i]);
+        simd::PieceEndCells ends;
+        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks; i < end; ++i)
+            markRay(rays[i], ends);
     });
 }
 
-bool RayGrid::mayMeet(const glm::vec3& lo, const glm::vec3& hi) const {
-    const int x0 = cellOf(lo[axis_[0]], 0), x1 = cellOf(hi[axis_[0]], 0), y0 = cellOf(lo[axis_[1]], 1),
-              y1 = cellOf(hi[axis_[1]], 1), z0 = cellOf(lo[axis_[2]], 2), z1 = cellOf(hi[axis_[2]], 2);
+bool RayGrid::meetsCells(const simd::BoxCells& cells, std::uint32_t i) const {
+    const int x0 = cells.first[0][i], x1 = cells.last[0][i], y0 = cells.first[1][i], y1 = cells.last[1][i],
+              z0 = cells.first[2][i], z1 = cells.last[2][i];
     const std::uint64_t bits = rowBits(x0, x1);
-    auto row = [&](int y, int z) { return rows_[std::size_t(z) * n_[1] + y]; };
+    auto row = [&](int y, int z) { return rows_[std::size_t(z) * axes_.count[1] + y]; };
     // Most triangles span at most two cells along y and z: their four rows, without a loop.
     if (y1 - y0 <= 1 && z1 - z0 <= 1) return ((row(y0, z0) | row(y1, z0) | row(y0, z1) | row(y1, z1)) & bits) != 0;
     if ((y1 - y0 + 1) * (z1 - z0 + 1) > kMostRowsLooked) return true;
@@ -217,8 +240,29 @@ namespace {
 
 // The verdicts, chunk by chunk (counts per chunk), then the kept ids in order: two passes
 // over the triangles, into the cull's reused buffers.
-void keepTriangles(const FrameGeometry& g, const RayGrid* grid, const glm::dvec3* direction, double reach,
-                   ThreadPool& pool, PassCull& cull) {
+// What every ray of a pass shares that the back-face tests read: its direction, or the box
+// its segments end in (ends.shared), and the reach of the rays and the scene.
+struct SharedFacing {
+    glm::dvec3 direction{0.0};
+    EndBox ends;
+    double reach = 0.0;
+};
+
+// away[j] for the block's triangles: facing away from the shared direction (in SIMD lanes) or
+// toward the shared end, for the triangles asked for (all where asked is null).
+void facingOfBlock(const Triangle* tris, std::uint32_t count, const SharedFacing& facing, const std::uint8_t* asked,
+                   std::uint8_t* away) {
+    if (!facing.ends.shared) {
+        simd::facingAwayAlong(tris, count, facing.direction, facing.reach, asked, away);
+        return;
+    }
+    for (std::uint32_t j = 0; j < count; ++j)
+        away[j] = (!asked || asked[j]) && tris[j].cullBackFace &&
+                  facesTowardEnds(tris[j], facing.ends.lo, facing.ends.hi, facing.reach);
+}
+
+void keepTriangles(const FrameGeometry& g, const RayGrid* grid, const SharedFacing* facing, ThreadPool& pool,
+                   PassCull& cull) {
     const std::vector<Triangle>& tris = *g.triangles;
     const std::vector<Bounds>& bounds = *g.triangleBounds;
     const std::size_t chunks = skipChunks(tris.size());
@@ -227,21 +271,32 @@ void keepTriangles(const FrameGeometry& g, const RayGrid* grid, const glm::dvec3
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
         const auto [begin, end] = skipChunkRange(c, chunks, tris.size());
         SkipTally tally;
-        for (std::size_t i = begin; i < end; ++i) {
-            const Bounds& b = bounds[i];
-            const Triangle& t = tris[i];
-            Verdict v = kTraced;
-            if (grid && !grid->mayMeet(b.lo, b.hi))
-                v = kOutsideRays, ++tally.outside;
-            else if (direction && t.cullBackFace && facesAwayAlong(t, *direction, reach))
-                v = kBackFacing, ++tally.backFacing;
-            else {
-                ++tally.kept;
-                tally.box.extend(b.lo);
-                tally.box.extend(b.hi);
+        // Block by block: the cells and the facing in SIMD lanes (cull_lanes.hpp), then each
+        // triangle's verdict from their answers, still in the first level of cache.
+        simd::BoxCells cells;
+        std::uint8_t meets[simd::kCullBlock], away[simd::kCullBlock];
+        for (std::size_t block = begin; block < end; block += simd::kCullBlock) {
+            const auto count = std::uint32_t(std::min<std::size_t>(simd::kCullBlock, end - block));
+            if (grid) {
+                simd::cellsOfBoxes(bounds.data() + block, count, grid->axes(), cells);
+                for (std::uint32_t j = 0; j < count; ++j) meets[j] = grid->meetsCells(cells, j);
             }
-            tally.singleSided += direction && t.cullBackFace != 0u;
-            cull.verdict[i] = v;
+            // Only the triangles the grid keeps are read.
+            if (facing) facingOfBlock(tris.data() + block, count, *facing, grid ? meets : nullptr, away);
+            for (std::uint32_t j = 0; j < count; ++j) {
+                const std::size_t i = block + j;
+                Verdict v = kTraced;
+                if (grid && !meets[j])
+                    v = kOutsideRays, ++tally.outside;
+                else if (facing && away[j])
+                    v = kBackFacing, ++tally.backFacing;
+                else {
+                    ++tally.kept;
+                    tally.box.extend(bounds[i].lo);
+                    tally.box.extend(bounds[i].hi);
+                }
+                cull.verdict[i] = v;
+            }
         }
         tallies[c] = tally;
     });
@@ -249,40 +304,67 @@ void keepTriangles(const FrameGeometry& g, const RayGrid* grid, const glm::dvec3
     cull.outsideRays = listTraced(tallies, cull.verdict.data(), tris.size(), false, pool, cull.skips);
 }
 
+// Whether the grid is marked for a pass of `rays` rays.
+bool gridOnFor(std::size_t rays, std::size_t triangles, const SkipSwitches& switches, unsigned cellsAlongLongest) {
+    return switches.passRays && (cellsAlongLongest || gridPaysFor(rays, triangles));
+}
+
 }  // namespace
 
-void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool, PassCull& cull,
-                 unsigned cellsAlongLongest) {
+void cullNothing(PassCull& cull) {
     cull.skips.applied = false;
     cull.skips.tracedBox = Box{};
     cull.skips.singleSided = cull.skips.backFacing = cull.skips.outsideFrustum = 0;
     cull.outsideRays = 0;
-    cull.raysTested = cull.directionShared = false;
+    cull.raysTested = cull.directionShared = cull.endShared = false;
     cull.cellsAlongLongest = 0;
-    const std::vector<Ray>& rays = *g.rays;
-    if ((!switches.passRays && !switches.backFaces) || rays.empty() || g.triangles->empty()) return;
+}
 
-    const double grow = 2.0 * double(g.margin);
-    const RaySurvey survey = surveyRays(g, glm::dvec3(g.sceneBox.lo) - grow, glm::dvec3(g.sceneBox.hi) + grow, pool);
+bool passCullTests(const std::vector<Ray>& rays, std::size_t triangles, const Box& sceneBox, const SkipSwitches& switches,
+                   unsigned cellsAlongLongest) {
+    if (rays.empty() || triangles == 0) return false;
+    if (gridOnFor(rays.size(), triangles, switches, cellsAlongLongest)) return true;
+    if (!switches.backFaces) return false;
+    // The first rays only: cullForPass asks every one.
+    const std::vector<Ray> first(rays.begin(), rays.begin() + std::ptrdiff_t(std::min<std::size_t>(rays.size(), 64)));
+    ThreadPool one(1);
+    return raysShareDirection(first, one) || raysShareEnd(first, sceneBox, one).shared;
+}
+
+void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool, PassCull& cull,
+                 unsigned cellsAlongLongest) {
+    cullNothing(cull);
+    const std::vector<Ray>& rays = *g.rays;
+    if (rays.empty() || g.triangles->empty()) return;
+    // Each test only where it may drop something, and the rays read only for the tests on: a
+    // pass of many rays and scattered directions (occlusion) reads a few of them and no
+    // triangle at all.
+    const bool gridOn = gridOnFor(rays.size(), g.triangles->size(), switches, cellsAlongLongest);
+    cull.directionShared = switches.backFaces && raysShareDirection(rays, pool);
+    const EndBox ends = switches.backFaces && !cull.directionShared ? raysShareEnd(rays, g.sceneBox, pool) : EndBox{};
+    cull.endShared = ends.shared;
+    if (!gridOn && !cull.directionShared && !cull.endShared) return;  // every triangle traced, unlisted
     RayGrid grid;
-    // A pass of many rays for its triangles spends its time on the rays: the grid would cost
-    // more than it saves (measured: docs/benchmarks.md, "Secondary passes").
-    if (switches.passRays && (cellsAlongLongest || gridPaysFor(rays.size(), g.triangles->size()))) {
+    if (gridOn) {
         // Cells along the longest side: as many as the marking budget allows, up to kMaxCells.
+        const double grow = 2.0 * double(g.margin);
+        const double spans = segmentSpans(rays, glm::dvec3(g.sceneBox.lo) - grow, glm::dvec3(g.sceneBox.hi) + grow);
         const double budget = kPiecesPerTriangle * double(g.triangles->size());
-        const double cells = std::clamp(budget / std::max(survey.cellSpans, 1e-30), 1.0, double(RayGrid::kMaxCells));
+        const double cells = std::clamp(budget / std::max(spans, 1e-30), 1.0, double(RayGrid::kMaxCells));
         grid.mark(g, cellsAlongLongest ? cellsAlongLongest : unsigned(cells), cull.rows, pool);
         cull.raysTested = true;
         cull.cellsAlongLongest = grid.cellsAlongLongest();
     }
-    cull.directionShared = switches.backFaces && survey.directionShared;
-    const glm::dvec3 direction(rays.front().dir);
-    keepTriangles(g, cull.raysTested ? &grid : nullptr, cull.directionShared ? &direction : nullptr,
-                  farthestReach(survey, g.sceneBox), pool, cull);
+    SharedFacing facing;
+    facing.direction = glm::dvec3(rays.front().dir);
+    facing.ends = ends;
+    if (cull.directionShared || cull.endShared) facing.reach = farthestReach(rays, g.sceneBox, ends, pool);
+    keepTriangles(g, cull.raysTested ? &grid : nullptr, cull.directionShared || cull.endShared ? &facing : nullptr, pool,
+                  cull);
 }
 
-bool passCullMayDrop(std::uint64_t mostRays, std::size_t triangles, bool oneDirection, const SkipSwitches& switches) {
-    return (switches.passRays && gridPaysFor(mostRays, triangles)) || (switches.backFaces && oneDirection);
+bool passCullMayDrop(std::uint64_t mostRays, std::size_t triangles, bool sharedFacing, const SkipSwitches& switches) {
+    return (switches.passRays && gridPaysFor(mostRays, triangles)) || (switches.backFaces && sharedFacing);
 }
 
 void planPassCull(const FrameGeometry& g, const SkipSwitches& switches, const PassCull& cull, MemoryPlan& plan) {
@@ -293,8 +375,9 @@ void planPassCull(const FrameGeometry& g, const SkipSwitches& switches, const Pa
                                      : "skip off (--no-skip)");
     plan.addWork("skipped: back-facing", cull.skips.backFacing,
                  cull.directionShared ? "single-sided, facing away from the rays' shared direction"
+                 : cull.endShared      ? "single-sided, facing toward the point where every ray ends"
                  : !switches.backFaces ? "skip off (--no-skip)"
-                                       : "needs rays with one direction (a directional light's)");
+                                       : "needs rays with one direction or one end (a light's)");
     plan.addWork("triangles traced", cull.skips.applied ? cull.skips.traced.size() : g.triangles->size());
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/thread_pool.hpp"
+#include "cpu/cull_lanes.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/memory_plan.hpp"
 #include "cpu/options.hpp"
@@ -30,28 +31,24 @@ public:
     // scene box, cellsAlongLongest cells along its longest side (1 to kMaxCells). rows is the
     // marks' storage (a word per row of cells along x), reused from pass to pass.
     void mark(const FrameGeometry& g, unsigned cellsAlongLongest, std::vector<std::uint64_t>& rows, ThreadPool& pool);
-    // Whether a box meets a marked cell (boxes over many cells are kept unlooked).
-    bool mayMeet(const glm::vec3& lo, const glm::vec3& hi) const;
     unsigned cellsAlongLongest() const { return longest_; }
+    // The grid's axes, whose simd::cellsOfBoxes gives the cells a box covers.
+    const simd::GridAxes& axes() const { return axes_; }
+    // Whether box i of cells, the cells cells.first[k][i] .. cells.last[k][i] along each of the
+    // grid's axes k, holds a marked cell (boxes over many rows of cells are kept unlooked).
+    bool meetsCells(const simd::BoxCells& cells, std::uint32_t i) const;
 
 private:
     // Cells from[k]..to[k] along the grid's axis k, inclusive.
     struct CellSpan {
         int from[3], to[3];
     };
-    int cellOf(float x, int k) const;  // along the grid's axis k
-    // The cells of the box around p grown by twice the margin, each bound rounded outwards.
-    CellSpan cellsNear(const glm::dvec3& p) const;
     void markCells(const CellSpan& cells);
-    void markRay(const Ray& ray);
+    void markRay(const Ray& ray, simd::PieceEndCells& ends);
 
     unsigned longest_ = 1;
-    // The grid's axes: axis_[0] the shortest side's (along a word), then the other two; n_,
-    // lo_ and scale_ are in that order.
-    int axis_[3] = {0, 1, 2};
-    int n_[3] = {1, 1, 1};
-    glm::vec3 lo_{};      // the grid's corner: the scene box's
-    glm::vec3 scale_{};   // cells per unit along each axis (0 on a flat axis)
+    // The grid's axes: axes_.axis[0] the shortest side's (along a word), then the other two.
+    simd::GridAxes axes_;
     glm::dvec3 clipLo_{}, clipHi_{};  // the scene box widened by twice the margin
     double grow_ = 0.0;               // twice the margin
     std::uint64_t* rows_ = nullptr;
@@ -60,27 +57,42 @@ private:
 // What a pass's cull keeps, with the buffers it reuses from pass to pass (fresh memory is
 // slow to touch on a VM: a pass must not allocate in proportion to the scene each time).
 struct PassCull {
-    TriangleSkips skips;                  // applied: the kept triangles (withSkips)
+    // Applied: the kept triangles (withSkips). Its singleSided stays 0: counting them would
+    // read the triangles the grid drops, which the cull never reads.
+    TriangleSkips skips;
     std::uint64_t outsideRays = 0;        // dropped: no ray's segment passes their cells
     bool raysTested = false;              // the grid was built (the skip was on)
     bool directionShared = false;         // the rays share one direction: back faces tested
+    bool endShared = false;               // the rays' segments end at one point: faces toward it tested
     unsigned cellsAlongLongest = 0;       // the grid's resolution
     std::vector<std::uint8_t> verdict;    // per triangle, reused
     std::vector<std::uint64_t> rows;      // the grid's marks, reused
 };
 
 // Culls the triangles of pass frame g (its rays are the pass's) that switches allow: those
-// outside the rays' cells (switches.passRays) and, where every ray has the same direction,
-// single-sided ones facing away from it (switches.backFaces). Fills cull.skips.
+// outside the rays' cells (switches.passRays) and, with switches.backFaces, single-sided ones
+// facing away from the rays' shared direction where they have one (a directional light's
+// shadow rays), or facing toward the point where every segment ends where they share one
+// (a point or spot light's). Fills cull.skips.
 // cellsAlongLongest: the grid's resolution; 0 chooses it from the rays' lengths, so that
 // marking them costs a fraction of the pass over the triangles.
 void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool, PassCull& cull,
                  unsigned cellsAlongLongest = 0);
 
+// Whether cullForPass may test anything for a pass of these rays over `triangles` triangles
+// (the grid pays for itself, or the first rays share a direction or an end): it reads a few of
+// them. Where it does not, the pass's geometry need not be made for the cull (cullNothing
+// says so).
+bool passCullTests(const std::vector<Ray>& rays, std::size_t triangles, const Box& sceneBox, const SkipSwitches& switches,
+                   unsigned cellsAlongLongest = 0);
+// The cull of a pass that tests nothing: every triangle traced, unlisted.
+void cullNothing(PassCull& cull);
+
 // Whether cullForPass may drop triangles of a pass of at most mostRays rays over `triangles`
-// triangles (oneDirection: its rays share one, as a directional light's shadow rays do): the
-// gpu, which makes a pass's rays on the device, makes them on the host for the cull only then.
-bool passCullMayDrop(std::uint64_t mostRays, std::size_t triangles, bool oneDirection, const SkipSwitches& switches);
+// triangles (sharedFacing: its rays share a direction or an end, as a light's shadow rays do):
+// the gpu, which makes a pass's rays on the device, makes them on the host for the cull only
+// then.
+bool passCullMayDrop(std::uint64_t mostRays, std::size_t triangles, bool sharedFacing, const SkipSwitches& switches);
 
 // The pass cull's lines of the work plan.
 void planPassCull(const FrameGeometry& g, const SkipSwitches& switches, const PassCull& cull, MemoryPlan& plan);

@@ -9,14 +9,9 @@
 namespace dacrt {
 namespace {
 
-constexpr double kFloatUnit = 0x1p-24;  // u: float32's unit roundoff
-
 // 2^-12 of the triangle's distance: far beyond how far from a triangle the watertight test
 // can place a hit (a few units in the last place of that distance, docs/correctness.md).
 constexpr double kFrustumSlack = 0x1p-12;
-
-// facesAwayFrom's bound: side / R^2 > kFacingL L + kFacingR R.
-constexpr double kFacingL = 480.0 * kFloatUnit, kFacingR = 200.0 * kFloatUnit * kFloatUnit;
 
 enum class Verdict : std::uint8_t { Traced = kTracedVerdict, BackFacing, OutsideFrustum };
 
@@ -35,7 +30,7 @@ bool facesAwayFrom(const Triangle& t, const glm::dvec3& origin) {
     // one, "back", where side / R^2 > 240 u L + 100 u^2 R (L <= 2R), required twice over.
     const double r2 = std::max({glm::dot(a, a), glm::dot(b, b), glm::dot(c, c)});
     const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
-    return side / r2 > kFacingL * std::sqrt(l2) + kFacingR * std::sqrt(r2);
+    return side / r2 > kFacingPerEdge * std::sqrt(l2) + kFacingPerReach * std::sqrt(r2);
 }
 
 bool facesAwayAlong(const Triangle& t, const glm::dvec3& direction, double reach) {
@@ -46,7 +41,22 @@ bool facesAwayAlong(const Triangle& t, const glm::dvec3& direction, double reach
     const double along = glm::dot(glm::cross(e1, e2), direction) / glm::length(direction);
     if (!(along > 0.0)) return false;
     const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
-    return along / reach > kFacingL * std::sqrt(l2) + kFacingR * reach;
+    return along / reach > kFacingPerEdge * std::sqrt(l2) + kFacingPerReach * reach;
+}
+
+bool facesTowardEnds(const Triangle& t, const glm::dvec3& endLo, const glm::dvec3& endHi, double reach) {
+    const glm::dvec3 p0(t.v0), p1(t.v1), p2(t.v2);
+    const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0, e3 = p2 - p1;
+    const glm::dvec3 n = glm::cross(e1, e2);
+    // The least of n . (E - v0) over the box's points E is at its corner lowest along n. A ray
+    // ending at E that crosses the plane at X before its end has n . d (tmax - t) = n . (E - X),
+    // so n . d > 0, and |n . d| / |d| = n . (E - v0) / |E - X|: the bound of facesAwayFrom with
+    // the end for the origin and R = reach (docs/correctness.md, "Skips").
+    const glm::dvec3 lowest(n.x > 0.0 ? endLo.x : endHi.x, n.y > 0.0 ? endLo.y : endHi.y, n.z > 0.0 ? endLo.z : endHi.z);
+    const double side = glm::dot(n, lowest - p0);
+    if (!(side > 0.0)) return false;
+    const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
+    return side / (reach * reach) > kFacingPerEdge * std::sqrt(l2) + kFacingPerReach * reach;
 }
 
 bool outsideFrustum(const Triangle& t, const ViewFrustum& f) {

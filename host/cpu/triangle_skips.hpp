@@ -24,6 +24,10 @@ struct TriangleSkips {
     bool frustumTested = false;          // false where the scene box lies inside the view
 };
 
+// The facing tests' bound (docs/correctness.md, "Skips"): side / R^2 > kFacingPerEdge L +
+// kFacingPerReach R, with L the longest edge and R the reach, u = 2^-24 float32's unit roundoff.
+constexpr double kFacingPerEdge = 480.0 * 0x1p-24, kFacingPerReach = 200.0 * 0x1p-24 * 0x1p-24;
+
 // Whether a single-sided triangle faces away from `origin` by a margin that no rounding of the
 // watertight test (or Moller-Trumbore's, or float64's) can overcome: every ray from origin
 // then meets its back, and the face rule rejects it.
@@ -32,6 +36,12 @@ bool facesAwayFrom(const Triangle& triangle, const glm::dvec3& origin);
 // that direction (bit for bit) whose origins lie within `reach` of every vertex: each of them
 // meets its back.
 bool facesAwayAlong(const Triangle& triangle, const glm::dvec3& direction, double reach);
+// Whether a single-sided triangle shows its front to every point of the box [endLo, endHi] by
+// the same margin, for rays whose segments end in that box (a point or spot light's shadow
+// rays end at the light, within rounding) and whose origins, ends and crossing points lie
+// within `reach` of one another: each of them meets its back, or crosses its plane so far
+// beyond its end that no hit there is reported.
+bool facesTowardEnds(const Triangle& triangle, const glm::dvec3& endLo, const glm::dvec3& endHi, double reach);
 // Whether the triangle lies outside one side plane of the frustum by more than the test's
 // rounding can bridge: no ray inside the frustum can hit it.
 bool outsideFrustum(const Triangle& triangle, const ViewFrustum& frustum);

@@ -42,8 +42,9 @@ bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryH
                      const SkipSwitches& switches) {
     std::uint64_t surfaces = 0;
     for (const Hit& h : primaryHits) surfaces += hitSendsRays(h);
-    const bool oneDirection = pass.kind == shared::kPassShadow && pass.light.type == shared::kLightDirectional;
-    return passCullMayDrop(surfaces * pass.raysPerHit, triangles, oneDirection, switches);
+    // A light's shadow rays share its direction or end at it.
+    const bool sharedFacing = pass.kind == shared::kPassShadow;
+    return passCullMayDrop(surfaces * pass.raysPerHit, triangles, sharedFacing, switches);
 }
 
 // The most rays a batch of a pass's rays holds (--ray-grouping batches, and a gpu pass's ray
@@ -367,11 +368,16 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
                                            const std::vector<std::size_t>& groups, const BackendRequest& request,
                                            const PlanHook& onPlan) {
     // The pass cull once, over every ray: each group's own would survey its rays again.
+    // The pass's geometry only where the cull tests something: its survey of the rays is a
+    // pass over every one of them (3 ms for the room's 1.2 million occlusion rays).
     const auto start = Clock::now();
-    const FrameGeometry all = passGeometry(primary, rays);
-    cullForPass(all, request.trace.skips, pool(threadsOf(request.trace)), passCull_);
+    ThreadPool& threadPool = pool(threadsOf(request.trace));
+    if (passCullTests(rays, primary.triangles->size(), primary.sceneBox, request.trace.skips))
+        cullForPass(passGeometry(primary, rays), request.trace.skips, threadPool, passCull_);
+    else
+        cullNothing(passCull_);
     MemoryPlan cullPlan;
-    planPassCull(all, request.trace.skips, passCull_, cullPlan);
+    planPassCull(primary, request.trace.skips, passCull_, cullPlan);  // the pass's triangles are the primary's
     double cullMs = msSince(start);
     std::vector<std::size_t> live;  // the groups with rays
     for (std::size_t k = 0; k + 1 < groups.size(); ++k)

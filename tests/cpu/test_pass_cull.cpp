@@ -65,6 +65,21 @@ std::vector<Hit> traceCulled(const FrameGeometry& g, const PassCull& cull, Backe
     return traceFrame(withSkips(g, cull.skips), backend, regions, 2).hits;
 }
 
+// A pass of these rays over these triangles (both outlive it), culled by the faces' tests
+// alone.
+struct FacesOnlyPass {
+    std::vector<Bounds> bounds;
+    FrameGeometry geometry;
+    PassCull cull;
+    FacesOnlyPass(const std::vector<Triangle>& tris, const std::vector<Ray>& rays)
+        : bounds(allTriangleBounds(tris)), geometry(secondaryFrame(tris, bounds, rays, sceneBounds(tris))) {
+        SkipSwitches facesOnly;
+        facesOnly.passRays = false;
+        cull = cullOf(geometry, facesOnly);
+    }
+    FacesOnlyPass(const FacesOnlyPass&) = delete;
+};
+
 // Random triangles of size `scale` in a box of side 40 scale around `shift`, single-sided one
 // in two, and rays from points on them: lengths from a thousandth of a triangle to unbounded,
 // directions with zero components, one shared direction where `sharedDirection`, and origins
@@ -261,13 +276,74 @@ TEST(PassCull, KeepsASingleSidedTriangleNearlyAlongTheSharedDirectionThatRoundin
         tris.push_back(t);
         rays.push_back(ray);
     }
-    const std::vector<Bounds> bounds = allTriangleBounds(tris);
-    const FrameGeometry g = secondaryFrame(tris, bounds, rays, sceneBounds(tris));
-    SkipSwitches facesOnly;
-    facesOnly.passRays = false;
-    const PassCull cull = cullOf(g, facesOnly);
+    const FacesOnlyPass pass(tris, rays);
+    const FrameGeometry& g = pass.geometry;
+    const PassCull& cull = pass.cull;
     ASSERT_TRUE(cull.directionShared);
     EXPECT_GT(cull.skips.backFacing, 0u) << "no triangle tilted enough to drop";
     EXPECT_TRUE(keepsEveryHitTriangle(g, cull));
     EXPECT_GT(frontByRounding, 0u) << "rounding never showed a back face from the front: the test proves nothing";
+}
+
+TEST(PassCull, KeepsASingleSidedTriangleNearlyEdgeOnToTheSharedEndThatRoundingShowsFront) {
+    // Triangles tilted by 1e-9 to 1e-1 of their size out of a plane through a point light
+    // L, to show their front to it (n . (L - v0) > 0, exactly), and a shadow ray to L from far
+    // beyond each, through its centroid, made as a pass makes one (the direction L - origin
+    // rounded, the segment ending at t = 1): every ray meets a back face in exact arithmetic,
+    // and rounding makes the watertight test see some from the front and accept them, among
+    // them triangles whose plane passes the light by far more than the spread of the rays'
+    // ends. Only the margin of facesTowardEnds keeps those.
+    Random random(10);
+    const glm::vec3 light(3.0f, 40.0f, -7.0f);
+    const glm::dvec3 l(light);
+    std::vector<Triangle> tris;
+    std::vector<Ray> rays;
+    std::size_t frontByRounding = 0;
+    for (int i = 0; i < 2000; ++i) {
+        // One in four large and tilted enough for the margin, with a near origin: the drops.
+        const bool large = i % 4 == 0;
+        const double size = std::pow(10.0, large ? random.uniform(1.0, 2.0) : random.uniform(-3.0, 0.0));
+        const double tilt = std::pow(10.0, large ? random.uniform(-2.0, -0.5) : random.uniform(-9.0, -1.0));
+        const glm::dvec3 a = random.inBox(-1.0, 1.0) * 30.0;
+        const glm::dvec3 toLight = glm::normalize(l - a), u = glm::normalize(glm::cross(toLight, random.inBox(-1.0, 1.0)));
+        const glm::dvec3 w = glm::cross(toLight, u);
+        // v0 = a, v1 along u, v2 toward the light tilted along w: n = u x (toLight + w tilt) =
+        // tilt toLight - w, so n . (L - a) = tilt |L - a| > 0: its front faces L.
+        const Triangle t{glm::vec3(a), 1, glm::vec3(a + u * size), 0, glm::vec3(a + (toLight + w * tilt) * size), 0};
+        const glm::dvec3 p0(t.v0), p1(t.v1), p2(t.v2);
+        const glm::dvec3 n = glm::cross(p1 - p0, p2 - p0);
+        if (!(glm::dot(n, l - p0) > 0.0)) continue;  // float rounding turned it: not a front to the light
+        const glm::dvec3 centroid = (p0 + p1 + p2) / 3.0;
+        const glm::vec3 origin(centroid + (centroid - l) * (large ? random.uniform(0.05, 0.5) : random.uniform(1.0, 30.0)));
+        const Ray ray = shared::segmentRay(origin, light - origin, 1.0f);
+        // The rays' ends spread by about 1e-4 (a unit in the last place of 1500): a plane 1e-2
+        // from the light leaves all of them on its front.
+        frontByRounding += accepted(shared::intersectWatertight(ray, t.v0, t.v1, t.v2, true), ray) &&
+                           glm::dot(n, l - p0) / glm::length(n) > 1e-2;
+        tris.push_back(t);
+        rays.push_back(ray);
+    }
+    const FacesOnlyPass pass(tris, rays);
+    const FrameGeometry& g = pass.geometry;
+    const PassCull& cull = pass.cull;
+    ASSERT_FALSE(cull.directionShared);
+    ASSERT_TRUE(cull.endShared);
+    EXPECT_GT(cull.skips.backFacing, 0u) << "no triangle tilted enough to drop";
+    EXPECT_TRUE(keepsEveryHitTriangle(g, cull));
+    EXPECT_GT(frontByRounding, 0u) << "rounding never showed a back face well off the light from the front: the test "
+                                      "proves nothing";
+}
+
+TEST(PassCull, SharesNoEndWhereTheSegmentsEndApartOrAreWhole) {
+    // Occlusion-like segments of one length but scattered directions, and unbounded rays
+    // toward one point: neither ends at one point, so no face is tested.
+    SecondaryPassSet set = shapesUnderACeilingPasses();
+    SkipSwitches facesOnly;
+    facesOnly.passRays = false;
+    for (const SecondaryPass& p : {occlusionPass(2, 0.3f), occlusionPass(2, kNoHitT)}) {
+        const PassFrame pass(set.frame, set.primary.hits, p);
+        const PassCull cull = cullOf(pass.geometry, facesOnly);
+        EXPECT_FALSE(cull.endShared);
+        EXPECT_FALSE(cull.skips.applied);
+    }
 }

@@ -1,9 +1,11 @@
 // The SIMD kernels against the scalar predicates they replace, on every instruction set this
 // binary holds that the machine runs: same ids in the same order, same hits bit for bit.
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,7 @@
 
 #include "core/camera.hpp"
 #include "core/random.hpp"
+#include "cpu/cull_lanes.hpp"
 #include "cpu/predicates.hpp"
 #include "cpu/simd_kernels.hpp"
 #include "cpu/traversal.hpp"
@@ -399,4 +402,208 @@ TEST_F(EveryTarget, FacingVerdictsNeverContradictTheFloat64Skip) {
         EXPECT_GT(certified, total * 4 / 10);
         EXPECT_GT(dropped, total / 10);
     });
+}
+
+namespace {
+
+// A pass cull's grid of any shape: its axes a rotation of the scene's, 1 to 128 cells along
+// each (one in five axes a single cell), flat axes (scale 0) among them.
+simd::GridAxes randomGrid(Random& rng) {
+    simd::GridAxes grid;
+    const int first = int(rng.index(3));
+    for (int k = 0; k < 3; ++k) {
+        grid.axis[k] = (first + k) % 3;
+        grid.count[k] = rng.uniform() < 0.2 ? 1 : int(rng.index(128)) + 1;
+        grid.lo[k] = adversarialCoordinate(rng);
+        grid.scale[k] = rng.uniform() < 0.15 ? 0.0f : float(grid.count[k]) / rng.uniformFloat(0.01f, 4.0f);
+    }
+    return grid;
+}
+
+}  // namespace
+
+TEST_F(EveryTarget, BoxCellsAreTheGridRulesCells) {
+    // Grids of every shape (flat axes of scale 0, one cell, 128) and boxes on cell faces, far
+    // outside the grid and infinite: every cell is cellAlong's, for every count of a block.
+    forEachTarget([] {
+        Random rng(11);
+        std::size_t clamped = 0, inside = 0;
+        for (int round = 0; round < 60; ++round) {
+            const simd::GridAxes grid = randomGrid(rng);
+            const int first = grid.axis[0];
+            const auto count = std::uint32_t(rng.index(simd::kCullBlock)) + 1;
+            std::vector<Bounds> bounds(count);
+            for (Bounds& b : bounds) {
+                const Box box = randomCell(rng);
+                b.lo = box.lo;
+                b.hi = box.hi;
+                for (int a = 0; a < 3; ++a) {
+                    const int k = (a - first + 3) % 3;  // the grid axis of scene axis a
+                    const double u = rng.uniform();
+                    if (u < 0.2 && grid.scale[k] > 0.0f)  // on a cell face
+                        b.lo[a] = grid.lo[k] + float(rng.index(std::size_t(grid.count[k]) + 1)) / grid.scale[k];
+                    else if (u < 0.25)
+                        b.lo[a] = -std::numeric_limits<float>::infinity();
+                    else if (u < 0.3)
+                        b.hi[a] = std::numeric_limits<float>::infinity();
+                    b.hi[a] = std::max(b.hi[a], b.lo[a]);
+                }
+            }
+            simd::BoxCells cells;
+            for (auto& side : {&cells.first, &cells.last})
+                for (auto& axis : *side) std::fill(std::begin(axis), std::end(axis), -7);
+            simd::cellsOfBoxes(bounds.data(), count, grid, cells);
+            for (std::uint32_t i = 0; i < count; ++i)
+                for (int k = 0; k < 3; ++k) {
+                    const int lo = simd::cellAlong(grid, bounds[i].lo[grid.axis[k]], k);
+                    const int hi = simd::cellAlong(grid, bounds[i].hi[grid.axis[k]], k);
+                    ASSERT_EQ(cells.first[k][i], lo) << "round " << round << ", box " << i << ", axis " << k;
+                    ASSERT_EQ(cells.last[k][i], hi) << "round " << round << ", box " << i << ", axis " << k;
+                    clamped += (lo == 0) + (hi == grid.count[k] - 1);
+                    inside += (lo > 0 && lo < grid.count[k] - 1) + (hi > 0 && hi < grid.count[k] - 1);
+                }
+        }
+        EXPECT_GT(clamped, 1000u) << "few boxes reach the grid's ends";
+        EXPECT_GT(inside, 1000u) << "few boxes end inside the grid";
+    });
+}
+
+namespace {
+
+// One of the two adjacent doubles between which facesAwayAlong(t, direction, reach) turns
+// false as the reach grows (it falls with the reach): a lane that rounds any step otherwise
+// than the rule answers differently there, one time in a few. False where t is never away.
+bool thresholdReach(const Triangle& t, const glm::dvec3& direction, bool above, double& reach) {
+    if (!t.cullBackFace) return false;
+    std::int64_t lo = std::bit_cast<std::int64_t>(1e-30), hi = std::bit_cast<std::int64_t>(1e30);
+    if (!facesAwayAlong(t, direction, std::bit_cast<double>(lo)) || facesAwayAlong(t, direction, std::bit_cast<double>(hi)))
+        return false;
+    while (hi - lo > 1) {  // positive doubles are ordered as their bits
+        const std::int64_t mid = lo + (hi - lo) / 2;
+        (facesAwayAlong(t, direction, std::bit_cast<double>(mid)) ? lo : hi) = mid;
+    }
+    reach = std::bit_cast<double>(above ? hi : lo);
+    return true;
+}
+
+}  // namespace
+
+TEST_F(EveryTarget, FacingAlongADirectionIsTheFloat64Rule) {
+    // Triangles of every size and slant against a direction, some nearly edge-on to it, and in
+    // half the rounds a reach on either side of the first triangle's threshold:
+    // every asked lane is facesAwayAlong's answer (single-sided ones only), and no lane of a
+    // vector none of whose lanes was asked is set.
+    forEachTarget([] {
+        Random rng(13);
+        std::size_t away = 0, kept = 0, onThreshold = 0;
+        for (int round = 0; round < 400; ++round) {
+            const glm::dvec3 direction = rng.onSphere() * std::pow(10.0, rng.uniform(-3.0, 3.0));
+            const auto count = std::uint32_t(rng.index(simd::kCullBlock)) + 1;
+            std::vector<Triangle> tris(count);
+            for (Triangle& t : tris) {
+                const glm::dvec3 centre = rng.inBox(-1.0, 1.0) * std::pow(10.0, rng.uniform(-3.0, 5.0));
+                const double size = std::pow(10.0, rng.uniform(-6.0, 2.0));
+                glm::dvec3 p[3];
+                for (glm::dvec3& q : p) q = centre + size * rng.inBox(-1.0, 1.0);
+                if (rng.uniform() < 0.5) {  // nearly edge-on to the direction
+                    const glm::dvec3 n = glm::normalize(glm::cross(direction, p[1] - p[0]));
+                    const double squeeze = std::pow(10.0, rng.uniform(-9.0, -1.0));
+                    for (glm::dvec3& q : p) q -= (1.0 - squeeze) * glm::dot(q - centre, n) * n;
+                }
+                t.v0 = glm::vec3(p[0]);
+                t.v1 = glm::vec3(p[1]);
+                t.v2 = glm::vec3(p[2]);
+                t.cullBackFace = rng.uniform() < 0.8 ? 1u : 0u;
+            }
+            double reach = std::pow(10.0, rng.uniform(-2.0, 6.0));
+            if (round % 2 == 1) {
+                tris[0].cullBackFace = 1u;
+                if (!thresholdReach(tris[0], direction, rng.uniform() < 0.5, reach)) {
+                    std::swap(tris[0].v1, tris[0].v2);  // its other face
+                    onThreshold += thresholdReach(tris[0], direction, rng.uniform() < 0.5, reach);
+                } else {
+                    ++onThreshold;
+                }
+            }
+            std::vector<std::uint8_t> asked(count), answer(count, 0xFF);
+            const bool everyLane = round % 2 == 0;
+            for (std::uint8_t& a : asked) a = rng.uniform() < 0.3;
+            simd::facingAwayAlong(tris.data(), count, direction, reach, everyLane ? nullptr : asked.data(), answer.data());
+            const std::uint32_t lanes = 16;  // a multiple of every target's double lanes
+            for (std::uint32_t i = 0; i < count; ++i) {
+                ASSERT_LE(answer[i], 1u) << "every answer written, 0 or 1";
+                const bool rule = tris[i].cullBackFace && facesAwayAlong(tris[i], direction, reach);
+                if (everyLane || asked[i]) {
+                    ASSERT_EQ(answer[i] == 1, rule) << "round " << round << ", triangle " << i;
+                    (rule ? away : kept) += 1;
+                } else {
+                    bool anyAsked = false;
+                    for (std::uint32_t j = i / lanes * lanes; j < std::min(count, (i / lanes + 1) * lanes); ++j)
+                        anyAsked = anyAsked || asked[j];
+                    if (!anyAsked) {
+                        ASSERT_EQ(answer[i], 0u) << "a lane of a vector none asked for";
+                    }
+                }
+            }
+        }
+        EXPECT_GT(away, 2000u);
+        EXPECT_GT(kept, 2000u);
+        EXPECT_GT(onThreshold, 150u);
+    });
+}
+
+TEST_F(EveryTarget, PieceEndCellsAreTheGridRulesCells) {
+    // Segments of every length and direction (axis-parallel ones, ends far outside the grid),
+    // cut in 1 to kMostPieces pieces, over grids of every shape: each end's cells are those of
+    // the rule (pieceEnd, floatBelow / floatAbove, cellAlong), bounds bit for bit, and
+    // floatBelow steps often, -0 and +0 among the points.
+    forEachTarget([] {
+        Random rng(17);
+        std::size_t ends = 0, stepped = 0;
+        for (int round = 0; round < 300; ++round) {
+            const simd::GridAxes grid = randomGrid(rng);
+            const Ray ray = randomRay(rng);
+            const glm::dvec3 origin(ray.origin), dir(ray.dir);
+            const double t0 = rng.uniform() < 0.3 ? 0.0 : rng.uniform(-3.0, 3.0);
+            const double t1 = t0 + (rng.uniform() < 0.1 ? 0.0 : std::pow(10.0, rng.uniform(-6.0, 3.0)));
+            const int pieces = rng.uniform() < 0.1 ? simd::kMostPieces : int(rng.index(40)) + 1;
+            const double grow = rng.uniform() < 0.2 ? 0.0 : std::pow(10.0, rng.uniform(-9.0, 0.0));
+            simd::PieceEndCells cells;
+            simd::cellsNearPieceEnds(origin, dir, t0, t1, pieces, grow, grid, cells);
+            for (int e = 0; e <= pieces; ++e) {
+                const glm::dvec3 p = origin + simd::pieceEnd(t0, t1, e, pieces) * dir;
+                for (int k = 0; k < 3; ++k) {
+                    const double x = p[grid.axis[k]];
+                    const float below = simd::floatBelow(x - grow), above = simd::floatAbove(x + grow);
+                    ASSERT_EQ(std::bit_cast<std::uint32_t>(cells.below[k][e]), std::bit_cast<std::uint32_t>(below))
+                        << "round " << round << ", end " << e << " of " << pieces << ", axis " << k;
+                    ASSERT_EQ(std::bit_cast<std::uint32_t>(cells.above[k][e]), std::bit_cast<std::uint32_t>(above))
+                        << "round " << round << ", end " << e << " of " << pieces << ", axis " << k;
+                    ASSERT_EQ(cells.from[k][e], simd::cellAlong(grid, simd::floatBelow(x - grow), k))
+                        << "round " << round << ", end " << e << " of " << pieces << ", axis " << k;
+                    ASSERT_EQ(cells.to[k][e], simd::cellAlong(grid, simd::floatAbove(x + grow), k))
+                        << "round " << round << ", end " << e << " of " << pieces << ", axis " << k;
+                    stepped += double(float(x - grow)) > x - grow;
+                }
+                ++ends;
+            }
+        }
+        EXPECT_GT(ends, 10000u);
+        EXPECT_GT(stepped, ends / 4) << "floatBelow's step is seldom taken: the test proves little";
+    });
+}
+
+TEST(FloatBounds, AreTheNearestFloatsOnTheirSide) {
+    Random rng(19);
+    for (int i = 0; i < 100000; ++i) {
+        const double x = rng.uniform(-1.0, 1.0) * std::pow(10.0, rng.uniform(-40.0, 39.0));
+        const float below = simd::floatBelow(x), above = simd::floatAbove(x);
+        ASSERT_LE(double(below), x);
+        ASSERT_GE(double(above), x);
+        ASSERT_GT(double(std::nextafter(below, std::numeric_limits<float>::infinity())), x) << x;
+        ASSERT_LT(double(std::nextafter(above, -std::numeric_limits<float>::infinity())), x) << x;
+    }
+    EXPECT_EQ(simd::floatBelow(0.0), 0.0f);
+    EXPECT_EQ(simd::floatBelow(1e300), std::numeric_limits<float>::max());
+    EXPECT_EQ(simd::floatAbove(-1e300), -std::numeric_limits<float>::max());
 }
