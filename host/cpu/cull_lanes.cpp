@@ -31,7 +31,8 @@ void CellsOfBoxes(const Bounds* bounds, std::uint32_t count, const GridAxes& gri
     const hn::ScalableTag<float> df;
     const std::size_t n = hn::Lanes(df);
     static_assert(kCullBlock % 64 == 0, "whole vectors of up to 64 lanes fill the block");
-    // Each box's six faces copied into lanes with plain loads: the boxes are consecutive.
+    // Each box's six faces transposed into lanes in scalar code: the boxes are consecutive,
+    // and gathers are the slower way here (simd_kernels.cpp, loadPerLane).
     alignas(64) float lo[3][64], hi[3][64];
     for (std::uint32_t i = 0; i < count; i += std::uint32_t(n)) {
         for (std::size_t l = 0; l < n; ++l) {
@@ -45,7 +46,9 @@ void CellsOfBoxes(const Bounds* bounds, std::uint32_t count, const GridAxes& gri
     }
 }
 
-// floatBelow of float64 lanes, into float32 lanes (half as wide).
+// floatBelow of float64 lanes, into float32 lanes (half as wide). For finite x only, which
+// every point of a segment clipped to the scene box is: Highway's portable target (EMU128)
+// demotes an infinity to FLT_MAX where the scalar float(x) gives the infinity.
 template <class DD, class VD = hn::Vec<DD>>
 HWY_INLINE hn::Vec<hn::Rebind<float, DD>> floatsBelow(DD dd, VD x) {
     const hn::Rebind<float, DD> df;
@@ -86,8 +89,9 @@ void CellsNearPieceEnds(const glm::dvec3& origin, const glm::dvec3& dir, double 
 }
 
 // facesAwayAlong in float64 lanes, its operations in its order: glm's cross (x.y y.z - y.y x.z
-// and so on), glm's dot ((x + y) + z) and std::max over the edges' squares, which are never
-// negative or NaN, so any order of the maximum gives the same value.
+// and so on), glm's dot ((x + y) + z) and std::max over the edges' squares, which for finite
+// vertices are never negative or NaN, so any order of the maximum gives the same value (and
+// where a vertex is not finite, along is NaN and both answer false).
 void FacingAwayAlong(const Triangle* triangles, std::uint32_t count, const glm::dvec3& direction, double reach,
                      const std::uint8_t* asked, std::uint8_t* away) {
     const hn::ScalableTag<double> dd;

@@ -1,9 +1,10 @@
 #pragma once
-// The pass cull's per-triangle tests (pass_cull.hpp) in SIMD lanes, through Google Highway as
-// the DACRT kernels are (simd_kernels.hpp): the cells a triangle's bounds cover, in float32
-// lanes, and the back-face test along a shared direction, in float64 lanes. Each lane computes
-// the scalar rule's IEEE operations in the same order, with the same min/max operand order and
-// no contraction, so its answers are the scalar ones bit for bit
+// The pass cull's arithmetic (pass_cull.hpp) in SIMD lanes, through Google Highway as the DACRT
+// kernels are (simd_kernels.hpp): the cells near the ends of a ray's pieces, in float64 lanes,
+// when the grid is marked; the cells a triangle's bounds cover, in float32 lanes, and the
+// back-face test along a shared direction, in float64 lanes, when the triangles are culled.
+// Each lane computes the scalar rule's IEEE operations in the same order, with the same
+// min/max operand order and no contraction, so its answers are the scalar ones bit for bit
 // (tests/cpu/test_simd_kernels.cpp runs both side by side on every compiled target).
 #include <algorithm>
 #include <bit>

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <span>
 
 namespace dacrt {
 namespace {
@@ -48,90 +49,101 @@ Interval clipped(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi) {
     return iv;
 }
 
-// Chunks of a pass over the rays: up to 64, of at least 4096 rays.
-std::size_t rayChunks(std::size_t rays) { return std::max<std::size_t>(1, std::min<std::size_t>(64, rays / 4096 + 1)); }
+// A box of points in float64.
+struct PointBox {
+    glm::dvec3 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
+    void extend(const glm::dvec3& p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    void extend(const PointBox& b) { extend(b.lo), extend(b.hi); }
+    double diagonal() const { return glm::length(hi - lo); }
+};
+
+// Calls scan(begin, end, c) for the chunks c of a pass over `count` rays (up to 64, of at least
+// 4096 rays) on the pool's threads, or as one chunk on the calling thread without a pool.
+// Returns how many chunks there are.
+template <typename Scan>
+std::size_t scanRayChunks(std::size_t count, ThreadPool* pool, Scan&& scan) {
+    const std::size_t chunks = pool ? std::max<std::size_t>(1, std::min<std::size_t>(64, count / 4096 + 1)) : 1;
+    auto chunk = [&](std::size_t c, unsigned) { scan(count * c / chunks, count * (c + 1) / chunks, c); };
+    if (pool)
+        pool->parallelFor(chunks, chunk);
+    else
+        chunk(0, 0);
+    return chunks;
+}
 
 // Whether every ray has the first one's direction, bit for bit (the back-face test's exactness
-// rests on it), in parallel: a chunk stops at its first other direction, and the others at
-// their next ray, so a pass of scattered directions (occlusion rays) reads a few rays only.
-bool raysShareDirection(const std::vector<Ray>& rays, ThreadPool& pool) {
-    const std::size_t chunks = rayChunks(rays.size());
+// rests on it): a chunk stops at its first other direction, and the others at their next ray,
+// so a pass of scattered directions (occlusion rays) reads a few rays only.
+bool raysShareDirection(std::span<const Ray> rays, ThreadPool* pool) {
     std::atomic<bool> shared{true};
-    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks;
-             i < end && shared.load(std::memory_order_relaxed); ++i)
+    scanRayChunks(rays.size(), pool, [&](std::size_t begin, std::size_t end, std::size_t) {
+        for (std::size_t i = begin; i < end && shared.load(std::memory_order_relaxed); ++i)
             if (std::memcmp(&rays[i].dir, &rays.front().dir, sizeof(Ray::dir)) != 0) shared.store(false, std::memory_order_relaxed);
     });
     return shared.load();
 }
 
-// Where every ray's segment ends, origin + tmax dir, as a box: where every ray has the same
-// finite tmax and the ends lie within kEndSpread of the scene's diagonal of one another along
-// every axis (a point or spot light's shadow rays end at the light, within rounding), in
-// parallel; a chunk stops at its first end too far from its first. The box holds the exact
-// ends: each end is one rounding of exact terms (tmax dir is exact in float64), so a step
-// outwards covers it.
+// The box of the rays' origins (the back-face tests' reach rests on every one of them).
+PointBox originsOf(std::span<const Ray> rays, ThreadPool* pool) {
+    std::vector<PointBox> parts(64);
+    const std::size_t chunks = scanRayChunks(rays.size(), pool, [&](std::size_t begin, std::size_t end, std::size_t c) {
+        PointBox box;  // in a local, written once: neighbouring chunks' boxes share cache lines
+        for (std::size_t i = begin; i < end; ++i) box.extend(glm::dvec3(rays[i].origin));
+        parts[c] = box;
+    });
+    for (std::size_t c = 1; c < chunks; ++c) parts[0].extend(parts[c]);
+    return parts[0];
+}
+
+// Where every ray's segment ends, origin + tmax dir: shared where every ray has the same finite
+// tmax and every end lies within kEndSpread of the scene's diagonal of the first ray's end
+// along every axis (a point or spot light's shadow rays end at the light, within rounding).
+// A chunk stops at its first end too far. The box of the ends holds the exact ones: each is
+// one rounding of exact terms (tmax dir is exact in float64), so a step outwards covers it.
+// The origins' box comes from the same pass.
 constexpr double kEndSpread = 0x1p-10;
-struct EndBox {
+struct SharedEnd {
     bool shared = false;
-    glm::dvec3 lo{0.0}, hi{0.0};
+    PointBox ends, origins;
 };
-EndBox raysShareEnd(const std::vector<Ray>& rays, const Box& sceneBox, ThreadPool& pool) {
-    EndBox box;
+SharedEnd raysShareEnd(std::span<const Ray> rays, const Box& sceneBox, ThreadPool* pool) {
+    SharedEnd out;
     const float tmax = rays.front().tmax;
-    if (!(tmax < kNoHitT)) return box;
+    if (!(tmax < kNoHitT)) return out;
     const double spread = kEndSpread * glm::length(glm::dvec3(sceneBox.hi) - glm::dvec3(sceneBox.lo));
     auto endOf = [&](const Ray& r) { return glm::dvec3(r.origin) + double(tmax) * glm::dvec3(r.dir); };
     const glm::dvec3 first = endOf(rays.front());
-    const std::size_t chunks = rayChunks(rays.size());
-    std::vector<EndBox> parts(chunks);
+    std::vector<SharedEnd> parts(64);
     std::atomic<bool> shared{true};
-    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        // Each chunk's box in locals, written once: neighbouring chunks' boxes share lines.
-        glm::dvec3 lo = first, hi = first;
-        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks;
-             i < end && shared.load(std::memory_order_relaxed); ++i) {
-            const glm::dvec3 e = endOf(rays[i]);
-            lo = glm::min(lo, e);
-            hi = glm::max(hi, e);
-            const glm::dvec3 extent = hi - lo;
-            if (rays[i].tmax != tmax || !(std::max({extent.x, extent.y, extent.z}) <= spread))
+    const std::size_t chunks = scanRayChunks(rays.size(), pool, [&](std::size_t begin, std::size_t end, std::size_t c) {
+        SharedEnd part;  // in a local, as originsOf's
+        for (std::size_t i = begin; i < end && shared.load(std::memory_order_relaxed); ++i) {
+            const glm::dvec3 e = endOf(rays[i]), off = glm::abs(e - first);
+            part.ends.extend(e);
+            part.origins.extend(glm::dvec3(rays[i].origin));
+            if (rays[i].tmax != tmax || !(std::max({off.x, off.y, off.z}) <= spread))
                 shared.store(false, std::memory_order_relaxed);
         }
-        parts[c] = EndBox{true, lo, hi};
+        parts[c] = part;
     });
-    if (!shared.load()) return box;
-    box = parts[0];
-    for (const EndBox& p : parts) {
-        box.lo = glm::min(box.lo, p.lo);
-        box.hi = glm::max(box.hi, p.hi);
-    }
+    if (!shared.load()) return out;
+    out.shared = true;
+    for (std::size_t c = 0; c < chunks; ++c) out.ends.extend(parts[c].ends), out.origins.extend(parts[c].origins);
     constexpr double inf = std::numeric_limits<double>::infinity();
-    for (int a = 0; a < 3; ++a) box.lo[a] = std::nextafter(box.lo[a], -inf), box.hi[a] = std::nextafter(box.hi[a], inf);
-    return box;
+    for (int a = 0; a < 3; ++a) out.ends.lo[a] = std::nextafter(out.ends.lo[a], -inf), out.ends.hi[a] = std::nextafter(out.ends.hi[a], inf);
+    return out;
 }
 
-// The largest distance between a ray's origin, a point of the scene and a point of `also`:
-// the origins' box over every ray (the back-face tests' exactness rests on it), in parallel,
-// joined to the scene's and to `also`.
-double farthestReach(const std::vector<Ray>& rays, const Box& sceneBox, const EndBox& also, ThreadPool& pool) {
-    const std::size_t chunks = rayChunks(rays.size());
-    glm::dvec3 sceneLo(sceneBox.lo), sceneHi(sceneBox.hi);
-    if (also.shared) sceneLo = glm::min(sceneLo, also.lo), sceneHi = glm::max(sceneHi, also.hi);
-    std::vector<EndBox> parts(chunks);
-    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        glm::dvec3 lo = sceneLo, hi = sceneHi;  // in locals, as raysShareEnd's
-        for (std::size_t i = rays.size() * c / chunks, end = rays.size() * (c + 1) / chunks; i < end; ++i) {
-            lo = glm::min(lo, glm::dvec3(rays[i].origin));
-            hi = glm::max(hi, glm::dvec3(rays[i].origin));
-        }
-        parts[c] = EndBox{true, lo, hi};
-    });
-    for (const EndBox& p : parts) {
-        sceneLo = glm::min(sceneLo, p.lo);
-        sceneHi = glm::max(sceneHi, p.hi);
-    }
-    return glm::length(sceneHi - sceneLo);
+// The largest distance between a ray's origin, a point of the scene and a ray's end (where
+// they share one): what bounds every distance the back-face tests' margins scale with.
+double reachOf(PointBox origins, const Box& sceneBox, const SharedEnd& end) {
+    origins.extend(glm::dvec3(sceneBox.lo));
+    origins.extend(glm::dvec3(sceneBox.hi));
+    if (end.shared) origins.extend(end.ends);
+    return origins.diagonal();
 }
 
 // The clipped segments' lengths, in the box's longest side, estimated from a sample of the
@@ -238,29 +250,30 @@ bool RayGrid::meetsCells(const simd::BoxCells& cells, std::uint32_t i) const {
 
 namespace {
 
-// The verdicts, chunk by chunk (counts per chunk), then the kept ids in order: two passes
-// over the triangles, into the cull's reused buffers.
 // What every ray of a pass shares that the back-face tests read: its direction, or the box
-// its segments end in (ends.shared), and the reach of the rays and the scene.
+// its segments end in (end.shared), and the reach of the rays and the scene.
 struct SharedFacing {
     glm::dvec3 direction{0.0};
-    EndBox ends;
+    SharedEnd end;
     double reach = 0.0;
 };
 
-// away[j] for the block's triangles: facing away from the shared direction (in SIMD lanes) or
-// toward the shared end, for the triangles asked for (all where asked is null).
+// backFacing[j] for the block's triangles: single-sided and facing away from the shared
+// direction (in SIMD lanes) or toward the shared end, so that every ray meets its back, for
+// the triangles asked for (all where asked is null; the others 0).
 void facingOfBlock(const Triangle* tris, std::uint32_t count, const SharedFacing& facing, const std::uint8_t* asked,
-                   std::uint8_t* away) {
-    if (!facing.ends.shared) {
-        simd::facingAwayAlong(tris, count, facing.direction, facing.reach, asked, away);
+                   std::uint8_t* backFacing) {
+    if (!facing.end.shared) {
+        simd::facingAwayAlong(tris, count, facing.direction, facing.reach, asked, backFacing);
         return;
     }
     for (std::uint32_t j = 0; j < count; ++j)
-        away[j] = (!asked || asked[j]) && tris[j].cullBackFace &&
-                  facesTowardEnds(tris[j], facing.ends.lo, facing.ends.hi, facing.reach);
+        backFacing[j] = (!asked || asked[j]) && tris[j].cullBackFace &&
+                        facesTowardEnds(tris[j], facing.end.ends.lo, facing.end.ends.hi, facing.reach);
 }
 
+// The verdicts, chunk by chunk (counts per chunk), then the kept ids in order: two passes
+// over the triangles, into the cull's reused buffers.
 void keepTriangles(const FrameGeometry& g, const RayGrid* grid, const SharedFacing* facing, ThreadPool& pool,
                    PassCull& cull) {
     const std::vector<Triangle>& tris = *g.triangles;
@@ -274,7 +287,7 @@ void keepTriangles(const FrameGeometry& g, const RayGrid* grid, const SharedFaci
         // Block by block: the cells and the facing in SIMD lanes (cull_lanes.hpp), then each
         // triangle's verdict from their answers, still in the first level of cache.
         simd::BoxCells cells;
-        std::uint8_t meets[simd::kCullBlock], away[simd::kCullBlock];
+        std::uint8_t meets[simd::kCullBlock], backFacing[simd::kCullBlock];
         for (std::size_t block = begin; block < end; block += simd::kCullBlock) {
             const auto count = std::uint32_t(std::min<std::size_t>(simd::kCullBlock, end - block));
             if (grid) {
@@ -282,13 +295,13 @@ void keepTriangles(const FrameGeometry& g, const RayGrid* grid, const SharedFaci
                 for (std::uint32_t j = 0; j < count; ++j) meets[j] = grid->meetsCells(cells, j);
             }
             // Only the triangles the grid keeps are read.
-            if (facing) facingOfBlock(tris.data() + block, count, *facing, grid ? meets : nullptr, away);
+            if (facing) facingOfBlock(tris.data() + block, count, *facing, grid ? meets : nullptr, backFacing);
             for (std::uint32_t j = 0; j < count; ++j) {
                 const std::size_t i = block + j;
                 Verdict v = kTraced;
                 if (grid && !meets[j])
                     v = kOutsideRays, ++tally.outside;
-                else if (facing && away[j])
+                else if (facing && backFacing[j])
                     v = kBackFacing, ++tally.backFacing;
                 else {
                     ++tally.kept;
@@ -325,10 +338,9 @@ bool passCullTests(const std::vector<Ray>& rays, std::size_t triangles, const Bo
     if (rays.empty() || triangles == 0) return false;
     if (gridOnFor(rays.size(), triangles, switches, cellsAlongLongest)) return true;
     if (!switches.backFaces) return false;
-    // The first rays only: cullForPass asks every one.
-    const std::vector<Ray> first(rays.begin(), rays.begin() + std::ptrdiff_t(std::min<std::size_t>(rays.size(), 64)));
-    ThreadPool one(1);
-    return raysShareDirection(first, one) || raysShareEnd(first, sceneBox, one).shared;
+    // The first rays only, on this thread: cullForPass asks every one.
+    const std::span<const Ray> first(rays.data(), std::min<std::size_t>(rays.size(), 64));
+    return raysShareDirection(first, nullptr) || raysShareEnd(first, sceneBox, nullptr).shared;
 }
 
 void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool, PassCull& cull,
@@ -340,9 +352,10 @@ void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPoo
     // pass of many rays and scattered directions (occlusion) reads a few of them and no
     // triangle at all.
     const bool gridOn = gridOnFor(rays.size(), g.triangles->size(), switches, cellsAlongLongest);
-    cull.directionShared = switches.backFaces && raysShareDirection(rays, pool);
-    const EndBox ends = switches.backFaces && !cull.directionShared ? raysShareEnd(rays, g.sceneBox, pool) : EndBox{};
-    cull.endShared = ends.shared;
+    cull.directionShared = switches.backFaces && raysShareDirection(rays, &pool);
+    SharedFacing facing;
+    if (switches.backFaces && !cull.directionShared) facing.end = raysShareEnd(rays, g.sceneBox, &pool);
+    cull.endShared = facing.end.shared;
     if (!gridOn && !cull.directionShared && !cull.endShared) return;  // every triangle traced, unlisted
     RayGrid grid;
     if (gridOn) {
@@ -355,10 +368,9 @@ void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPoo
         cull.raysTested = true;
         cull.cellsAlongLongest = grid.cellsAlongLongest();
     }
-    SharedFacing facing;
     facing.direction = glm::dvec3(rays.front().dir);
-    facing.ends = ends;
-    if (cull.directionShared || cull.endShared) facing.reach = farthestReach(rays, g.sceneBox, ends, pool);
+    if (cull.directionShared) facing.reach = reachOf(originsOf(rays, &pool), g.sceneBox, facing.end);
+    if (cull.endShared) facing.reach = reachOf(facing.end.origins, g.sceneBox, facing.end);
     keepTriangles(g, cull.raysTested ? &grid : nullptr, cull.directionShared || cull.endShared ? &facing : nullptr, pool,
                   cull);
 }

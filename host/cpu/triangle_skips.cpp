@@ -51,7 +51,9 @@ bool facesTowardEnds(const Triangle& t, const glm::dvec3& endLo, const glm::dvec
     // The least of n . (E - v0) over the box's points E is at its corner lowest along n. A ray
     // ending at E that crosses the plane at X before its end has n . d (tmax - t) = n . (E - X),
     // so n . d > 0, and |n . d| / |d| = n . (E - v0) / |E - X|: the bound of facesAwayFrom with
-    // the end for the origin and R = reach (docs/correctness.md, "Skips").
+    // the end for the origin and R = reach. One that crosses it beyond its end stays on the
+    // front side, farther from the plane than a reported hit can be from its triangle
+    // (docs/correctness.md, "Skips").
     const glm::dvec3 lowest(n.x > 0.0 ? endLo.x : endHi.x, n.y > 0.0 ? endLo.y : endHi.y, n.z > 0.0 ? endLo.z : endHi.z);
     const double side = glm::dot(n, lowest - p0);
     if (!(side > 0.0)) return false;

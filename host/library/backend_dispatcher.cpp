@@ -38,13 +38,15 @@ bool usesVulkan(const std::vector<Backend>& backends) {
 // Whether a gpu pass goes the host's way although the primary hits are on the device: its rays
 // made on the host (the device's, bit for bit) for the pass cull, where the cull may drop
 // triangles. The pass makes at most raysPerHit rays per surface the primary rays hit.
-bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryHits, std::size_t triangles,
+bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
                      const SkipSwitches& switches) {
     std::uint64_t surfaces = 0;
     for (const Hit& h : primaryHits) surfaces += hitSendsRays(h);
-    // A light's shadow rays share its direction or end at it.
-    const bool sharedFacing = pass.kind == shared::kPassShadow;
-    return passCullMayDrop(surfaces * pass.raysPerHit, triangles, sharedFacing, switches);
+    // A light's shadow rays share its direction or end at it, and the back-face tests drop
+    // single-sided triangles only (glTF's default: the search stops at the first one).
+    const bool sharedFacing = pass.kind == shared::kPassShadow &&
+                              std::any_of(triangles.begin(), triangles.end(), [](const Triangle& t) { return t.cullBackFace != 0u; });
+    return passCullMayDrop(surfaces * pass.raysPerHit, triangles.size(), sharedFacing, switches);
 }
 
 // The most rays a batch of a pass's rays holds (--ray-grouping batches, and a gpu pass's ray
@@ -212,7 +214,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     // left empty (no triangle: every primary ray misses) kept nothing on the device.
     if (request.trace.backend == Backend::Gpu && passSource_ &&
         !gpu::takesCpuDefaults(gpu_->info(), request.gpuTuning.profile) &&
-        !culledOnTheHost(pass, primaryHits, primary.triangles->size(), request.trace.skips))
+        !culledOnTheHost(pass, primaryHits, *primary.triangles, request.trace.skips))
         return traceMadeOnDevice(primary, pass, request, onPlan);
     PassTrace out;
     // The slot arrays are allocated before the tracer plans: checked first, as its plan is.

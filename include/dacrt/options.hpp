@@ -92,7 +92,7 @@ struct DacrtOptions {
 enum class Skip { BackFaces, Frustum, Uploads, SubScenes, PassRays };
 struct SkipSwitches {
     bool backFaces = true;  // single-sided triangles facing away from the rays' shared origin (or
-                            // a secondary pass's shared direction)
+                            // a secondary pass's shared direction, or toward its shared end)
     bool frustum = true;    // triangles outside the camera's view frustum
     bool uploads = true;    // gpu: triangle buffers kept on the device while the triangles do not change
     bool subScenes = true;  // cpu: one sequential DACRT instead of sub-scenes for frames too small to pay

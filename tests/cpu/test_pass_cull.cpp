@@ -335,8 +335,43 @@ TEST(PassCull, KeepsASingleSidedTriangleNearlyEdgeOnToTheSharedEndThatRoundingSh
 }
 
 TEST(PassCull, SharesNoEndWhereTheSegmentsEndApartOrAreWhole) {
-    // Occlusion-like segments of one length but scattered directions, and unbounded rays
-    // toward one point: neither ends at one point, so no face is tested.
+    // A triangle above a point light, facing down to it, and rays from below toward the light:
+    // segments that end at the light never reach it (it is dropped), but one ray of a longer
+    // segment, or rays that do not end, pass the light and hit its front. Occlusion rays of one
+    // length end apart.
+    const glm::vec3 light(0.0f, 10.0f, 0.0f);
+    const std::vector<Triangle> tris{Triangle{{-5, 12, -5}, 1, {5, 12, -5}, 0, {0, 12, 5}, 0}};
+    ASSERT_GT(glm::dot(glm::cross(glm::dvec3(tris[0].v1 - tris[0].v0), glm::dvec3(tris[0].v2 - tris[0].v0)),
+                       glm::dvec3(light - tris[0].v0)),
+              0.0)
+        << "the triangle shows its front to the light";
+    auto toLight = [&](float tmaxOfTheLast) {
+        std::vector<Ray> rays;
+        for (int i = 0; i < 50; ++i) {
+            const glm::vec3 origin(float(i % 7) - 3.0f, 0.0f, float(i % 5) - 2.0f);
+            rays.push_back(shared::segmentRay(origin, light - origin, i == 49 ? tmaxOfTheLast : 1.0f));
+        }
+        return rays;
+    };
+    {
+        const std::vector<Ray> rays = toLight(1.0f);
+        const FacesOnlyPass pass(tris, rays);
+        EXPECT_TRUE(pass.cull.endShared);
+        EXPECT_EQ(pass.cull.skips.backFacing, 1u);
+        EXPECT_TRUE(keepsEveryHitTriangle(pass.geometry, pass.cull));
+    }
+    for (float tmax : {2.5f, kNoHitT}) {
+        const std::vector<Ray> rays = toLight(tmax);
+        const FacesOnlyPass pass(tris, rays);
+        EXPECT_FALSE(pass.cull.endShared) << "the last ray ends at " << tmax;
+        EXPECT_TRUE(keepsEveryHitTriangle(pass.geometry, pass.cull)) << "the last ray ends at " << tmax;
+    }
+    std::vector<Ray> whole = toLight(kNoHitT);
+    for (Ray& r : whole) r = shared::segmentRay(r.origin, r.dir, kNoHitT);
+    const FacesOnlyPass wholeRays(tris, whole);
+    EXPECT_FALSE(wholeRays.cull.endShared) << "rays that do not end";
+    EXPECT_TRUE(keepsEveryHitTriangle(wholeRays.geometry, wholeRays.cull));
+
     SecondaryPassSet set = shapesUnderACeilingPasses();
     SkipSwitches facesOnly;
     facesOnly.passRays = false;
@@ -346,4 +381,42 @@ TEST(PassCull, SharesNoEndWhereTheSegmentsEndApartOrAreWhole) {
         EXPECT_FALSE(cull.endShared);
         EXPECT_FALSE(cull.skips.applied);
     }
+}
+
+TEST(PassCull, FacesTowardEndsAsksEveryPointOfTheEndBox) {
+    // n = (1, 1, 1): a box whose centre lies in front of the plane x + y + z = 0 but whose
+    // lowest corner lies behind it keeps the triangle; a box wholly in front drops it.
+    const Triangle t{{0, 0, 0}, 1, {1, -1, 0}, 0, {1, 0, -1}, 0};
+    EXPECT_TRUE(facesTowardEnds(t, glm::dvec3(0.5), glm::dvec3(1.0), 4.0));
+    EXPECT_FALSE(facesTowardEnds(t, glm::dvec3(-0.6), glm::dvec3(1.0), 4.0));
+    EXPECT_FALSE(facesTowardEnds(t, glm::dvec3(-1.0), glm::dvec3(-0.5), 4.0)) << "behind it";
+    EXPECT_FALSE(facesTowardEnds(t, glm::dvec3(0.5), glm::dvec3(1.0), 1e9)) << "a reach the margin cannot clear";
+}
+
+TEST(PassCull, TestsNothingOnlyWhereItsCheapCheckSaysSo) {
+    // passCullTests spares a pass its geometry; where it says no, the full cull must drop
+    // nothing and test nothing, on every pass of the test sets.
+    SecondaryPassSet shapes = shapesSecondaryPasses(), ceiling = shapesUnderACeilingPasses();
+    ThreadPool pool(2);
+    std::size_t spared = 0, tested = 0;
+    for (SecondaryPassSet* set : {&shapes, &ceiling}) {
+        set->passes.push_back({"directional", directionalShadowPass({0.2, -1.0, -0.1})});
+        for (const auto& [name, p] : set->passes) {
+            SCOPED_TRACE(set->name + ": " + name);
+            const PassFrame pass(set->frame, set->primary.hits, p);
+            const std::vector<Ray>& rays = *pass.geometry.rays;
+            for (const SkipSwitches& switches : {SkipSwitches{}, SkipSwitches{.passRays = false}}) {
+                PassCull cull;
+                cullForPass(pass.geometry, switches, pool, cull);
+                if (passCullTests(rays, pass.geometry.triangles->size(), pass.geometry.sceneBox, switches)) {
+                    ++tested;
+                    continue;
+                }
+                ++spared;
+                EXPECT_FALSE(cull.raysTested || cull.directionShared || cull.endShared || cull.skips.applied);
+            }
+        }
+    }
+    EXPECT_GT(spared, 0u);
+    EXPECT_GT(tested, 0u);
 }

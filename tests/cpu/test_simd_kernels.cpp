@@ -556,7 +556,7 @@ TEST_F(EveryTarget, PieceEndCellsAreTheGridRulesCells) {
     // Segments of every length and direction (axis-parallel ones, ends far outside the grid),
     // cut in 1 to kMostPieces pieces, over grids of every shape: each end's cells are those of
     // the rule (pieceEnd, floatBelow / floatAbove, cellAlong), bounds bit for bit, and
-    // floatBelow steps often, -0 and +0 among the points.
+    // floatBelow steps often.
     forEachTarget([] {
         Random rng(17);
         std::size_t ends = 0, stepped = 0;
