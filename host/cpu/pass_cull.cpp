@@ -75,15 +75,12 @@ std::size_t scanRayChunks(std::size_t count, ThreadPool* pool, Scan&& scan) {
 }
 
 // Whether every ray has the first one's direction, bit for bit (the back-face test's exactness
-// rests on it): a chunk stops at its first other direction, and the others at their next ray,
-// so a pass of scattered directions (occlusion rays) reads a few rays only.
+// rests on it): each chunk stops at its first other direction, so a pass of scattered
+// directions (occlusion rays) reads a few rays only.
 bool raysShareDirection(std::span<const Ray> rays, ThreadPool* pool) {
-    std::atomic<bool> shared{true};
-    scanRayChunks(rays.size(), pool, [&](std::size_t begin, std::size_t end, std::size_t) {
-        for (std::size_t i = begin; i < end && shared.load(std::memory_order_relaxed); ++i)
-            if (std::memcmp(&rays[i].dir, &rays.front().dir, sizeof(Ray::dir)) != 0) shared.store(false, std::memory_order_relaxed);
-    });
-    return shared.load();
+    return firstFailureInChunks(rays.size(), 4096, pool, [&](std::size_t i) {
+               return std::memcmp(&rays[i].dir, &rays.front().dir, sizeof(Ray::dir)) == 0;
+           }) == rays.size();
 }
 
 // The box of the rays' origins (the back-face tests' reach rests on every one of them).

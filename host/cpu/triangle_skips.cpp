@@ -15,6 +15,11 @@ constexpr double kFrustumSlack = 0x1p-12;
 
 enum class Verdict : std::uint8_t { Traced = kTracedVerdict, BackFacing, OutsideFrustum };
 
+// L^2 of the facing tests' bounds: the longest of a triangle's three edges, squared.
+double longestEdgeSquared(const glm::dvec3& e1, const glm::dvec3& e2, const glm::dvec3& e3) {
+    return std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
+}
+
 }  // namespace
 
 bool facesAwayFrom(const Triangle& t, const glm::dvec3& origin) {
@@ -29,7 +34,7 @@ bool facesAwayFrom(const Triangle& t, const glm::dvec3& origin) {
     // 96 u L R + 72 u L^2 + 100 u^2 R^2 (docs/correctness.md, "Skips"); its sign is the exact
     // one, "back", where side / R^2 > 240 u L + 100 u^2 R (L <= 2R), required twice over.
     const double r2 = std::max({glm::dot(a, a), glm::dot(b, b), glm::dot(c, c)});
-    const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
+    const double l2 = longestEdgeSquared(e1, e2, e3);
     return side / r2 > kFacingPerEdge * std::sqrt(l2) + kFacingPerReach * std::sqrt(r2);
 }
 
@@ -40,7 +45,7 @@ bool facesAwayAlong(const Triangle& t, const glm::dvec3& direction, double reach
     // whatever its origin; its rounding error is facesAwayFrom's, with R = reach.
     const double along = glm::dot(glm::cross(e1, e2), direction) / glm::length(direction);
     if (!(along > 0.0)) return false;
-    const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
+    const double l2 = longestEdgeSquared(e1, e2, e3);
     return along / reach > kFacingPerEdge * std::sqrt(l2) + kFacingPerReach * reach;
 }
 
@@ -57,7 +62,7 @@ bool facesTowardEnds(const Triangle& t, const glm::dvec3& endLo, const glm::dvec
     const glm::dvec3 lowest(n.x > 0.0 ? endLo.x : endHi.x, n.y > 0.0 ? endLo.y : endHi.y, n.z > 0.0 ? endLo.z : endHi.z);
     const double side = glm::dot(n, lowest - p0);
     if (!(side > 0.0)) return false;
-    const double l2 = std::max({glm::dot(e1, e1), glm::dot(e2, e2), glm::dot(e3, e3)});
+    const double l2 = longestEdgeSquared(e1, e2, e3);
     return side / (reach * reach) > kFacingPerEdge * std::sqrt(l2) + kFacingPerReach * reach;
 }
 
