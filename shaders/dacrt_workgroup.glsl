@@ -332,12 +332,71 @@ Ray leafRay(uint id) {
     return ray;
 }
 
+// One ray against one triangle: the better hit under the tie rule kept (the host's testTriangle).
+void testTriangle(Ray ray, uint prim, vec3 v0, vec3 v1, vec3 v2, bool cullBackFace, inout Hit best) {
+    TriangleHit h = intersectWatertight(ray, v0, v1, v2, cullBackFace);
+    if (h.hit && h.t > ray.tmin && hitPrecedes(h.t, prim, best.t, best.prim)) {
+        best.t = h.t;
+        best.prim = prim;
+        best.u = h.u;
+        best.v = h.v;
+    }
+}
+
+// The subgroup's active rays as one packet (the host's addToPacketBounds over them): where
+// rays share their start, a triangle whose bounds, widened by twice the filter margin, the
+// packet cannot cross is a triangle none of them can hit (docs/correctness.md, "Leaf groups").
+PacketBounds subgroupRaysBounds(bool rayActive, uint id) {
+    vec3 invDir = RAYS(id).invDir;
+    PacketBounds p;
+    uint unbounded = 0u;
+    [[unroll]] for (int a = 0; a < 3; ++a) {
+        // Not finite written as a comparison: the compiler may assume no infinity in isinf().
+        if (rayActive && (invDir[a] == 0.0 || !(abs(invDir[a]) <= 3.4028234e38))) unbounded |= 1u << uint(a);
+        p.invLo[a] = subgroupMin(rayActive ? invDir[a] : kNoHitT);
+        p.invHi[a] = subgroupMax(rayActive ? invDir[a] : -kNoHitT);
+    }
+    p.unboundedAxes = subgroupOr(unbounded);
+    return p;
+}
+
+// The subgroup's lanes where the condition holds, a bit each (lane l: bit l & 31 of word
+// l >> 5): subgroupBallot's answer from the arithmetic operations the device already offers,
+// for subgroups of up to 128 lanes.
+uvec4 lanesWhere(bool condition) {
+    uint lane = gl_SubgroupInvocationID;
+    uvec4 bits = uvec4(0u);
+    if (condition) bits[lane >> 5u] = 1u << (lane & 31u);
+    return subgroupOr(bits);
+}
+
+// The lowest lane of a non-empty lanesWhere answer (Vulkan's subgroups have at most 128
+// lanes). No loop: llvmpipe's loop limiter counts every iteration (leafTestCost).
+uint firstLane(uvec4 lanes) {
+    return lanes.x != 0u   ? uint(findLSB(lanes.x))
+           : lanes.y != 0u ? 32u + uint(findLSB(lanes.y))
+           : lanes.z != 0u ? 64u + uint(findLSB(lanes.z))
+                           : 96u + uint(findLSB(lanes.w));
+}
+
+// Whether a triangle's bounds widened by twice the filter margin may be crossed by a ray of
+// the packet.
+bool packetMayCrossTriangle(PacketBounds p, vec3 v0, vec3 v1, vec3 v2) {
+    precise float widening = 2.0 * gMargin;
+    precise vec3 lo = min(min(v0, v1), v2) - vec3(widening);
+    precise vec3 hi = max(max(v0, v1), v2) + vec3(widening);
+    return packetMayCrossCell(p, lo, hi);
+}
+
 // Rays rayIds[rayBegin, rayEnd) of a leaf against its triangles, updating their best hits.
 // A large leaf may take several calls (slices) over consecutive ray ranges. Each subgroup
 // works alone: every lane loads one triangle of a subgroup-sized tile and the tile reaches
 // the other lanes by shuffles, not through shared memory (llvmpipe reads and writes memory
 // one invocation at a time, but shuffles in registers). With fewer rays than lanes each ray
 // gets `lanes` lanes that split the tile; a butterfly then gives all of them the best hit.
+// Where rays share their start and each has its own lane, the subgroup's rays test only the
+// tile's triangles their packet may reach (subgroupRaysBounds): no more loop iterations than
+// the whole tile, so leafTestCost still bounds them.
 void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
     uint start = stageClock();
     uint lane = gl_SubgroupInvocationID;
@@ -354,10 +413,28 @@ void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
         uint id = rayActive ? RAY_IDS(index) : 0u;
         Ray ray = leafRay(id);
         Hit best = liveRayHit(id);
+        bool grouped = kSharedStart && lanes == 1u;
+        PacketBounds group;
+        if (grouped) group = subgroupRaysBounds(rayActive, id);
         for (uint tile = triBegin; tile < triEnd; tile += gl_SubgroupSize) {
             uint tileSize = min(gl_SubgroupSize, triEnd - tile);
             uint myPrim = lane < tileSize ? TRI_IDS(tile + lane) : 0u;
             Triangle mine = TRIANGLES(myPrim);
+            if (grouped) {
+                uvec4 kept = lanesWhere(lane < tileSize && packetMayCrossTriangle(group, mine.v0, mine.v1, mine.v2));
+                uint keptCount = bitCount(kept.x) + bitCount(kept.y) + bitCount(kept.z) + bitCount(kept.w);
+                for (uint j = 0; j < keptCount; ++j) {  // uniform: kept is the subgroup's
+                    uint k = firstLane(kept);
+                    kept[k >> 5u] &= ~(1u << (k & 31u));
+                    uint prim = subgroupShuffle(myPrim, k);
+                    vec3 v0 = subgroupShuffle(mine.v0, k);
+                    vec3 v1 = subgroupShuffle(mine.v1, k);
+                    vec3 v2 = subgroupShuffle(mine.v2, k);
+                    bool cullBackFace = subgroupShuffle(mine.cullBackFace, k) != 0u;
+                    if (rayActive) testTriangle(ray, prim, v0, v1, v2, cullBackFace, best);
+                }
+                continue;
+            }
             for (uint j = 0; j < tileSize; j += lanes) {  // uniform: every lane shuffles
                 uint k = j + slot;
                 uint prim = subgroupShuffle(myPrim, k);
@@ -365,15 +442,7 @@ void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
                 vec3 v1 = subgroupShuffle(mine.v1, k);
                 vec3 v2 = subgroupShuffle(mine.v2, k);
                 bool cullBackFace = subgroupShuffle(mine.cullBackFace, k) != 0u;
-                if (rayActive && k < tileSize) {
-                    TriangleHit h = intersectWatertight(ray, v0, v1, v2, cullBackFace);
-                    if (h.hit && h.t > ray.tmin && hitPrecedes(h.t, prim, best.t, best.prim)) {
-                        best.t = h.t;
-                        best.prim = prim;
-                        best.u = h.u;
-                        best.v = h.v;
-                    }
-                }
+                if (rayActive && k < tileSize) testTriangle(ray, prim, v0, v1, v2, cullBackFace, best);
             }
         }
         // hitPrecedes is a total order on (t, prim), so the butterfly's order of comparisons

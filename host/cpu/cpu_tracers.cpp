@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "cpu/backend_options.hpp"
+#include "cpu/ray_grouping.hpp"
 #include "cpu/traversal.hpp"
 #include "core/errors.hpp"
 #include "core/mapped_memory.hpp"
@@ -236,6 +237,76 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     return result;
 }
 
+std::vector<std::uint32_t> imageBands(const FrameGeometry& g, unsigned workers) {
+    const std::uint32_t rays = std::uint32_t(g.rays->size());
+    if (!g.imageWidth || g.query != HitQuery::Closest || workers < 2 || rays % g.imageWidth != 0) return {};
+    // Whole rows of tiles: a band's packets are the image's own (buildPackets tiles by ray id).
+    const std::uint32_t tileRows = (rays / g.imageWidth + kPacketTile - 1) / kPacketTile;
+    const std::vector<std::size_t> batches = rayBatches(tileRows, std::max<std::size_t>(
+                                                                      1, passBatchRays(g.triangles->size()) /
+                                                                             (std::size_t(g.imageWidth) * kPacketTile)),
+                                                        workers);
+    std::vector<std::uint32_t> starts;
+    for (std::size_t b : batches) {
+        const std::uint32_t start = std::min(rays, std::uint32_t(b) * kPacketTile * g.imageWidth);
+        if (starts.empty() || start != starts.back()) starts.push_back(start);
+    }
+    return starts.size() > 2 ? starts : std::vector<std::uint32_t>{};
+}
+
+TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options, ThreadPool& pool,
+                            const std::vector<std::uint32_t>& bands, const PlanHook& onPlan) {
+    TraceResult result;
+    const std::uint32_t rayCount = std::uint32_t(g.rays->size());
+    const std::uint32_t triCount = std::uint32_t(g.tracedTriangleCount());
+    const std::size_t bandCount = bands.size() - 1;
+    const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), bandCount));
+    std::uint32_t widest = 0;
+    for (std::size_t b = 0; b < bandCount; ++b) widest = std::max(widest, bands[b + 1] - bands[b]);
+    const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
+    const std::uint64_t scratchIds = usesSimd(g, resolved) ? partitionScratchIds(widest, triCount) : 0;
+    planFrameInputs(g, result.memory);
+    result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
+    result.memory.add("triangle ids (per thread)", std::uint64_t(triCount) * 4 * workers);
+    if (scratchIds) result.memory.add("partition scratch (per thread)", scratchIds * 4 * workers);
+    planPacketBuffers(g, resolved, scratchIds, workers, result.memory);
+    result.memory.work.push_back({"image bands side by side", bandCount,
+                                  "rows of 8x8 tiles, each a sequential DACRT on one of " + std::to_string(workers) +
+                                      " workers: no division or transfer rounds"});
+    if (onPlan && !onPlan(result.memory)) return result;
+
+    const auto start = Clock::now();
+    const bool raysShareSegment = startHits(g, result.hits);
+    std::vector<std::uint32_t> rayIds(rayCount);
+    std::iota(rayIds.begin(), rayIds.end(), 0u);
+    std::vector<std::vector<std::uint32_t>> triIds(workers), scratch(workers);
+    PacketStorage packets(g, resolved, scratchIds, workers);
+    std::vector<Counters> counters(workers);
+    pool.parallelFor(bandCount, [&](std::size_t b, unsigned w) {
+        // The traversal permutes its triangle ids: each band starts from the traced ones.
+        triIds[w].resize(triCount);
+        for (std::uint32_t i = 0; i < triCount; ++i) triIds[w][i] = g.tracedTriangle(i);
+        scratch[w].resize(scratchIds);
+        DacrtTraversal traversal(g, options,
+                                 {result.hits.data(), rayIds.data() + bands[b], triIds[w].data(),
+                                  scratchIds ? scratch[w].data() : nullptr, packets.forWorker(w), raysShareSegment},
+                                 counters[w]);
+        std::uint32_t finished = 0;
+        const std::uint32_t crossing = traversal.trace(g.sceneBox, finished, bands[b + 1] - bands[b], 0, triCount);
+        counters[w].raysCulled += bands[b + 1] - bands[b] - crossing;
+        counters[w].finishedStep1 += finished;
+    });
+    for (const Counters& c : counters) {
+        result.counters.add(c);
+        result.counters.raysCulled += c.raysCulled;
+        result.counters.finishedStep1 += c.finishedStep1;
+    }
+    result.phases.step1 = msSince(start);
+    result.threads = workers;
+    result.regions = 1;
+    return result;
+}
+
 TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool,
                           const PlanHook& onPlan) {
     ParallelFrame frame(g, options, pool);
@@ -265,6 +336,11 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
                 r.regions = 1;
                 r.memory.work.insert(r.memory.work.end(), line.begin(), line.end());
                 return r;
+            }
+            // Bands skip the sub-scenes too: --no-skip subscenes asks for the parallel scheme.
+            if (options.regions == 0 && options.skips.subScenes) {
+                const std::vector<std::uint32_t> bands = imageBands(g, pool.size());
+                if (!bands.empty()) return traceImageBands(g, options.dacrt, pool, bands, onPlan);
             }
             return traceParallel(g, options, pool, onPlan);
         }

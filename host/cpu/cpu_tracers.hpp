@@ -1,6 +1,7 @@
 #pragma once
 // The CPU backends: brute force, sequential DACRT, and the parallel scheme.
 #include <functional>
+#include <vector>
 
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
@@ -23,6 +24,19 @@ TraceResult traceSequential(const FrameGeometry& geometry, const DacrtOptions& o
 // transfer rounds; work items of a step run on the pool.
 TraceResult traceParallel(const FrameGeometry& geometry, const TraceOptions& options, ThreadPool& pool,
                           const PlanHook& onPlan = {});
+
+// A closest-hit frame of an image's rays in bands of whole rows of 8x8 tiles, for `workers`
+// workers: where each band starts, then the end (rayBatches of passBatchRays' size, as a
+// multiple of the workers, in tile rows). Empty where the frame is no such image, a worker
+// is alone, or one band would hold it.
+std::vector<std::uint32_t> imageBands(const FrameGeometry& geometry, unsigned workers);
+
+// The bands side by side: each a sequential DACRT over every traced triangle, its rays the
+// band's ids into the frame's arrays (packets and hits are the frame's), on one worker at a
+// time. Exact as traceSequential is: no division, no transfer rounds. The cpu backend's
+// primary frames where --regions is not given (docs/cpu-reference.md, "Image bands").
+TraceResult traceImageBands(const FrameGeometry& geometry, const DacrtOptions& options, ThreadPool& pool,
+                            const std::vector<std::uint32_t>& bands, const PlanHook& onPlan = {});
 
 // The backend options.backend names: brute, cpu-seq or cpu. Throws InputError first when the
 // options ask it for DACRT options it does not take, or do not combine (checkTraceOptions).

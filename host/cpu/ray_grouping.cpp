@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/mapped_memory.hpp"
+#include "cpu/options.hpp"
 
 namespace dacrt {
 
@@ -49,6 +50,10 @@ OctantStarts groupByOctant(SecondaryRays& rays, GroupingBuffers& buffers, Thread
     std::swap(rays.rays, grouped);
     std::swap(rays.slots, slots);
     return starts;
+}
+
+std::size_t passBatchRays(std::size_t triangles) {
+    return std::max<std::size_t>(kPassBatchRays, std::size_t(kPassBatchRaysPerTriangle) * triangles);
 }
 
 std::vector<std::size_t> rayBatches(std::size_t rays, std::size_t most, std::size_t multipleOf) {

@@ -40,4 +40,10 @@ OctantStarts groupByOctant(SecondaryRays& rays, GroupingBuffers& buffers, Thread
 // `most` and multipleOf is 1).
 std::vector<std::size_t> rayBatches(std::size_t rays, std::size_t most, std::size_t multipleOf = 1);
 
+// The most rays a batch traced as one sequential DACRT holds (a pass's --ray-grouping batches,
+// a gpu pass's ray groups on a CPU device, the cpu backend's image bands): kPassBatchRays, or
+// kPassBatchRaysPerTriangle per triangle of the scene where that is more, so that a batch's
+// rays outnumber what its own filtering of every triangle costs.
+std::size_t passBatchRays(std::size_t triangles);
+
 }  // namespace dacrt

@@ -6,8 +6,10 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "cpu/predicates.hpp"
+#include "cpu/ray_packet.hpp"
 #include "cpu/simd_kernels.hpp"
 
 #ifndef DACRT_SIMD_COMPRESS_TABLE
@@ -362,8 +364,8 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
 // ky the next two in cyclic order, swapped where the direction along kz is negative.
 constexpr std::uint32_t packedAxes(int kx, int ky, int kz) { return std::uint32_t(kx | ky << 2 | kz << 4); }
 
-void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                    const LeafTriangles& batch) {
+HWY_INLINE void intersectRays(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                              const LeafTriangles& batch) {
     // A few rays ahead asked for: a leaf's rays are scattered over the pass's arrays.
     constexpr std::uint32_t kRaysAhead = 4;
     for (std::uint32_t r = 0; r < rayCount; ++r) {
@@ -384,6 +386,125 @@ void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
             default: HWY_ABORT("ray axes %u: makeRay and segmentRay make only six", ray.axes);
         }
     }
+}
+
+void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                    const LeafTriangles& batch) {
+    intersectRays(rays, hits, rayIds, rayCount, batch);
+}
+
+// The batch's triangle bounds, widened, lanes at a time: min and max of exact vertices, then
+// one rounding of the widening.
+struct WidenedBounds {
+    alignas(64) float lo[3][kLeafBatch];
+    alignas(64) float hi[3][kLeafBatch];
+};
+
+HWY_INLINE void widenedBoundsOf(const LeafTriangles& batch, float widening, WidenedBounds& b) {
+    const DF df;
+    const std::size_t n = hn::Lanes(df);
+    const VF w = hn::Set(df, widening);
+    for (std::size_t j = 0; j < batch.count; j += n)
+        for (int c = 0; c < 3; ++c) {
+            const VF v0 = hn::Load(df, &batch.vertex[0][c][j]), v1 = hn::Load(df, &batch.vertex[1][c][j]),
+                     v2 = hn::Load(df, &batch.vertex[2][c][j]);
+            hn::Store(hn::Sub(hn::Min(hn::Min(v0, v1), v2), w), df, &b.lo[c][j]);
+            hn::Store(hn::Add(hn::Max(hn::Max(v0, v1), v2), w), df, &b.hi[c][j]);
+        }
+}
+
+// The triangles of batch whose widened bounds the group may cross (packetMayCrossCell,
+// ray_packet.cpp: the same products, minima and maxima lane by lane), in order, into
+// narrowed. Returns how many.
+HWY_INLINE std::uint32_t narrowToGroup(const LeafTriangles& batch, const WidenedBounds& b, const RayPacket& group,
+                                       const glm::vec3& origin, float tmin, LeafTriangles& narrowed) {
+    const DF df;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    std::uint32_t count = 0;
+    auto keep = [&](auto mask, const auto* from, auto* to) {
+        const VU v = hn::Load(du, reinterpret_cast<const std::uint32_t*>(from));
+        hn::StoreU(compressIds(v, mask), du, reinterpret_cast<std::uint32_t*>(to) + count);
+    };
+    for (std::size_t j = 0; j < batch.count; j += n) {
+        VF tNear = hn::Set(df, -kNoHitT), tFar = hn::Set(df, kNoHitT);
+        for (int a = 0; a < 3; ++a) {
+            if ((group.unboundedAxes >> a) & 1u) continue;
+            const VF o = hn::Set(df, origin[a]), lo = hn::Set(df, group.invLo[a]), hi = hn::Set(df, group.invHi[a]);
+            const VF d0 = hn::Sub(hn::Load(df, &b.lo[a][j]), o), d1 = hn::Sub(hn::Load(df, &b.hi[a][j]), o);
+            const VF q0 = hn::Mul(d0, lo), q1 = hn::Mul(d0, hi), q2 = hn::Mul(d1, lo), q3 = hn::Mul(d1, hi);
+            tNear = hn::Max(tNear, hn::Min(hn::Min(q0, q1), hn::Min(q2, q3)));
+            tFar = hn::Min(tFar, hn::Max(hn::Max(q0, q1), hn::Max(q2, q3)));
+        }
+        const MF may = hn::And(hn::And(tNear <= tFar, tFar >= hn::Set(df, tmin)), hn::FirstN(df, batch.count - j));
+        if (hn::AllFalse(df, may)) continue;
+        const auto mask = hn::RebindMask(du, may);
+        for (int k = 0; k < 3; ++k)
+            for (int c = 0; c < 3; ++c) keep(mask, &batch.vertex[k][c][j], narrowed.vertex[k][c]);
+        keep(mask, &batch.prim[j], narrowed.prim);
+        keep(mask, &batch.cullBackFace[j], narrowed.cullBackFace);
+        count += std::uint32_t(hn::CountTrue(df, may));
+    }
+    narrowed.count = count;
+    return count;
+}
+
+// startPacketBounds and addToPacketBounds over rays[rayIds[0, count)], lanes at a time: on the
+// axes left bounded every lane is finite and nonzero, so the lanes' minimum and maximum are
+// the scalar fold's.
+HWY_INLINE RayPacket boundsOfGroup(const Ray* rays, const std::uint32_t* rayIds, std::uint32_t count) {
+    const DF df;
+    const std::size_t n = hn::Lanes(df);
+    const float* base = reinterpret_cast<const float*>(rays);
+    const VF zero = hn::Zero(df), infinity = hn::Set(df, std::numeric_limits<float>::infinity());
+    VF lo[3], hi[3];
+    MF unbounded[3];
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = hn::Set(df, kNoHitT);
+        hi[a] = hn::Set(df, -kNoHitT);
+        unbounded[a] = hn::FirstN(df, 0);
+    }
+    alignas(64) std::uint32_t ids[64];
+    for (std::uint32_t i = 0; i < count; i += std::uint32_t(n)) {
+        const std::uint32_t lanes = std::min(std::uint32_t(n), count - i);
+        for (std::size_t l = 0; l < n; ++l) ids[l] = rayIds[i + std::min(std::uint32_t(l), lanes - 1)];
+        VF invDir[4];
+        loadQuadPerLane<8>(base, ids, invDir);  // floats 8-10 of a Ray
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = hn::Min(lo[a], invDir[a]);
+            hi[a] = hn::Max(hi[a], invDir[a]);
+            unbounded[a] = hn::Or(unbounded[a], hn::Or(invDir[a] == zero, hn::Not(hn::Abs(invDir[a]) < infinity)));
+        }
+    }
+    RayPacket p;
+    for (int a = 0; a < 3; ++a) {
+        p.invLo[a] = hn::GetLane(hn::MinOfLanes(df, lo[a]));
+        p.invHi[a] = hn::GetLane(hn::MaxOfLanes(df, hi[a]));
+        if (!hn::AllFalse(df, unbounded[a])) p.unboundedAxes |= 1u << a;
+    }
+    return p;
+}
+
+RayPacket BoundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32_t count) {
+    return boundsOfGroup(rays, rayIds, count);
+}
+
+std::uint64_t IntersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                                     const LeafTriangles& batch, float widening, LeafTriangles& narrowed) {
+    WidenedBounds bounds;
+    widenedBoundsOf(batch, widening, bounds);
+    const glm::vec3 origin = rays[0].origin;  // every ray's (SharedRayFields::Start)
+    const float tmin = rays[0].tmin;
+    std::uint64_t skipped = 0;
+    for (std::uint32_t g = 0; g < rayCount; g += kLeafGroupRays) {
+        const std::uint32_t groupRays = std::min(kLeafGroupRays, rayCount - g);
+        const RayPacket group = boundsOfGroup(rays, rayIds + g, groupRays);
+        const std::uint32_t kept = narrowToGroup(batch, bounds, group, origin, tmin, narrowed);
+        skipped += std::uint64_t(groupRays) * (batch.count - kept);
+        if (kept == 0) continue;
+        intersectRays(rays, hits, rayIds + g, groupRays, kept == batch.count ? batch : narrowed);
+    }
+    return skipped;
 }
 
 // firstRegionOfRay lanes at a time: each lane's walk start, then every region's test in
@@ -515,6 +636,8 @@ namespace dacrt::simd {
 HWY_EXPORT(PartitionRays);
 HWY_EXPORT(PartitionTrianglesOnFace);
 HWY_EXPORT(IntersectBatch);
+HWY_EXPORT(IntersectBatchInGroups);
+HWY_EXPORT(BoundsOfRays);
 HWY_EXPORT(GatherLeafTriangles);
 HWY_EXPORT(CompiledTarget);
 HWY_EXPORT(ClassifyFacing);
@@ -579,6 +702,15 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                     const LeafTriangles& batch) {
     HWY_DYNAMIC_DISPATCH(IntersectBatch)(rays, hits, rayIds, rayCount, batch);
+}
+
+RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32_t count) {
+    return HWY_DYNAMIC_DISPATCH(BoundsOfRays)(rays, rayIds, count);
+}
+
+std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                                     const LeafTriangles& batch, float widening, LeafTriangles& narrowed) {
+    return HWY_DYNAMIC_DISPATCH(IntersectBatchInGroups)(rays, hits, rayIds, rayCount, batch, widening, narrowed);
 }
 
 std::string activeTarget() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CompiledTarget)()); }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/scene.hpp"
+#include "cpu/ray_packet.hpp"
 
 namespace dacrt::simd {
 
@@ -50,12 +51,14 @@ std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids,
                                        FaceSide keep = FaceSide::Reaching);
 
 // Up to kLeafBatch triangles of a leaf in structure-of-arrays form: coordinate c of vertex k
-// of triangle j is vertex[k][c][j]. Lanes past `count` are padding and never hit.
+// of triangle j is vertex[k][c][j]. Lanes past `count` are padding and never hit; one
+// vector's worth of lanes past kLeafBatch takes whole-vector stores.
 constexpr std::uint32_t kLeafBatch = 64;
+constexpr std::uint32_t kLeafLanes = kLeafBatch + 16;
 struct LeafTriangles {
-    alignas(64) float vertex[3][3][kLeafBatch];
-    alignas(64) std::uint32_t prim[kLeafBatch];
-    alignas(64) std::uint32_t cullBackFace[kLeafBatch];  // Triangle::cullBackFace
+    alignas(64) float vertex[3][3][kLeafLanes];
+    alignas(64) std::uint32_t prim[kLeafLanes];
+    alignas(64) std::uint32_t cullBackFace[kLeafLanes];  // Triangle::cullBackFace
     std::uint32_t count = 0;
 };
 
@@ -69,6 +72,20 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 // any order, since the rule is a total order on distinct ids.
 void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                     const LeafTriangles& batch);
+
+// intersectBatch for rays that share their start (SharedRayFields::Start: every ray has
+// rays[0]'s origin and tmin), in groups of up to kLeafGroupRays consecutive ids: each group
+// tests only the triangles whose bounds, widened by `widening` (twice the filter margin),
+// packetMayCrossCell (ray_packet.hpp) says the group may cross, gathered into narrowed. The
+// same hits as intersectBatch: a triangle the test reports a hit on lies within the margin of
+// its bounds on the ray's segment (docs/correctness.md, "Leaf groups"). Returns the ray/triangle
+// tests skipped.
+constexpr std::uint32_t kLeafGroupRays = 16;
+// The bounds of rays[rayIds[0, count)] (count > 0) as startPacketBounds and addToPacketBounds
+// (ray_packet.hpp) make them, lanes at a time (begin and end left 0).
+RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32_t count);
+std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                                     const LeafTriangles& batch, float widening, LeafTriangles& narrowed);
 
 // The regions of a scene division as the ray binning reads them (scene_division.cpp): `count`
 // (at least 1) slabs along `axis` between ascending boundaries boundary[0] .. boundary[count]

@@ -15,7 +15,10 @@ namespace dacrt {
 struct Counters {
     std::uint64_t rayBoxTests = 0;
     std::uint64_t packetBoxTests = 0;    // packets of rays tested at once against a box
-    std::uint64_t rayTriangleTests = 0;
+    std::uint64_t rayTriangleTests = 0;  // a leaf's rays times its triangles, summed
+    // Of those, the pairs a leaf's ray groups skipped: no ray of the group can reach the
+    // triangle's bounds (simd::intersectBatchInGroups).
+    std::uint64_t rayTriangleTestsSkipped = 0;
     std::uint64_t leaves = 0;
     // A ray is finished once it has its final hit (or none): the parallel scheme finishes rays
     // early, without a further hit, when they cannot reach the next region.
@@ -31,6 +34,7 @@ struct Counters {
         rayBoxTests += o.rayBoxTests;
         packetBoxTests += o.packetBoxTests;
         rayTriangleTests += o.rayTriangleTests;
+        rayTriangleTestsSkipped += o.rayTriangleTestsSkipped;
         leaves += o.leaves;
         raysFinishedWithoutHit += o.raysFinishedWithoutHit;
     }

@@ -329,28 +329,13 @@ std::uint32_t DacrtTraversal::buildPackets(std::uint32_t begin, std::uint32_t en
     for (std::uint32_t t = 0; t < tiles_; tileBegin = start[t], ++t) {
         if (start[t] == tileBegin) continue;
         RayPacket& p = packet_.packets[packets];
+        p = simd::boundsOfRays(rays_, packet_.packetRays + tileBegin, start[t] - tileBegin);
         p.begin = tileBegin;
         p.end = start[t];
-        startPacketBounds(p);
-        for (std::uint32_t k = p.begin; k < p.end; ++k) addToPacketBounds(p, rays_[packet_.packetRays[k]].invDir);
         packet_.packetIds[packets] = packets;
         ++packets;
     }
     return packets;
-}
-
-// Conservative for every ray of the packet (see RayPacket): false only where the ray filter
-// would reject each of them.
-bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin, const Box& cell) {
-    float tNear = -kNoHitT, tFar = kNoHitT;
-    for (int a = 0; a < 3; ++a) {
-        if ((p.unboundedAxes >> a) & 1u) continue;
-        const float d0 = cell.lo[a] - origin[a], d1 = cell.hi[a] - origin[a];  // the ray filter's own first factors
-        const float q0 = d0 * p.invLo[a], q1 = d0 * p.invHi[a], q2 = d1 * p.invLo[a], q3 = d1 * p.invHi[a];
-        tNear = std::max(tNear, std::min(std::min(q0, q1), std::min(q2, q3)));
-        tFar = std::min(tFar, std::max(std::max(q0, q1), std::max(q2, q3)));
-    }
-    return tNear <= tFar && tFar >= tmin;
 }
 
 std::uint32_t DacrtTraversal::filterPackets(const Box& cell, std::uint32_t begin, std::uint32_t end) {
@@ -432,9 +417,14 @@ template <typename PrepareRay, typename TestTriangle>
 
 void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
                               std::uint32_t triBegin, std::uint32_t triEnd) {
+    const bool groups = sharedRayFields_ == simd::SharedRayFields::Start;
     for (std::uint32_t j = triBegin; j < triEnd; j += simd::kLeafBatch) {
         simd::gatherLeafTriangles(triangles_, triIds_ + j, std::min(triEnd - j, simd::kLeafBatch), batch_);
-        simd::intersectBatch(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_);
+        if (groups)
+            counters_.rayTriangleTestsSkipped += simd::intersectBatchInGroups(
+                rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_, 2.0f * margin_, narrowed_);
+        else
+            simd::intersectBatch(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_);
     }
     endRaysHitInBox(box, terminated, rayEnd);
 }

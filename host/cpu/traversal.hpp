@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cpu/predicates.hpp"
+#include "cpu/ray_packet.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/memory_plan.hpp"
 #include "cpu/simd_kernels.hpp"
@@ -30,36 +31,6 @@ struct RetireRule {
 // longest ray or triangle id range it is given.
 std::uint64_t partitionScratchIds(std::uint64_t rayRange, std::uint64_t triRange);
 
-// A packet: the live rays of one 8x8 pixel tile, and bounds of their direction reciprocals
-// per axis. Rays that share their start compute (lo - origin) * invDir with the same first
-// factor, and rounding is monotone, so the packet's four corner products bound every ray's
-// rounded slab values: a packet the bounds reject holds no ray the ray filter would keep.
-// Some axes are left unbounded (addToPacketBounds).
-struct RayPacket {
-    std::uint32_t begin = 0, end = 0;  // its rays: packetRays[begin, end)
-    glm::vec3 invLo{0.0f}, invHi{0.0f};
-    std::uint32_t unboundedAxes = 0;   // bit per axis
-};
-constexpr std::uint32_t kPacketTile = 8;
-
-// A packet's bounds with no ray yet, then grown by each ray's invDir: the cpu's RayPacket and
-// the gpu's PacketBounds (shaders/layout.h) alike. An axis where some ray's invDir is 0 (the
-// ray filter's branch) or not finite (no product could be trusted) gets no bound.
-template <typename Packet>
-void startPacketBounds(Packet& p) {
-    p.invLo = glm::vec3(kNoHitT);
-    p.invHi = glm::vec3(-kNoHitT);
-    p.unboundedAxes = 0;
-}
-template <typename Packet>
-void addToPacketBounds(Packet& p, const glm::vec3& invDir) {
-    for (int a = 0; a < 3; ++a) {
-        if (invDir[a] == 0.0f || !std::isfinite(invDir[a])) p.unboundedAxes |= 1u << a;
-        p.invLo[a] = std::min(p.invLo[a], invDir[a]);
-        p.invHi[a] = std::max(p.invHi[a], invDir[a]);
-    }
-}
-
 // Packets' working arrays, one set per worker: rays grouped by tile, the rays of a node's
 // packets when it goes on ray by ray, the packets and their ids (partitioned like ray ids),
 // and per-ray "finished" flags shared by all workers (each ray belongs to one work item).
@@ -71,9 +42,6 @@ struct PacketBuffers {
     std::uint32_t* tileCounts = nullptr;  // packetTiles() + 1
     std::uint8_t* rayDone = nullptr;      // one per ray of the frame, zeroed
 };
-// The packet filter: false only where shared::rayMayCrossCell(ray, cell, tmax) is false for
-// every ray of p (origin and tmin: the rays' shared start).
-bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin, const Box& cell);
 // Whether a traversal of these (resolved) options on this frame runs the SIMD kernels: the
 // default tests, and counts whose ids fit the kernels' 32-bit gather offsets.
 bool usesSimd(const FrameGeometry& geometry, const DacrtOptions& options);
@@ -197,6 +165,7 @@ private:
     std::uint32_t imageWidth_;
     std::uint32_t tiles_;  // the default options (bounds filter, watertight float32 test) on SIMD kernels
     simd::LeafTriangles batch_;
+    simd::LeafTriangles narrowed_{};  // a group's triangles of batch_ (intersectBatchInGroups)
     Counters& counters_;
 };
 

@@ -22,11 +22,13 @@ namespace {
 // Bounds of the direction reciprocals of rays packetRays[begin, end).
 PacketBounds boundPacket(const FrameGeometry& g, const std::vector<std::uint32_t>& packetRays, std::uint32_t begin,
                          std::uint32_t end) {
+    const RayPacket bounds = simd::boundsOfRays(g.rays->data(), packetRays.data() + begin, end - begin);
     PacketBounds p{};
+    p.invLo = bounds.invLo;
+    p.invHi = bounds.invHi;
+    p.unboundedAxes = bounds.unboundedAxes;
     p.rayBegin = begin;
     p.rayEnd = end;
-    startPacketBounds(p);
-    for (std::uint32_t k = begin; k < end; ++k) addToPacketBounds(p, (*g.rays)[packetRays[k]].invDir);
     return p;
 }
 

@@ -36,6 +36,7 @@ TraceCounters countersOf(const TraceResult& result) {
     c.rayBoxTests = result.counters.rayBoxTests;
     c.packetBoxTests = result.counters.packetBoxTests;
     c.rayTriangleTests = result.counters.rayTriangleTests;
+    c.rayTriangleTestsSkipped = result.counters.rayTriangleTestsSkipped;
     c.leaves = result.counters.leaves;
     c.raysCulled = result.counters.raysCulled;
     c.raysFinishedWithoutHit = result.counters.raysFinishedWithoutHit;

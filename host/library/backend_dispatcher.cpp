@@ -49,13 +49,6 @@ bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryH
     return passCullMayDrop(surfaces * pass.raysPerHit, triangles.size(), sharedFacing, switches);
 }
 
-// The most rays a batch of a pass's rays holds (--ray-grouping batches, and a gpu pass's ray
-// groups on a CPU device): kPassBatchRays, or kPassBatchRaysPerTriangle per triangle where that
-// is more.
-std::size_t passBatchRays(std::size_t triangles) {
-    return std::max<std::size_t>(kPassBatchRays, std::size_t(kPassBatchRaysPerTriangle) * triangles);
-}
-
 // A gpu pass's request on a device that takes a CPU's defaults (lavapipe), where neither the
 // regions nor the ray groups were asked for: one region, its rays in the cpu backend's
 // batches, each batch a ray group (a work item of Step 1 with the whole scene's triangles).
@@ -73,6 +66,26 @@ BackendRequest gpuPassRequest(const BackendRequest& request, const gpu::DeviceIn
     pass.trace.regions = 1;
     pass.gpuTuning.rayGroups = std::uint32_t(std::min<std::size_t>(batches, gpu::kMostDefaultRayGroups));
     return pass;
+}
+
+// A gpu primary frame's request on a device that takes a CPU's defaults, where neither the
+// regions nor the ray groups were asked for and the cpu backend would cut the image into at
+// least two bands a core (imageBands: a scene of few triangles for its rays, as the room):
+// one region, the bands its ray groups, so that no ray waits for a transfer round. Where the
+// bands are fewer, the regions stay: a work item's own pass over every triangle costs the
+// kernel more than the rounds save (docs/gpu.md, "Leaf groups and image bands").
+BackendRequest gpuPrimaryRequest(const BackendRequest& request, const gpu::DeviceInfo& device,
+                                 const FrameGeometry& geometry) {
+    if (request.trace.regions != 0 || request.gpuTuning.rayGroups != 0 ||
+        !gpu::takesCpuDefaults(device, request.gpuTuning.profile))
+        return request;
+    const unsigned cores = gpu::defaultGpuRegions(device, request.gpuTuning.profile);
+    const std::size_t bands = std::max<std::size_t>(imageBands(geometry, cores).size(), 1) - 1;
+    if (bands < 2 * std::size_t(cores)) return request;
+    BackendRequest primary = request;
+    primary.trace.regions = 1;
+    primary.gpuTuning.rayGroups = std::uint32_t(std::min<std::size_t>(bands, gpu::kMostDefaultRayGroups));
+    return primary;
 }
 
 }  // namespace
@@ -174,9 +187,10 @@ TraceResult BackendDispatcher::traceOnBackend(const FrameGeometry& geometry, con
             const bool closest = geometry.query == HitQuery::Closest;
             if (closest && request.keepForPasses) passSource_.reset();
             bool whole = true;
+            const BackendRequest asked = closest ? gpuPrimaryRequest(request, gpu_->info(), geometry) : request;
             const auto traceOne = [&](const FrameGeometry& g, const std::vector<WorkLine>& planLines) {
                 if (closest) arena_->startFrame();
-                GpuTracer tracer(*gpu_, threadPool, request.trace, request.gpuTuning, pipelines_.get(), resident_.get(),
+                GpuTracer tracer(*gpu_, threadPool, asked.trace, asked.gpuTuning, pipelines_.get(), resident_.get(),
                                  arena_.get());
                 const bool keep = whole && request.keepForPasses && closest;
                 whole = false;

@@ -15,6 +15,7 @@ nlohmann::ordered_json countersJson(const TraceCounters& c) {
     return {{"ray_box_tests", c.rayBoxTests},
             {"packet_box_tests", c.packetBoxTests},
             {"ray_triangle_tests", c.rayTriangleTests},
+            {"ray_triangle_tests_skipped", c.rayTriangleTestsSkipped},
             {"leaves", c.leaves},
             {"rays_retired_without_hit", c.raysFinishedWithoutHit},
             {"rays_culled", c.raysCulled},

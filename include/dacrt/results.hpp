@@ -52,7 +52,8 @@ struct TraceTimings {
 struct TraceCounters {
     std::uint64_t rayBoxTests = 0;
     std::uint64_t packetBoxTests = 0;    // packets of rays tested against a box at once
-    std::uint64_t rayTriangleTests = 0;
+    std::uint64_t rayTriangleTests = 0;         // a leaf's rays times its triangles, summed over leaves
+    std::uint64_t rayTriangleTestsSkipped = 0;  // cpu: of those, pairs a leaf's ray groups ruled out unrun
     std::uint64_t leaves = 0;
     std::uint64_t raysCulled = 0;        // missed the scene's bounds
     std::uint64_t raysFinishedWithoutHit = 0;  // cpu: finished early, unable to reach a further region

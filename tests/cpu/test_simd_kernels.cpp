@@ -14,6 +14,7 @@
 #include "core/camera.hpp"
 #include "core/random.hpp"
 #include "cpu/cull_lanes.hpp"
+#include "cpu/frame_geometry.hpp"
 #include "cpu/predicates.hpp"
 #include "cpu/simd_kernels.hpp"
 #include "cpu/traversal.hpp"
@@ -308,6 +309,146 @@ TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
         }
         EXPECT_GT(hitsFound, 2000u);
         EXPECT_GT(tiesOnDuplicates, 50u);  // the tie rule is exercised, not only distinct depths
+    });
+}
+
+// The packet bounds made lanes at a time are the scalar fold's on every bounded axis, and the
+// same axes go unbounded: direction reciprocals of 0, infinity and NaN mixed in, any count.
+TEST_F(EveryTarget, RayBoundsAreTheScalarFold) {
+    forEachTarget([] {
+        Random rng(31);
+        std::size_t unbounded = 0, bounded = 0;
+        for (int trial = 0; trial < 2000; ++trial) {
+            std::vector<Ray> rays(1 + rng.index(80));
+            for (Ray& r : rays) {
+                r = randomRay(rng);
+                for (int a = 0; a < 3; ++a) {
+                    const double pick = rng.uniform();
+                    if (pick < 0.01) r.invDir[a] = std::numeric_limits<float>::infinity();
+                    else if (pick < 0.02) r.invDir[a] = -std::numeric_limits<float>::infinity();
+                    else if (pick < 0.025) r.invDir[a] = std::numeric_limits<float>::quiet_NaN();
+                }
+            }
+            std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(rays.size()), std::uint32_t(rays.size()));
+            ids.resize(1 + rng.index(ids.size()));
+            RayPacket expected;
+            startPacketBounds(expected);
+            for (std::uint32_t id : ids) addToPacketBounds(expected, rays[id].invDir);
+            const RayPacket got = simd::boundsOfRays(rays.data(), ids.data(), std::uint32_t(ids.size()));
+            ASSERT_EQ(got.unboundedAxes, expected.unboundedAxes) << "trial " << trial;
+            for (int a = 0; a < 3; ++a) {
+                if ((expected.unboundedAxes >> a) & 1u) {
+                    ++unbounded;
+                    continue;
+                }
+                ++bounded;
+                ASSERT_EQ(std::bit_cast<std::uint32_t>(got.invLo[a]), std::bit_cast<std::uint32_t>(expected.invLo[a]))
+                    << "trial " << trial << " axis " << a;
+                ASSERT_EQ(std::bit_cast<std::uint32_t>(got.invHi[a]), std::bit_cast<std::uint32_t>(expected.invHi[a]))
+                    << "trial " << trial << " axis " << a;
+            }
+        }
+        EXPECT_GT(unbounded, 500u);
+        EXPECT_GT(bounded, 500u);
+    });
+}
+
+// A leaf's triangles and rays sharing one start, as the group test of a leaf sees them: a fan
+// of triangles (some duplicated, some with no area, half single-sided) and rays from the
+// start aimed at its hub, its vertices and its edges' midpoints, where a hit lies on the
+// triangle's bounds, in an order that keeps aims together (groups of neighbours, as a leaf's
+// tile-ordered rays are) or shuffles them.
+struct SharedStartLeaf {
+    std::vector<Triangle> tris;
+    std::vector<Ray> rays;
+    std::vector<std::uint32_t> triIds, rayIds;
+    float margin = 0.0f;
+};
+
+SharedStartLeaf sharedStartLeaf(Random& rng) {
+    SharedStartLeaf leaf;
+    const float scale = rng.uniform() < 0.3 ? 1e5f : 1.0f;
+    const glm::vec3 offset = rng.uniform() < 0.3 ? rng.vec3(-1e6f, 1e6f) : glm::vec3(0.0f);
+    leaf.tris.resize(std::uint32_t(rng.index(90)) + 1);
+    const glm::vec3 hub = offset + rng.vec3(-1.0f, 1.0f) * scale;
+    Box box;
+    for (std::size_t i = 0; i < leaf.tris.size(); ++i) {
+        Triangle& t = leaf.tris[i];
+        if (i > 0 && rng.uniform() < 0.15) {
+            t = leaf.tris[rng.index(i)];
+        } else {
+            t.v0 = rng.uniform() < 0.6 ? hub : offset + rng.vec3(-1.0f, 1.0f) * scale;
+            t.v1 = offset + rng.vec3(-1.0f, 1.0f) * scale;
+            t.v2 = rng.uniform() < 0.1 ? t.v1 : offset + rng.vec3(-1.0f, 1.0f) * scale;
+            // Some axis-aligned: bounds with no extent on an axis, hits on their faces.
+            if (rng.uniform() < 0.2) t.v1[rng.index(3)] = t.v0[rng.index(3)], t.v2.y = t.v1.y = t.v0.y;
+            t.cullBackFace = rng.uniform() < 0.5 ? 1u : 0u;
+        }
+        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) box.lo = glm::min(box.lo, v), box.hi = glm::max(box.hi, v);
+    }
+    const glm::vec3 eye = offset + rng.vec3(-3.0f, 3.0f) * scale;
+    const float tmin = rng.uniform() < 0.2 ? rng.uniformFloat(0.0f, 2.0f) * scale : 0.0f;
+    leaf.rays.resize(40 + rng.index(200));
+    for (std::size_t i = 0; i < leaf.rays.size(); ++i) {
+        const Triangle& aim = leaf.tris[rng.index(leaf.tris.size())];
+        const double pick = rng.uniform();
+        glm::dvec3 target = pick < 0.2 ? glm::dvec3(hub)
+                            : pick < 0.4 ? glm::dvec3(aim.v1)
+                            : pick < 0.6 ? 0.5 * (glm::dvec3(aim.v0) + glm::dvec3(aim.v1))
+                            : pick < 0.8 ? glm::dvec3(aim.v2)
+                                         : glm::dvec3(aim.v0) + 0.3 * glm::dvec3(aim.v1 - aim.v0) +
+                                               0.3 * glm::dvec3(aim.v2 - aim.v0);
+        if (rng.uniform() < 0.3) target += glm::dvec3(rng.onSphere()) * double(scale) * 1e-6;  // beside it
+        glm::dvec3 d = target - glm::dvec3(eye);
+        if (glm::length(d) == 0.0) d = {0.0, 0.0, 1.0};
+        leaf.rays[i] = makeRay(eye, glm::normalize(d), tmin);
+    }
+    leaf.triIds = shuffledIds(rng, std::uint32_t(leaf.tris.size()), std::uint32_t(leaf.tris.size()));
+    leaf.triIds.resize(std::min<std::size_t>(leaf.triIds.size(), simd::kLeafBatch));
+    leaf.rayIds = shuffledIds(rng, std::uint32_t(leaf.rays.size()), std::uint32_t(leaf.rays.size()));
+    if (rng.uniform() < 0.7)  // neighbours together: ids sorted by direction along one axis
+        std::sort(leaf.rayIds.begin(), leaf.rayIds.end(),
+                  [&](std::uint32_t a, std::uint32_t b) { return leaf.rays[a].dir.x < leaf.rays[b].dir.x; });
+    glm::vec3 farthest = glm::abs(eye);
+    leaf.margin = filterMargin(box, farthest);
+    return leaf;
+}
+
+// The groups narrow a leaf's triangles per group of rays and still find every hit the batch
+// finds, bit for bit: the same hits, the same tie winners. With no widening they would miss
+// hits on the bounds' faces, which this leaf makes on purpose.
+TEST_F(EveryTarget, LeafGroupsGiveTheBatchsHitsBitForBit) {
+    forEachTarget([] {
+        Random rng(29);
+        std::uint64_t tests = 0, skipped = 0, missedWithoutWidening = 0;
+        std::size_t hitsFound = 0;
+        for (int trial = 0; trial < 400; ++trial) {
+            SharedStartLeaf leaf = sharedStartLeaf(rng);
+            std::vector<Hit> expected(leaf.rays.size(), missHit());
+            for (std::size_t i = 0; i < leaf.rays.size(); ++i)
+                if (rng.uniform() < 0.2) expected[i] = Hit{rng.uniformFloat(0.0f, 5.0f), 7, 0.25f, 0.5f};
+            std::vector<Hit> got = expected, unwidened = expected;
+            for (std::uint32_t id : leaf.rayIds)
+                for (std::uint32_t prim : leaf.triIds) testTriangle(leaf.rays[id], leaf.tris[prim], prim, expected[id]);
+            simd::LeafTriangles batch, narrowed{};
+            simd::gatherLeafTriangles(leaf.tris.data(), leaf.triIds.data(), std::uint32_t(leaf.triIds.size()), batch);
+            const std::uint32_t rayCount = std::uint32_t(leaf.rayIds.size());
+            skipped += simd::intersectBatchInGroups(leaf.rays.data(), got.data(), leaf.rayIds.data(), rayCount, batch,
+                                                    2.0f * leaf.margin, narrowed);
+            simd::intersectBatchInGroups(leaf.rays.data(), unwidened.data(), leaf.rayIds.data(), rayCount, batch, 0.0f,
+                                         narrowed);
+            tests += std::uint64_t(rayCount) * leaf.triIds.size();
+            for (std::size_t i = 0; i < leaf.rays.size(); ++i) {
+                ASSERT_TRUE(sameHit(got[i], expected[i]))
+                    << "trial " << trial << " ray " << i << ": groups prim " << got[i].prim << " t " << got[i].t
+                    << ", scalar prim " << expected[i].prim << " t " << expected[i].t;
+                hitsFound += expected[i].prim != kMissPrim && expected[i].prim != 7;
+                missedWithoutWidening += !sameHit(unwidened[i], expected[i]);
+            }
+        }
+        EXPECT_GT(hitsFound, 5000u);
+        EXPECT_GT(skipped, tests / 20) << "the groups must narrow the leaf, not only keep it";
+        EXPECT_GT(missedWithoutWidening, 0u) << "the leaf must hold hits that only the widening keeps";
     });
 }
 

@@ -1,9 +1,12 @@
 // Known answers on tiny scenes, and brute / cpu-seq / cpu agreeing bit for bit.
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
 #include "core/gltf_loader.hpp"
 #include "core/procedural.hpp"
+#include "cpu/cpu_tracers.hpp"
 #include "cpu/traversal.hpp"
 #include "support/frames.hpp"
 
@@ -268,4 +271,84 @@ TEST(BackendsAgree, RaysWithoutANearSideGoFrontToBackRayByRay) {
     EXPECT_TRUE(identicalHits(reference.hits, traceFrame(g, Backend::CpuSeq).hits));
     for (unsigned regions : {1u, 2u, 5u})
         EXPECT_TRUE(identicalHits(reference.hits, traceFrame(g, Backend::Cpu, regions, 2).hits)) << regions;
+}
+
+// The bands tile the image in whole rows of 8x8 tiles, ascending, as many as a multiple of the
+// workers allows, and only for a closest-hit image with more than one worker.
+TEST(ImageBands, CoverTheImageInWholeRowsOfTilesForEveryWorker) {
+    const Scene s = test::shapesScene();
+    for (const int height : {48, 50, 300, 2000}) {
+        SCOPED_TRACE("height " + std::to_string(height));
+        const Frame frame(test::shapesScene(), defaultCamera(s, 64, height), 64, height);
+        for (const unsigned workers : {2u, 3u, 8u}) {
+            const std::vector<std::uint32_t> bands = imageBands(frame.geometry, workers);
+            const std::uint32_t tileRows = std::uint32_t(height + 7) / 8;
+            if (tileRows < 2) {
+                EXPECT_TRUE(bands.empty());
+                continue;
+            }
+            ASSERT_GE(bands.size(), 3u);
+            EXPECT_EQ(bands.front(), 0u);
+            EXPECT_EQ(bands.back(), frame.rays.size());
+            for (std::size_t b = 0; b + 1 < bands.size(); ++b) {
+                EXPECT_LT(bands[b], bands[b + 1]);
+                EXPECT_EQ(bands[b] % (64 * 8), 0u) << "band " << b << " starts inside a row of tiles";
+            }
+            if (tileRows % workers == 0) EXPECT_EQ((bands.size() - 1) % workers, 0u);
+        }
+        EXPECT_TRUE(imageBands(frame.geometry, 1).empty()) << "one worker traces the frame as one";
+        FrameGeometry anyHit = frame.geometry;
+        anyHit.query = HitQuery::Any;
+        EXPECT_TRUE(imageBands(anyHit, 2).empty()) << "only closest-hit frames of an image";
+        FrameGeometry noImage = frame.geometry;
+        noImage.imageWidth = 0;
+        EXPECT_TRUE(imageBands(noImage, 2).empty());
+    }
+}
+
+// Bands of any size, perspective and orthographic, from outside and inside the scene, with and
+// without packets, give brute force's hits bit for bit.
+TEST(ImageBands, GiveBruteForcesHitsBitForBit) {
+    const Scene s = test::shapesScene();
+    ThreadPool pool(2);
+    std::vector<Camera> cameras{defaultCamera(s, 64, 50), orthographicView(glm::dvec3(4.0, 3.0, 5.0), 1.8),
+                                orthographicView(glm::dvec3(0.6, 0.35, 0.45), 1.8)};
+    for (std::size_t c = 0; c < cameras.size(); ++c) {
+        SCOPED_TRACE("camera " + std::to_string(c));
+        const Frame frame(test::shapesScene(), cameras[c], 64, 50);
+        const TraceResult reference = frame.trace(Backend::Brute, 0, 2);
+        ASSERT_GT(hitCount(reference.hits), frame.rays.size() / 20);
+        for (const std::vector<std::uint32_t>& bands : std::vector<std::vector<std::uint32_t>>{
+                 {0, 64 * 8, std::uint32_t(frame.rays.size())},
+                 {0, 64 * 16, 64 * 24, 64 * 48, std::uint32_t(frame.rays.size())},
+                 {0, 64 * 8, 64 * 16, 64 * 24, 64 * 32, 64 * 40, 64 * 48, std::uint32_t(frame.rays.size())}})
+            for (const bool packets : {true, false}) {
+                DacrtOptions options;
+                options.packets = packets;
+                const TraceResult r = traceImageBands(frame.geometry, options, pool, bands);
+                EXPECT_TRUE(identicalHits(reference.hits, r.hits))
+                    << bands.size() - 1 << " bands, packets " << packets;
+                EXPECT_EQ(r.regions, 1u);
+                EXPECT_GT(r.counters.rayTriangleTests, 0u);
+                EXPECT_EQ(r.counters.finishedStep1 + r.counters.raysCulled <= frame.rays.size(), true);
+            }
+    }
+}
+
+// The cpu backend takes the bands for a primary frame large enough to divide, unless regions
+// are asked for, and says so in its plan.
+TEST(ImageBands, AreTheCpuBackendsWayForAPrimaryFrameUnlessRegionsAreAsked) {
+    const Scene s = test::shapesScene();
+    const Frame frame(test::shapesScene(), defaultCamera(s, 320, 240), 320, 240);
+    const TraceResult reference = frame.trace(Backend::CpuSeq);
+    const TraceResult banded = frame.trace(Backend::Cpu, 0, 2);
+    EXPECT_TRUE(identicalHits(reference.hits, banded.hits));
+    EXPECT_EQ(banded.regions, 1u);
+    EXPECT_TRUE(std::any_of(banded.memory.work.begin(), banded.memory.work.end(),
+                            [](const WorkLine& w) { return w.name == "image bands side by side" && w.count >= 2; }));
+    const TraceResult divided = frame.trace(Backend::Cpu, 2, 2);
+    EXPECT_TRUE(identicalHits(reference.hits, divided.hits));
+    EXPECT_EQ(divided.regions, 2u);
+    EXPECT_TRUE(std::none_of(divided.memory.work.begin(), divided.memory.work.end(),
+                             [](const WorkLine& w) { return w.name == "image bands side by side"; }));
 }

@@ -7,9 +7,12 @@
 #include <exception>
 #include <functional>
 #include <memory>
+#include <string>
 
+#include "cpu/cpu_tracers.hpp"
 #include "gpu/device_defaults.hpp"
 #include "support/dispatcher_passes.hpp"
+#include "support/frames.hpp"
 #include "support/gpu_support.hpp"
 
 namespace dacrt {
@@ -52,14 +55,21 @@ void expectPassShapes(const SecondaryPassSet& set, BackendDispatcher& dispatcher
     EXPECT_EQ(dispatcher.validationErrors(), 0u);
 }
 
+// A dispatcher for the gpu backend under the validation layers, or none (why says why).
+std::unique_ptr<BackendDispatcher> validatingGpuDispatcher(std::string& why) {
+    try {
+        return std::make_unique<BackendDispatcher>(DeviceChoice{"", true}, std::vector<Backend>{Backend::Gpu});
+    } catch (const std::exception& e) {
+        why = e.what();
+        return nullptr;
+    }
+}
+
 TEST(GpuPassGroups, OnACpuDeviceAPassIsOneRegionsRayGroupsUnlessAskedOtherwise) {
     DACRT_REQUIRE_GPU(context);
-    std::unique_ptr<BackendDispatcher> dispatcher;
-    try {
-        dispatcher = std::make_unique<BackendDispatcher>(DeviceChoice{"", true}, std::vector<Backend>{Backend::Gpu});
-    } catch (const std::exception& e) {
-        GTEST_SKIP() << "no Vulkan device: " << e.what();
-    }
+    std::string why;
+    const std::unique_ptr<BackendDispatcher> dispatcher = validatingGpuDispatcher(why);
+    if (!dispatcher) GTEST_SKIP() << "no Vulkan device: " << why;
     const gpu::DeviceInfo& device = context->info();
     const bool cpuDevice = gpu::takesCpuDefaults(device, GpuProfile::Auto);
     // These passes make a few thousand rays: one batch, then as many as the device's threads.
@@ -70,6 +80,43 @@ TEST(GpuPassGroups, OnACpuDeviceAPassIsOneRegionsRayGroupsUnlessAskedOtherwise) 
     };
     expectPassShapes(shapesSecondaryPasses(), *dispatcher, expect);
     expectPassShapes(shapesUnderACeilingPasses(), *dispatcher, expect);
+}
+
+// A primary frame: where the cpu backend would cut the image into at least two bands a core
+// (few triangles for its rays), one region whose ray groups are those bands; elsewhere the
+// device's regions. cpu-seq's hits either way.
+TEST(GpuPassGroups, OnACpuDeviceAPrimaryFrameOfFewTrianglesForItsRaysIsOneRegionsRayGroups) {
+    DACRT_REQUIRE_GPU(context);
+    std::string why;
+    const std::unique_ptr<BackendDispatcher> dispatcher = validatingGpuDispatcher(why);
+    if (!dispatcher) GTEST_SKIP() << "no Vulkan device: " << why;
+    const gpu::DeviceInfo& device = context->info();
+    if (!gpu::takesCpuDefaults(device, GpuProfile::Auto)) GTEST_SKIP() << "not a CPU device: its regions stay";
+    const unsigned cores = gpu::defaultGpuRegions(device, GpuProfile::Auto);
+    const Scene s = shapesScene();
+    bool banded = false, divided = false;
+    for (const int height : {48, 480, 960}) {
+        SCOPED_TRACE("640x" + std::to_string(height));
+        const Frame frame(shapesScene(), defaultCamera(s, 640, height), 640, height);
+        const std::vector<std::uint32_t> bands = imageBands(frame.geometry, cores);
+        BackendRequest request;
+        request.trace.threads = 2;
+        request.trace.backend = Backend::Gpu;
+        const TraceResult r = dispatcher->trace(frame.geometry, request);
+        EXPECT_TRUE(identicalHits(frame.trace(Backend::CpuSeq).hits, r.hits));
+        ASSERT_TRUE(r.gpu.has_value());
+        if (bands.size() > 2 * std::size_t(cores)) {
+            banded = true;
+            EXPECT_EQ(r.regions, 1u);
+            EXPECT_EQ(r.gpu->rayGroups, bands.size() - 1);
+        } else {
+            divided = true;
+            EXPECT_EQ(r.regions, cores);
+        }
+    }
+    EXPECT_TRUE(banded) << "the tallest image is bands on a device of " << cores << " cores";
+    EXPECT_TRUE(divided) << "the shortest image keeps the regions";
+    EXPECT_EQ(dispatcher->validationErrors(), 0u);
 }
 
 }  // namespace
