@@ -351,7 +351,9 @@ PacketBounds subgroupRaysBounds(bool rayActive, uint id) {
     PacketBounds p;
     uint unbounded = 0u;
     [[unroll]] for (int a = 0; a < 3; ++a) {
-        // Not finite written as a comparison: the compiler may assume no infinity in isinf().
+        // Not finite written as a comparison, as the compiler may assume no infinity in
+        // isinf(); a NaN the compiler's reordering of it could let through cannot occur
+        // (makeRay's invDir is 1 / dir of a finite, nonzero component, or 0).
         if (rayActive && (invDir[a] == 0.0 || !(abs(invDir[a]) <= 3.4028234e38))) unbounded |= 1u << uint(a);
         p.invLo[a] = subgroupMin(rayActive ? invDir[a] : kNoHitT);
         p.invHi[a] = subgroupMax(rayActive ? invDir[a] : -kNoHitT);

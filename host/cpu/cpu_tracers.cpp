@@ -206,6 +206,28 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
     return result;
 }
 
+namespace {
+
+// The traced triangles' ids, for a traversal to permute.
+void fillTracedTriangleIds(const FrameGeometry& g, std::vector<std::uint32_t>& ids) {
+    ids.resize(g.tracedTriangleCount());
+    for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = g.tracedTriangle(i);
+}
+
+// One sequential DACRT of the rays rayIds[0, rayCount) over every traced triangle, from the
+// scene box down; culled and finished rays counted.
+void traceRayIds(const FrameGeometry& g, const DacrtOptions& options, const TraversalBuffers& buffers,
+                 std::uint32_t rayCount, Counters& counters) {
+    DacrtTraversal traversal(g, options, buffers, counters);
+    std::uint32_t finished = 0;  // the pivot: rays before it are finished
+    const std::uint32_t crossing =
+        traversal.trace(g.sceneBox, finished, rayCount, 0, std::uint32_t(g.tracedTriangleCount()));
+    counters.raysCulled += rayCount - crossing;
+    counters.finishedStep1 += finished;
+}
+
+}  // namespace
+
 TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options, const PlanHook& onPlan) {
     TraceResult result;
     const std::uint32_t rayCount = std::uint32_t(g.rays->size());
@@ -220,20 +242,15 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     if (onPlan && !onPlan(result.memory)) return result;
 
     const bool raysShareSegment = startHits(g, result.hits);
-    std::vector<std::uint32_t> rayIds(rayCount), triIds(triCount);
+    std::vector<std::uint32_t> rayIds(rayCount), triIds;
     std::iota(rayIds.begin(), rayIds.end(), 0u);
-    for (std::uint32_t i = 0; i < triCount; ++i) triIds[i] = g.tracedTriangle(i);
+    fillTracedTriangleIds(g, triIds);
     std::vector<std::uint32_t> scratch(scratchIds);
     PacketStorage packets(g, resolved, scratchIds, 1);
-    DacrtTraversal traversal(
-        g, options,
-        {result.hits.data(), rayIds.data(), triIds.data(), scratchIds ? scratch.data() : nullptr, packets.forWorker(0),
-         raysShareSegment},
-        result.counters);
-    std::uint32_t finished = 0;  // the pivot: rays before it are finished
-    const std::uint32_t crossing = traversal.trace(g.sceneBox, finished, rayCount, 0, triCount);
-    result.counters.raysCulled = rayCount - crossing;
-    result.counters.finishedStep1 = finished;
+    traceRayIds(g, options,
+                {result.hits.data(), rayIds.data(), triIds.data(), scratchIds ? scratch.data() : nullptr,
+                 packets.forWorker(0), raysShareSegment},
+                rayCount, result.counters);
     return result;
 }
 
@@ -246,6 +263,7 @@ std::vector<std::uint32_t> imageBands(const FrameGeometry& g, unsigned workers) 
                                                                       1, passBatchRays(g.triangles->size()) /
                                                                              (std::size_t(g.imageWidth) * kPacketTile)),
                                                         workers);
+    // More batches than tile rows (a short image, many workers) leave some empty: dropped.
     std::vector<std::uint32_t> starts;
     for (std::size_t b : batches) {
         const std::uint32_t start = std::min(rays, std::uint32_t(b) * kPacketTile * g.imageWidth);
@@ -260,18 +278,21 @@ TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options,
     const std::uint32_t rayCount = std::uint32_t(g.rays->size());
     const std::uint32_t triCount = std::uint32_t(g.tracedTriangleCount());
     const std::size_t bandCount = bands.size() - 1;
-    const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), bandCount));
+    // Any of the pool's threads may take a band: each has its arrays (a thread that takes
+    // none allocates no ids or scratch; the plan counts the threads that can be busy at once).
+    const unsigned threads = pool.size();
+    const unsigned busy = unsigned(std::min<std::size_t>(threads, bandCount));
     std::uint32_t widest = 0;
     for (std::size_t b = 0; b < bandCount; ++b) widest = std::max(widest, bands[b + 1] - bands[b]);
     const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
     const std::uint64_t scratchIds = usesSimd(g, resolved) ? partitionScratchIds(widest, triCount) : 0;
     planFrameInputs(g, result.memory);
     result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
-    result.memory.add("triangle ids (per thread)", std::uint64_t(triCount) * 4 * workers);
-    if (scratchIds) result.memory.add("partition scratch (per thread)", scratchIds * 4 * workers);
-    planPacketBuffers(g, resolved, scratchIds, workers, result.memory);
+    result.memory.add("triangle ids (per thread)", std::uint64_t(triCount) * 4 * busy);
+    if (scratchIds) result.memory.add("partition scratch (per thread)", scratchIds * 4 * busy);
+    planPacketBuffers(g, resolved, scratchIds, threads, result.memory);
     result.memory.work.push_back({"image bands side by side", bandCount,
-                                  "rows of 8x8 tiles, each a sequential DACRT on one of " + std::to_string(workers) +
+                                  "rows of 8x8 tiles, each a sequential DACRT on one of " + std::to_string(busy) +
                                       " workers: no division or transfer rounds"});
     if (onPlan && !onPlan(result.memory)) return result;
 
@@ -279,22 +300,17 @@ TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options,
     const bool raysShareSegment = startHits(g, result.hits);
     std::vector<std::uint32_t> rayIds(rayCount);
     std::iota(rayIds.begin(), rayIds.end(), 0u);
-    std::vector<std::vector<std::uint32_t>> triIds(workers), scratch(workers);
-    PacketStorage packets(g, resolved, scratchIds, workers);
-    std::vector<Counters> counters(workers);
+    std::vector<std::vector<std::uint32_t>> triIds(threads), scratch(threads);
+    PacketStorage packets(g, resolved, scratchIds, threads);
+    std::vector<Counters> counters(threads);
     pool.parallelFor(bandCount, [&](std::size_t b, unsigned w) {
         // The traversal permutes its triangle ids: each band starts from the traced ones.
-        triIds[w].resize(triCount);
-        for (std::uint32_t i = 0; i < triCount; ++i) triIds[w][i] = g.tracedTriangle(i);
+        fillTracedTriangleIds(g, triIds[w]);
         scratch[w].resize(scratchIds);
-        DacrtTraversal traversal(g, options,
-                                 {result.hits.data(), rayIds.data() + bands[b], triIds[w].data(),
-                                  scratchIds ? scratch[w].data() : nullptr, packets.forWorker(w), raysShareSegment},
-                                 counters[w]);
-        std::uint32_t finished = 0;
-        const std::uint32_t crossing = traversal.trace(g.sceneBox, finished, bands[b + 1] - bands[b], 0, triCount);
-        counters[w].raysCulled += bands[b + 1] - bands[b] - crossing;
-        counters[w].finishedStep1 += finished;
+        traceRayIds(g, options,
+                    {result.hits.data(), rayIds.data() + bands[b], triIds[w].data(),
+                     scratchIds ? scratch[w].data() : nullptr, packets.forWorker(w), raysShareSegment},
+                    bands[b + 1] - bands[b], counters[w]);
     });
     for (const Counters& c : counters) {
         result.counters.add(c);
@@ -302,7 +318,7 @@ TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options,
         result.counters.finishedStep1 += c.finishedStep1;
     }
     result.phases.step1 = msSince(start);
-    result.threads = workers;
+    result.threads = busy;
     result.regions = 1;
     return result;
 }

@@ -415,7 +415,8 @@ HWY_INLINE void widenedBoundsOf(const LeafTriangles& batch, float widening, Wide
 
 // The triangles of batch whose widened bounds the group may cross (packetMayCrossCell,
 // ray_packet.cpp: the same products, minima and maxima lane by lane), in order, into
-// narrowed. Returns how many.
+// narrowed. Returns how many. Each kept vector is stored whole at the count so far, which is
+// at most the vector's own first lane j, so no store passes lane j + n <= kLeafBatch.
 HWY_INLINE std::uint32_t narrowToGroup(const LeafTriangles& batch, const WidenedBounds& b, const RayPacket& group,
                                        const glm::vec3& origin, float tmin, LeafTriangles& narrowed) {
     const DF df;

@@ -51,14 +51,12 @@ std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids,
                                        FaceSide keep = FaceSide::Reaching);
 
 // Up to kLeafBatch triangles of a leaf in structure-of-arrays form: coordinate c of vertex k
-// of triangle j is vertex[k][c][j]. Lanes past `count` are padding and never hit; one
-// vector's worth of lanes past kLeafBatch takes whole-vector stores.
+// of triangle j is vertex[k][c][j]. Lanes past `count` are padding and never hit.
 constexpr std::uint32_t kLeafBatch = 64;
-constexpr std::uint32_t kLeafLanes = kLeafBatch + 16;
 struct LeafTriangles {
-    alignas(64) float vertex[3][3][kLeafLanes];
-    alignas(64) std::uint32_t prim[kLeafLanes];
-    alignas(64) std::uint32_t cullBackFace[kLeafLanes];  // Triangle::cullBackFace
+    alignas(64) float vertex[3][3][kLeafBatch];
+    alignas(64) std::uint32_t prim[kLeafBatch];
+    alignas(64) std::uint32_t cullBackFace[kLeafBatch];  // Triangle::cullBackFace
     std::uint32_t count = 0;
 };
 

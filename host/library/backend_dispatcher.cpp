@@ -69,14 +69,15 @@ BackendRequest gpuPassRequest(const BackendRequest& request, const gpu::DeviceIn
 }
 
 // A gpu primary frame's request on a device that takes a CPU's defaults, where neither the
-// regions nor the ray groups were asked for and the cpu backend would cut the image into at
-// least two bands a core (imageBands: a scene of few triangles for its rays, as the room):
-// one region, the bands its ray groups, so that no ray waits for a transfer round. Where the
+// regions nor the ray groups were asked for (nor the sub-scenes, --no-skip subscenes) and the
+// cpu backend would cut the image into at least two bands a core (imageBands: a scene of few
+// triangles for its rays, as the room): one region with as many ray groups as bands (the
+// kernel's even groups of its rays), so that no ray waits for a transfer round. Where the
 // bands are fewer, the regions stay: a work item's own pass over every triangle costs the
 // kernel more than the rounds save (docs/gpu.md, "Leaf groups and image bands").
 BackendRequest gpuPrimaryRequest(const BackendRequest& request, const gpu::DeviceInfo& device,
                                  const FrameGeometry& geometry) {
-    if (request.trace.regions != 0 || request.gpuTuning.rayGroups != 0 ||
+    if (request.trace.regions != 0 || request.gpuTuning.rayGroups != 0 || !request.trace.skips.subScenes ||
         !gpu::takesCpuDefaults(device, request.gpuTuning.profile))
         return request;
     const unsigned cores = gpu::defaultGpuRegions(device, request.gpuTuning.profile);

@@ -277,7 +277,7 @@ TEST(BackendsAgree, RaysWithoutANearSideGoFrontToBackRayByRay) {
 // workers allows, and only for a closest-hit image with more than one worker.
 TEST(ImageBands, CoverTheImageInWholeRowsOfTilesForEveryWorker) {
     const Scene s = test::shapesScene();
-    for (const int height : {48, 50, 300, 2000}) {
+    for (const int height : {8, 48, 50, 300, 2000}) {
         SCOPED_TRACE("height " + std::to_string(height));
         const Frame frame(test::shapesScene(), defaultCamera(s, 64, height), 64, height);
         for (const unsigned workers : {2u, 3u, 8u}) {
@@ -307,10 +307,11 @@ TEST(ImageBands, CoverTheImageInWholeRowsOfTilesForEveryWorker) {
 }
 
 // Bands of any size, perspective and orthographic, from outside and inside the scene, with and
-// without packets, give brute force's hits bit for bit.
+// without packets, give brute force's hits bit for bit; on three threads, so that a band may
+// go to any of them and two bands leave one idle.
 TEST(ImageBands, GiveBruteForcesHitsBitForBit) {
     const Scene s = test::shapesScene();
-    ThreadPool pool(2);
+    ThreadPool pool(3);
     std::vector<Camera> cameras{defaultCamera(s, 64, 50), orthographicView(glm::dvec3(4.0, 3.0, 5.0), 1.8),
                                 orthographicView(glm::dvec3(0.6, 0.35, 0.45), 1.8)};
     for (std::size_t c = 0; c < cameras.size(); ++c) {
@@ -329,8 +330,8 @@ TEST(ImageBands, GiveBruteForcesHitsBitForBit) {
                 EXPECT_TRUE(identicalHits(reference.hits, r.hits))
                     << bands.size() - 1 << " bands, packets " << packets;
                 EXPECT_EQ(r.regions, 1u);
+                EXPECT_EQ(r.threads, std::min<std::size_t>(3, bands.size() - 1));
                 EXPECT_GT(r.counters.rayTriangleTests, 0u);
-                EXPECT_EQ(r.counters.finishedStep1 + r.counters.raysCulled <= frame.rays.size(), true);
             }
     }
 }
