@@ -343,6 +343,16 @@ void testTriangle(Ray ray, uint prim, vec3 v0, vec3 v1, vec3 v2, bool cullBackFa
     }
 }
 
+// Lane k's tile triangle, shuffled to every lane (in uniform control flow), tested where test.
+void testTileTriangle(uint k, uint myPrim, Triangle mine, Ray ray, bool test, inout Hit best) {
+    uint prim = subgroupShuffle(myPrim, k);
+    vec3 v0 = subgroupShuffle(mine.v0, k);
+    vec3 v1 = subgroupShuffle(mine.v1, k);
+    vec3 v2 = subgroupShuffle(mine.v2, k);
+    bool cullBackFace = subgroupShuffle(mine.cullBackFace, k) != 0u;
+    if (test) testTriangle(ray, prim, v0, v1, v2, cullBackFace, best);
+}
+
 // The subgroup's active rays as one packet (the host's addToPacketBounds over them): where
 // rays share their start, a triangle whose bounds, widened by twice the filter margin, the
 // packet cannot cross is a triangle none of them can hit (docs/correctness.md, "Leaf groups").
@@ -428,23 +438,13 @@ void leafTests(uint rayBegin, uint rayEnd, uint triBegin, uint triEnd) {
                 for (uint j = 0; j < keptCount; ++j) {  // uniform: kept is the subgroup's
                     uint k = firstLane(kept);
                     kept[k >> 5u] &= ~(1u << (k & 31u));
-                    uint prim = subgroupShuffle(myPrim, k);
-                    vec3 v0 = subgroupShuffle(mine.v0, k);
-                    vec3 v1 = subgroupShuffle(mine.v1, k);
-                    vec3 v2 = subgroupShuffle(mine.v2, k);
-                    bool cullBackFace = subgroupShuffle(mine.cullBackFace, k) != 0u;
-                    if (rayActive) testTriangle(ray, prim, v0, v1, v2, cullBackFace, best);
+                    testTileTriangle(k, myPrim, mine, ray, rayActive, best);
                 }
                 continue;
             }
             for (uint j = 0; j < tileSize; j += lanes) {  // uniform: every lane shuffles
                 uint k = j + slot;
-                uint prim = subgroupShuffle(myPrim, k);
-                vec3 v0 = subgroupShuffle(mine.v0, k);
-                vec3 v1 = subgroupShuffle(mine.v1, k);
-                vec3 v2 = subgroupShuffle(mine.v2, k);
-                bool cullBackFace = subgroupShuffle(mine.cullBackFace, k) != 0u;
-                if (rayActive && k < tileSize) testTriangle(ray, prim, v0, v1, v2, cullBackFace, best);
+                testTileTriangle(k, myPrim, mine, ray, rayActive && k < tileSize, best);
             }
         }
         // hitPrecedes is a total order on (t, prim), so the butterfly's order of comparisons

@@ -71,6 +71,10 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                     const LeafTriangles& batch);
 
+// The bounds of rays[rayIds[0, count)] (count > 0) as startPacketBounds and addToPacketBounds
+// (ray_packet.hpp) make them, lanes at a time (begin and end left 0).
+RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32_t count);
+
 // intersectBatch for rays that share their start (SharedRayFields::Start: every ray has
 // rays[0]'s origin and tmin), in groups of up to kLeafGroupRays consecutive ids: each group
 // tests only the triangles whose bounds, widened by `widening` (twice the filter margin),
@@ -79,9 +83,6 @@ void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std
 // its bounds on the ray's segment (docs/correctness.md, "Leaf groups"). Returns the ray/triangle
 // tests skipped.
 constexpr std::uint32_t kLeafGroupRays = 16;
-// The bounds of rays[rayIds[0, count)] (count > 0) as startPacketBounds and addToPacketBounds
-// (ray_packet.hpp) make them, lanes at a time (begin and end left 0).
-RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32_t count);
 std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                                      const LeafTriangles& batch, float widening, LeafTriangles& narrowed);
 

@@ -49,6 +49,21 @@ bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryH
     return passCullMayDrop(surfaces * pass.raysPerHit, triangles.size(), sharedFacing, switches);
 }
 
+// Whether the request leaves the gpu's regions and ray groups to a device that takes a CPU's
+// defaults (lavapipe): neither asked for.
+bool shapeLeftToACpuDevice(const BackendRequest& request, const gpu::DeviceInfo& device) {
+    return request.trace.regions == 0 && request.gpuTuning.rayGroups == 0 &&
+           gpu::takesCpuDefaults(device, request.gpuTuning.profile);
+}
+
+// The request as one region of `groups` ray groups (at most kMostDefaultRayGroups).
+BackendRequest asOneRegion(const BackendRequest& request, std::size_t groups) {
+    BackendRequest one = request;
+    one.trace.regions = 1;
+    one.gpuTuning.rayGroups = std::uint32_t(std::min<std::size_t>(groups, gpu::kMostDefaultRayGroups));
+    return one;
+}
+
 // A gpu pass's request on a device that takes a CPU's defaults (lavapipe), where neither the
 // regions nor the ray groups were asked for: one region, its rays in the cpu backend's
 // batches, each batch a ray group (a work item of Step 1 with the whole scene's triangles).
@@ -57,15 +72,10 @@ bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryH
 // pass's rays as one region's ray groups on a CPU device"). Elsewhere the request as given.
 BackendRequest gpuPassRequest(const BackendRequest& request, const gpu::DeviceInfo& device, std::size_t rays,
                               std::size_t triangles) {
-    if (request.trace.regions != 0 || request.gpuTuning.rayGroups != 0 ||
-        !gpu::takesCpuDefaults(device, request.gpuTuning.profile))
-        return request;
+    if (!shapeLeftToACpuDevice(request, device)) return request;
     const std::size_t batches =
         rayBatches(rays, passBatchRays(triangles), gpu::defaultGpuRegions(device, request.gpuTuning.profile)).size() - 1;
-    BackendRequest pass = request;
-    pass.trace.regions = 1;
-    pass.gpuTuning.rayGroups = std::uint32_t(std::min<std::size_t>(batches, gpu::kMostDefaultRayGroups));
-    return pass;
+    return asOneRegion(request, batches);
 }
 
 // A gpu primary frame's request on a device that takes a CPU's defaults, where neither the
@@ -77,16 +87,10 @@ BackendRequest gpuPassRequest(const BackendRequest& request, const gpu::DeviceIn
 // kernel more than the rounds save (docs/gpu.md, "Leaf groups and image bands").
 BackendRequest gpuPrimaryRequest(const BackendRequest& request, const gpu::DeviceInfo& device,
                                  const FrameGeometry& geometry) {
-    if (request.trace.regions != 0 || request.gpuTuning.rayGroups != 0 || !request.trace.skips.subScenes ||
-        !gpu::takesCpuDefaults(device, request.gpuTuning.profile))
-        return request;
+    if (!shapeLeftToACpuDevice(request, device) || !request.trace.skips.subScenes) return request;
     const unsigned cores = gpu::defaultGpuRegions(device, request.gpuTuning.profile);
     const std::size_t bands = std::max<std::size_t>(imageBands(geometry, cores).size(), 1) - 1;
-    if (bands < 2 * std::size_t(cores)) return request;
-    BackendRequest primary = request;
-    primary.trace.regions = 1;
-    primary.gpuTuning.rayGroups = std::uint32_t(std::min<std::size_t>(bands, gpu::kMostDefaultRayGroups));
-    return primary;
+    return bands < 2 * std::size_t(cores) ? request : asOneRegion(request, bands);
 }
 
 }  // namespace
