@@ -14,7 +14,7 @@ usage() { sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 root=$(cd "$(dirname "$0")/../.." && pwd)
 [ $# -ge 1 ] && [ "${1#-}" = "$1" ] || usage
 out=$1; shift
-prebuilt="" libs="" debs="$root/.gl" scenes="$root/../shared/scenes" profiles="auto,discrete"
+prebuilt="" libs="" debs="$root/.gpu/debs" scenes="$root/../shared/scenes" profiles="auto,discrete"
 sizes="640x480,1920x1080" orbit=4 repeat=3 tests=1 bench=1 tar=0 dry=0
 while [ $# -gt 0 ]; do
   case $1 in
@@ -58,12 +58,15 @@ if command -v nvidia-smi > /dev/null; then nvidia-smi > "$out/nvidia-smi.txt" 2>
 else echo "nvidia-smi: not present" > "$out/nvidia-smi.txt"; fi
 
 # ---- the Vulkan loader and driver --------------------------------------------------------
-if ! ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'; then
+# grep reads ldconfig's whole list: with pipefail, `grep -q` stopping at the first match could
+# fail the pipeline on ldconfig's SIGPIPE (seen on the H100 machine, 2026-12-05).
+installed() { ldconfig -p 2>/dev/null | grep "$1" > /dev/null; }
+if ! installed 'libvulkan\.so\.1'; then
   if compgen -G "$debs/*.deb" > /dev/null; then
     note "no Vulkan loader installed: unpacking $debs/*.deb into /"
     if [ $dry = 0 ]; then for f in "$debs"/*.deb; do dpkg -x "$f" / || exit 2; done; ldconfig; fi
   fi
-  if [ $dry = 0 ] && ! ldconfig -p | grep -q 'libvulkan\.so\.1'; then
+  if [ $dry = 0 ] && ! installed 'libvulkan\.so\.1'; then
     note "missing: the Vulkan loader libvulkan.so.1 (Debian package libvulkan1); download it beforehand into $debs (tools/gpu/README.md)"
     exit 2
   fi
@@ -73,6 +76,12 @@ if [ -z "${VK_DRIVER_FILES:-}" ] && [ -f "$nvidia_icd" ] &&
    ! ls /usr/share/vulkan/icd.d/nvidia_icd*.json /etc/vulkan/icd.d/nvidia_icd*.json > /dev/null 2>&1; then
   export VK_DRIVER_FILES=$nvidia_icd
   note "VK_DRIVER_FILES=$nvidia_icd (the driver's ICD is not where the loader looks)"
+fi
+# NVIDIA's Vulkan driver lives in libGLX_nvidia, which needs glvnd's dispatch library: without
+# it the loader reports VK_ERROR_INCOMPATIBLE_DRIVER (seen on the H100 machine, 2026-12-05).
+if [ $dry = 0 ] && [ "${VK_DRIVER_FILES:-}" = "$nvidia_icd" ] && ! installed 'libGLdispatch\.so\.0'; then
+  note "missing: libGLdispatch.so.0, which NVIDIA's Vulkan driver needs (Debian package libglvnd0, with libglx0); download it beforehand into $debs (tools/gpu/README.md)"
+  exit 2
 fi
 echo "VK_DRIVER_FILES=${VK_DRIVER_FILES:-}" >> "$out/machine.txt"
 
