@@ -146,9 +146,14 @@ std::uint32_t runBlock(gpu::Context& context, BlockInputs& in, WorkgroupTestPush
 // refuses others, and full subgroups are requested where the device can promise them).
 class GpuBlocks : public ::testing::TestWithParam<BlockShape> {};
 
-// The workgroup size of the test's shape; skips a lockstep shape where the tracer would keep the barriers.
+// The workgroup size of the test's shape; skips a shape wider than the tracer allows (the
+// subgroup size squared: 16 on llvmpipe's 4-wide subgroups), and a lockstep shape where the
+// tracer would keep the barriers.
 #define DACRT_BLOCK_WORKGROUP(context, wg)                                                              \
     const std::uint32_t wg = GetParam().subgroups * (context)->info().subgroupSize;                     \
+    if (wg > gpu::widestWorkgroup((context)->info()))                                                   \
+        GTEST_SKIP() << "a workgroup of " << wg << " invocations is wider than the tracer allows on this device ("  \
+                     << gpu::widestWorkgroup((context)->info()) << ")";                                 \
     if (GetParam().lockstep && !gpu::dropsBarriers((context)->info(), wg))                              \
         GTEST_SKIP() << "the device does not run a workgroup of " << wg << " invocations in lockstep"
 
