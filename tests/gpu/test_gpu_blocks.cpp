@@ -152,7 +152,7 @@ class GpuBlocks : public ::testing::TestWithParam<BlockShape> {};
 #define DACRT_BLOCK_WORKGROUP(context, wg)                                                              \
     const std::uint32_t wg = GetParam().subgroups * (context)->info().subgroupSize;                     \
     if (wg > gpu::widestWorkgroup((context)->info()))                                                   \
-        GTEST_SKIP() << "a workgroup of " << wg << " invocations is wider than the tracer allows on this device ("  \
+        GTEST_SKIP() << "a workgroup of " << wg << " invocations is wider than the tracer allows here ("  \
                      << gpu::widestWorkgroup((context)->info()) << ")";                                 \
     if (GetParam().lockstep && !gpu::dropsBarriers((context)->info(), wg))                              \
         GTEST_SKIP() << "the device does not run a workgroup of " << wg << " invocations in lockstep"

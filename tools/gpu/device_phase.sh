@@ -32,7 +32,7 @@ export LD_LIBRARY_PATH=$work/libs${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 # run_gpu_checks.sh unpacks only where none is installed: unpack every package here.
 for f in "$root"/.gpu/debs/*.deb; do dpkg -x "$f" / || exit 2; done; ldconfig
 checks=("$root/tools/gpu/run_gpu_checks.sh" "$results" --prebuilt "$work/build" --libs "$work/libs"
-        --scenes "$work/scenes" --debs "$root/.gpu/debs")
+        --scenes "$work/scenes")
 
 case $phase in
   smoke)
