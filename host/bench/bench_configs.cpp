@@ -42,6 +42,7 @@ std::string optionText(const BenchConfig& c) {
     if (!d.packets) s << " packets=off";
     if (d.packets && d.packetFlush != kPacketFlushDefault) s << " packet_flush=" << d.packetFlush;
     if (d.rayGrouping != DacrtOptions{}.rayGrouping) s << " ray_grouping=" << toString(d.rayGrouping);
+    if (d.passTracing != DacrtOptions{}.passTracing) s << " pass_tracing=" << toString(d.passTracing);
     if (c.backend() == Backend::Gpu)
         s << " ray_groups=" << (c.options.gpu.rayGroups ? std::to_string(c.options.gpu.rayGroups) : "auto");
     if (c.backend() == Backend::Gpu)
@@ -234,6 +235,16 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
             c.name = "ray-grouping=" + toString(grouping);
             c.isDefault = false;
             c.options.trace.dacrt.rayGrouping = grouping;
+            out.push_back(c);
+        }
+    // The passes apart and together, whichever the default chose (docs/benchmarks.md, "A frame's
+    // passes traced together").
+    if (b == Backend::Cpu)
+        for (PassTracing tracing : {PassTracing::Apart, PassTracing::Together}) {
+            BenchConfig c = out.front();
+            c.name = "pass-tracing=" + toString(tracing);
+            c.isDefault = false;
+            c.options.trace.dacrt.passTracing = tracing;
             out.push_back(c);
         }
     return out;

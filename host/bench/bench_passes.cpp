@@ -32,6 +32,7 @@ struct PassFrame {
     std::uint64_t rays = 0;
     std::vector<std::pair<std::string, double>> parts;
     std::vector<RayHit> hits;  // per slot (the primary pass: per pixel)
+    bool together = false;     // traced with the frame's other passes (PassOutput::tracedIn)
 };
 
 // A secondary pass of the frame, as traceFrame traced it: its rays made from the primary hits
@@ -56,6 +57,7 @@ PassFrame secondaryPassFrame(const BenchConfig& c, PassOutput& pass) {
                 name = "not counted: " + name + " repeated by the pass";
             }
     f.hits = std::move(pass.output.hits);
+    f.together = !pass.tracedIn.empty();
     return f;
 }
 
@@ -138,8 +140,11 @@ struct PassTotals {
     std::map<std::string, double> partSums;
     std::vector<std::string> partOrder;
     std::uint64_t checked = 0, mismatches = 0;
+    std::uint64_t framesTogether = 0;  // timed frames whose passes were traced together
 
-    void addFrame(double ms, const std::vector<std::pair<std::string, double>>& parts, double frames) {
+    void addFrame(double ms, const std::vector<std::pair<std::string, double>>& parts, double frames,
+                  bool together = false) {
+        framesTogether += together;
         cameraMs.push_back(ms);
         meanMs += ms / frames;
         for (const auto& [name, t] : parts) {
@@ -189,7 +194,7 @@ void measureCamera(SceneRun& run, std::size_t k, const BenchCommand& cmd, BenchR
         if (w < cmd.warmup) continue;
         double frameMs = 0.0;
         for (std::size_t p = 0; p < passCount; ++p) {
-            r.totals[p].addFrame(frame[p].ms, frame[p].parts, frames);
+            r.totals[p].addFrame(frame[p].ms, frame[p].parts, frames, frame[p].together);
             frameMs += frame[p].ms;
         }
         std::vector<std::pair<std::string, double>> perPass;
@@ -268,6 +273,7 @@ void measureScene(const std::string& path, const BenchCommand& cmd, const std::v
             row.checkedSlots = t.checked;
             row.mismatches = t.mismatches;
             row.exactRequired = !isPeer(r.config.backend());
+            row.framesTogether = t.framesTogether;
             rows.push_back(std::move(row));
         }
     }
@@ -298,6 +304,9 @@ nlohmann::ordered_json passRowJson(const PassRow& r) {
     j["ms_min"] = r.msMin;
     j["ms_median"] = r.msMedian;
     j["ms_mean"] = r.msMean;
+    // Passes traced together (--pass-tracing): the trace's time is the last pass's, a pass
+    // before it reads 0 ms in those frames.
+    if (r.kind == "shadow" || r.kind == "occlusion") j["frames_traced_together"] = r.framesTogether;
     j["mrays_per_s"] = r.msMedian > 0.0 ? r.raysPerFrame / (r.msMedian * 1e3) : 0.0;
     const std::optional<double> build = buildMsOf(r);
     j["build_ms"] = build ? nlohmann::ordered_json(*build) : nullptr;

@@ -67,6 +67,7 @@ struct PassRow {
     // for bit too.
     std::uint64_t mismatches = 0;
     bool exactRequired = false;  // dacrt's backends: any mismatch fails the run
+    std::uint64_t framesTogether = 0;  // a secondary pass's timed frames traced with the others (--pass-tracing)
 };
 
 // --suite animation: one configuration's work for one frame, from the run of the frame (of its

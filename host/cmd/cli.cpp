@@ -112,6 +112,7 @@ void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
     addEnumOption(cmd, "--triangle-filter", o.triangleFilter, "");
     addEnumOption(cmd, "--precision", o.precision, "");
     addEnumOption(cmd, "--ray-grouping", o.rayGrouping, "");
+    addEnumOption(cmd, "--pass-tracing", o.passTracing, "");
 }
 
 // The help and heading of render's backend-specific options, from the table that also refuses

@@ -21,7 +21,7 @@ constexpr bool kDacrtOption = true;
 static_assert(kPassBatchRays == 65536 && kPassBatchRaysPerTriangle == 8, "--ray-grouping's help names the batch size");
 
 // The order is the help's, and the order in which a refusal names the options.
-constexpr std::array<BackendOption, 21> kBackendOptions{{
+constexpr std::array<BackendOption, 22> kBackendOptions{{
     {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device (a secondary pass's rays there: one, with --ray-groups as the cpu backend's batches), 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
@@ -59,6 +59,12 @@ constexpr std::array<BackendOption, 21> kBackendOptions{{
      "of their directions) or octant-calls (each octant's group traced on its own)",
      "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.rayGrouping != DacrtOptions{}.rayGrouping; }},
+    {"--pass-tracing", kCpuDacrt,
+     "how a frame's secondary passes are traced: apart (each pass on its own, after its own pass cull), together "
+     "(every pass's rays merged pixel by pixel into the same traces, which divide the triangles once) or auto "
+     "(together where the passes make fewer rays than the scene has triangles)",
+     "", kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.passTracing != DacrtOptions{}.passTracing; }},
     {"--workgroup-size", kGpu, "invocations per workgroup", "default: per device", kAdvanced, !kDacrtOption,
      [](const RequestedOptions& r) { return r.workgroupSize != 0; }},
     {"--ray-groups", kGpu, "work items per region, each a band of its rays with its own copy of the region's triangle ids",
@@ -126,6 +132,10 @@ void checkOptionCombinations(const DacrtOptions& dacrt) {
     if (dacrt.precision == Precision::F64 && dacrt.intersector != Intersector::Watertight)
         throw InputError("precision f64 runs the watertight test in float64; it does not combine with the " +
                          toString(dacrt.intersector) + " intersector");
+    const bool byOctant = dacrt.rayGrouping == RayGrouping::Octant || dacrt.rayGrouping == RayGrouping::OctantCalls;
+    if (dacrt.passTracing == PassTracing::Together && byOctant)
+        throw InputError("--pass-tracing together merges the passes' rays pixel by pixel; it does not combine with "
+                         "--ray-grouping " + toString(dacrt.rayGrouping));
 }
 
 void checkRequestedOptions(const RequestedOptions& request) {

@@ -39,6 +39,11 @@ struct EnumNames<RayGrouping> {
                                                                                     {RayGrouping::Batches, "batches"}}};
 };
 template <>
+struct EnumNames<PassTracing> {
+    static constexpr std::array<std::pair<PassTracing, std::string_view>, 3> table{
+        {{PassTracing::Auto, "auto"}, {PassTracing::Apart, "apart"}, {PassTracing::Together, "together"}}};
+};
+template <>
 struct EnumNames<DivisionAxis> {
     static constexpr std::array<std::pair<DivisionAxis, std::string_view>, 4> table{
         {{DivisionAxis::Best, "best"}, {DivisionAxis::X, "x"}, {DivisionAxis::Y, "y"}, {DivisionAxis::Z, "z"}}};

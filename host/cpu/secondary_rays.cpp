@@ -98,8 +98,23 @@ std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& 
     if (traced.size() != rays.rays.size())
         throw InternalError("a secondary pass traced " + std::to_string(traced.size()) + " rays of " +
                             std::to_string(rays.rays.size()));
-    std::vector<Hit> slots = mappedArray(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f});
-    for (std::size_t i = 0; i < traced.size(); ++i) slots[rays.slots[i]] = traced[i];
+    const Hit none{0.0f, kNotTracedPrim, 0.0f, 0.0f};
+    // Rays in slot order (as makeSecondaryRays makes them) fill the array in one sweep, each
+    // slot written once: an occlusion pass's slots are raysPerHit a pixel (the Bunny's 4-ray
+    // pass: 20 MB), mostly without a ray, and filling them before scattering the hits wrote
+    // them twice. Rays grouped out of slot order (groupByOctant) are scattered.
+    std::vector<Hit> slots;
+    reserveMapped(slots, rays.slotCount);
+    for (std::size_t i = 0; i < traced.size(); ++i) {
+        if (rays.slots[i] < slots.size()) {
+            slots.resize(rays.slotCount, none);
+            for (std::size_t j = 0; j < traced.size(); ++j) slots[rays.slots[j]] = traced[j];
+            return slots;
+        }
+        slots.resize(rays.slots[i], none);
+        slots.push_back(traced[i]);
+    }
+    slots.resize(rays.slotCount, none);
     return slots;
 }
 

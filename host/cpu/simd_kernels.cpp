@@ -194,6 +194,7 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
     static_assert(sizeof(Ray) == 16 * sizeof(float) && sizeof(Hit) == 4 * sizeof(float));
     constexpr bool kSharedStart = kShared == SharedRayFields::Start;
     constexpr bool kSharedSegment = kShared == SharedRayFields::Segment;
+    constexpr bool kOwnSegment = kShared == SharedRayFields::OwnSegment;
     const float* ray = reinterpret_cast<const float*>(rays);
     const float* hit = reinterpret_cast<const float*>(hits);
     const DF df;
@@ -206,12 +207,12 @@ HWY_INLINE std::uint32_t partitionRays(const Ray* rays, const Hit* hits, std::ui
     return stablePartition(ids, count, scratch, [&](VU, const std::uint32_t* idLanes) {
         // shared::rayMayCrossCell: origin at floats 0-2 of a Ray, tmin at 3, invDir at 8-10;
         // the best t so far is float 0 of the Hit (a second cache line per ray, which a
-        // shared segment spares).
+        // shared segment spares, and any-hit rays' own segments: tmax at float 11).
         VF start[4], invDir[4];
         if constexpr (!kSharedStart) loadQuadPerLane<0>(ray, idLanes, start);
         loadQuadPerLane<8>(ray, idLanes, invDir);
         const VF tmin = kSharedStart || kSharedSegment ? sharedTmin : start[3];
-        const VF tmax = kSharedSegment ? sharedBestT : loadPerLane<4>(hit, idLanes, 0);
+        const VF tmax = kSharedSegment ? sharedBestT : kOwnSegment ? invDir[3] : loadPerLane<4>(hit, idLanes, 0);
         return hn::RebindMask(du, mayCrossCell(kSharedStart ? sharedOrigin : start, invDir, tmin, tmax, cell.lo, cell.hi));
     });
 }
@@ -222,6 +223,8 @@ std::uint32_t PartitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids
         case SharedRayFields::Start: return partitionRays<SharedRayFields::Start>(rays, hits, ids, count, cell, scratch);
         case SharedRayFields::Segment:
             return partitionRays<SharedRayFields::Segment>(rays, hits, ids, count, cell, scratch);
+        case SharedRayFields::OwnSegment:
+            return partitionRays<SharedRayFields::OwnSegment>(rays, hits, ids, count, cell, scratch);
         case SharedRayFields::None: break;
     }
     return partitionRays<SharedRayFields::None>(rays, hits, ids, count, cell, scratch);

@@ -31,7 +31,10 @@ constexpr std::uint32_t kScratchSlack = 64;
 // - Segment: tmin, and as the best hit so far rays[0].tmax, which every id's hits[id].t must
 //   then be (any-hit rays of one segment, raysShareSegment(): a live one has no hit yet, and
 //   its hit is missHit's, at the segment's end). The Hit records are not read.
-enum class SharedRayFields : std::uint8_t { None, Start, Segment };
+// - OwnSegment: nothing shared, but the rays are any-hit rays as Segment's, each of its own
+//   segment, so each id's hits[id].t is its own ray's tmax (float 11 of the Ray, loaded with
+//   invDir): the Hit records are not read either (a frame's passes traced together).
+enum class SharedRayFields : std::uint8_t { None, Start, Segment, OwnSegment };
 
 // Stable partition of ids[0, count): the ids whose ray may cross the (already widened) cell
 // before its best hit so far (shared::rayMayCrossCell with hits[id].t) first, in their order;

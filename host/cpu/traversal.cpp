@@ -24,7 +24,8 @@ int longestAxis(const Box& b) {
 // What the ray filter may broadcast from the first ray (simd::SharedRayFields).
 simd::SharedRayFields sharedRayFieldsOf(const FrameGeometry& g, const TraversalBuffers& buffers) {
     if (g.raysShareStart) return simd::SharedRayFields::Start;
-    if (g.query == HitQuery::Any && buffers.raysShareSegment) return simd::SharedRayFields::Segment;
+    if (g.query == HitQuery::Any)
+        return buffers.raysShareSegment ? simd::SharedRayFields::Segment : simd::SharedRayFields::OwnSegment;
     return simd::SharedRayFields::None;
 }
 

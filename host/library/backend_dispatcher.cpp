@@ -30,6 +30,16 @@ std::size_t sideBySideWorkers(const BackendRequest& request, std::size_t workers
     return request.trace.backend == Backend::Cpu && request.trace.regions == 0 ? workers : 1;
 }
 
+// What making a pass's rays on the host allocates, from the counts: its rays and their slots
+// (at most: a miss sends none) and its hit per slot. Throws where the pass has too many slots.
+MemoryPlan makingPlan(const SecondaryPass& pass, std::uint64_t primaryRays) {
+    const std::uint64_t slots = secondarySlots(pass, primaryRays);
+    MemoryPlan making;
+    making.add("secondary rays and their slots (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
+    making.add("hits per slot", slots * sizeof(Hit));
+    return making;
+}
+
 // Whether any of `backends` opens the Vulkan device.
 bool usesVulkan(const std::vector<Backend>& backends) {
     return std::any_of(backends.begin(), backends.end(), runsOnVulkan);
@@ -238,9 +248,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     PassTrace out;
     // The slot arrays are allocated before the tracer plans: checked first, as its plan is.
     const std::uint64_t slots = secondarySlots(pass, primary.rays->size());
-    MemoryPlan making;
-    making.add("secondary rays and their slots (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
-    making.add("hits per slot", slots * sizeof(Hit));
+    MemoryPlan making = makingPlan(pass, primary.rays->size());
     const bool cpuDacrt = request.trace.backend == Backend::Cpu || request.trace.backend == Backend::CpuSeq;
     const RayGrouping grouping = cpuDacrt ? request.trace.dacrt.rayGrouping : RayGrouping::Slots;
     const bool byOctant = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
@@ -278,6 +286,90 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
         out.result.phases.groupRays = groupMs;
     }
     out.result.phases.makeRays = makeMs;
+    return out;
+}
+
+std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryTogether(
+    const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const std::vector<SecondaryPass>& passes,
+    const BackendRequest& request, const PlanHook& onPlan) {
+    checkBackendRequest(request);
+    if (passes.size() > kMostPassesTogether) throw InternalError("more passes traced together than a pass index holds");
+    ThreadPool& threadPool = pool(threadsOf(request.trace));
+    // Each pass's making plan (as traceSecondary's), every one checked before anything is made,
+    // then the merged copy of their rays.
+    std::vector<MemoryPlan> makings;
+    std::uint64_t slots = 0;
+    for (const SecondaryPass& pass : passes) {
+        makings.push_back(makingPlan(pass, primary.rays->size()));
+        slots += secondarySlots(pass, primary.rays->size());
+    }
+    MemoryPlan merging;
+    merging.add("the passes' rays merged pixel by pixel, with their pass and slot (at most)",
+                slots * (sizeof(Ray) + sizeof(std::uint32_t) + sizeof(std::uint16_t)));
+    merging.addWork("passes traced together", passes.size(),
+                    "their rays merged pixel by pixel into the same traces, which divide the triangles once");
+    for (const MemoryPlan& plan : makings)
+        if (onPlan && !onPlan(plan)) return {};
+    if (onPlan && !onPlan(merging)) return {};
+    const auto start = Clock::now();
+    std::vector<SecondaryRays> made;
+    made.reserve(passes.size());
+    std::size_t total = 0;
+    for (const SecondaryPass& pass : passes) {
+        made.push_back(makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool));
+        total += made.back().rays.size();
+    }
+    // Pixel by pixel: a pixel's rays of every pass start at its surface and lie together in
+    // the batches (equal runs of the merged rays).
+    std::vector<Ray> rays;
+    std::vector<std::uint32_t> slotOf;
+    std::vector<std::uint16_t> passOf;
+    reserveMapped(rays, total);
+    reserveMapped(slotOf, total);
+    reserveMapped(passOf, total);
+    std::vector<std::size_t> next(passes.size(), 0);
+    constexpr std::uint64_t kNoPixel = ~std::uint64_t(0);
+    auto pixelOf = [&](std::size_t p) {
+        return next[p] < made[p].slots.size() ? std::uint64_t(made[p].slots[next[p]] / passes[p].raysPerHit) : kNoPixel;
+    };
+    while (rays.size() < total) {
+        std::size_t first = 0;
+        for (std::size_t p = 1; p < passes.size(); ++p)
+            if (pixelOf(p) < pixelOf(first)) first = p;
+        const std::uint64_t pixel = pixelOf(first);
+        for (std::size_t p = first; p < passes.size(); ++p)
+            for (; pixelOf(p) == pixel; ++next[p]) {
+                rays.push_back(made[p].rays[next[p]]);
+                slotOf.push_back(made[p].slots[next[p]]);
+                passOf.push_back(std::uint16_t(p));
+            }
+    }
+    std::vector<PassTrace> out(passes.size());
+    for (std::size_t p = 0; p < passes.size(); ++p) {  // each pass's own copy no longer needed
+        out[p].rays = made[p].rays.size();
+        std::vector<Ray>().swap(made[p].rays);
+    }
+    const double makeMs = msSince(start);
+    TraceResult traced;
+    if (!rays.empty()) {
+        const std::vector<std::size_t> groups =
+            request.trace.dacrt.rayGrouping == RayGrouping::Batches
+                ? rayBatches(rays.size(), passBatchRays(primary.triangles->size()),
+                             sideBySideWorkers(request, threadPool.size()))
+                : std::vector<std::size_t>{0, rays.size()};
+        traced = groups.size() > 2 ? traceGroups(primary, rays, groups, request, onPlan)
+                                   : tracePassRays(primary, rays, request, onPlan);
+        if (traced.hits.empty()) return {};  // stopped at the plan
+    }
+    const Hit none{0.0f, kNotTracedPrim, 0.0f, 0.0f};
+    for (std::size_t p = 0; p < passes.size(); ++p) out[p].result.hits = mappedArray(made[p].slotCount, none);
+    for (std::size_t i = 0; i < traced.hits.size(); ++i) out[passOf[i]].result.hits[slotOf[i]] = traced.hits[i];
+    std::vector<Hit> lastHits = std::move(out.back().result.hits);
+    out.back().result = std::move(traced);
+    out.back().result.hits = std::move(lastHits);
+    out.back().result.phases.makeRays = makeMs;
+    std::vector<WorkLine>& work = out.back().result.memory.work;
+    work.insert(work.begin(), merging.work.begin(), merging.work.end());
     return out;
 }
 

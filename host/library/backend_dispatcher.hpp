@@ -84,6 +84,16 @@ public:
     PassTrace traceSecondary(const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const SecondaryPass& pass,
                              const BackendRequest& request, const PlanHook& onPlan = {});
 
+    // Several secondary passes of that frame traced as one (cpu backends, --passes together):
+    // each pass's rays made as traceSecondary makes them, merged pixel by pixel (a pixel's rays
+    // of every pass together, the passes in their order), traced for any hit in one DACRT, and
+    // each hit put back in its pass's slot: one PassTrace per pass, its hits and rays; the
+    // trace's plan, counters and phases go with the last pass (the passes share them).
+    static constexpr std::size_t kMostPassesTogether = 65536;  // a pass index per ray: 16 bits
+    std::vector<PassTrace> traceSecondaryTogether(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
+                                                  const std::vector<SecondaryPass>& passes,
+                                                  const BackendRequest& request, const PlanHook& onPlan = {});
+
     // gpu: how many slots one traceSecondary of the last frame holds on the device
     // (secondaryPassCapacity); unlimited elsewhere.
     PassCapacity secondaryPassCapacity(const BackendRequest& request) const;

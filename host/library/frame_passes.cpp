@@ -71,11 +71,38 @@ void addBatch(TracedPass& whole, const SecondaryPass& batch, TracedPass&& part, 
 
 }  // namespace
 
+bool passesTracedTogether(const std::vector<SecondaryPass>& passes, const std::vector<Hit>& primaryHits,
+                          std::size_t triangles, const BackendRequest& request) {
+    const Backend b = request.trace.backend;
+    const PassTracing tracing = request.trace.dacrt.passTracing;
+    if (passes.size() < 2 || passes.size() > BackendDispatcher::kMostPassesTogether ||
+        (b != Backend::Cpu && b != Backend::CpuSeq) || tracing == PassTracing::Apart)
+        return false;
+    if (tracing == PassTracing::Together) return true;  // checkOptionCombinations: not with octant groupings
+    if (request.trace.dacrt.rayGrouping != RayGrouping::Batches && request.trace.dacrt.rayGrouping != RayGrouping::Slots)
+        return false;
+    std::uint64_t surfaces = 0, raysPerSurface = 0;
+    for (const Hit& h : primaryHits) surfaces += hitSendsRays(h);
+    for (const SecondaryPass& pass : passes) raysPerSurface += pass.raysPerHit;
+    return surfaces * raysPerSurface < triangles;
+}
+
 std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& passes, const FrameGeometry& primary,
                                              const std::vector<Hit>& primaryHits, BackendDispatcher& backends,
                                              const BackendRequest& request, const PlanHook& onPlan) {
     std::vector<TracedPass> traced;
     const std::uint64_t primaryRays = primary.rays->size();
+    if (passesTracedTogether(passes, primaryHits, primary.triangles->size(), request)) {
+        const auto start = Clock::now();
+        std::vector<BackendDispatcher::PassTrace> t =
+            backends.traceSecondaryTogether(primary, primaryHits, passes, request, onPlan);
+        if (t.empty()) return traced;  // stopped at the plan
+        const double ms = msSince(start);
+        for (std::size_t p = 0; p < passes.size(); ++p)
+            traced.push_back(TracedPass{passes[p], std::move(t[p].result), t[p].rays, p + 1 == passes.size() ? ms : 0.0,
+                                        passes.back().name});
+        return traced;
+    }
     for (const SecondaryPass& pass : passes) {
         std::string limit;
         const std::uint32_t batch = samplesPerBatch(pass, primaryRays, backends, request, limit);
@@ -144,6 +171,10 @@ MemoryPlan secondaryPassBound(const SecondaryPass& pass, std::uint64_t primaryRa
     } else if (backend == Backend::Cpu || backend == Backend::CpuSeq) {
         plan.add("ray ids and binning (at most)", slots * 8);
         plan.add("partition scratch (at most, per thread)", slots * 4);
+        // Passes traced together (PassTracing) copy their rays into one merged array, with
+        // each ray's slot and pass, before the passes' own copies are freed.
+        plan.add("its rays merged with the frame's other passes' (--pass-tracing, at most)",
+                 slots * (sizeof(Ray) + sizeof(std::uint32_t) + sizeof(std::uint16_t)));
     }
     plan.addWork("rays (at most)", slots,
                  std::to_string(primaryRays) + " primary rays x " + std::to_string(pass.raysPerHit) +

@@ -24,9 +24,16 @@ struct TracedPass {
     TraceResult result;        // hits: one per slot
     std::uint64_t rays = 0;    // rays made
     double ms = 0.0;           // making and tracing them
+    std::string tracedIn;      // PassOutput::tracedIn
 };
 
-// Each pass in turn on the backend that traced `primary` (the dispatcher's last frame).
+// Whether the cpu backends trace these passes together (PassTracing; Auto: where they make
+// fewer rays, raysPerHit for each primary hit that sends rays, than there are triangles).
+bool passesTracedTogether(const std::vector<SecondaryPass>& passes, const std::vector<Hit>& primaryHits,
+                          std::size_t triangles, const BackendRequest& request);
+
+// Each pass in turn on the backend that traced `primary` (the dispatcher's last frame), or all
+// of them in one trace where passesTracedTogether.
 std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& passes, const FrameGeometry& primary,
                                              const std::vector<Hit>& primaryHits, BackendDispatcher& backends,
                                              const BackendRequest& request, const PlanHook& onPlan);

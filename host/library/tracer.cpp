@@ -93,7 +93,7 @@ PlanHook planHookOf(const PlanCallback& onPlan) {
 std::vector<PassOutput> passOutputsOf(std::vector<TracedPass> traced, const TraceScene::Impl& s) {
     std::vector<PassOutput> out;
     for (TracedPass& t : traced)
-        out.push_back({framePassOf(t.pass), traceOutputOf(t.result, s.callerIds, t.ms), t.rays, t.ms});
+        out.push_back({framePassOf(t.pass), traceOutputOf(t.result, s.callerIds, t.ms), t.rays, t.ms, t.tracedIn});
     return out;
 }
 

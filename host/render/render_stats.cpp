@@ -109,6 +109,7 @@ nlohmann::ordered_json passesJson(const RenderedFrame& frame, double primaryMs) 
                                     {"trace_phases", phasesJson(r.timings)},  // a batched pass's: summed
                                     {"counters", countersJson(r.counters)},
                                     {"memory_plan_bytes", memoryJson(r.plan)}};
+        if (!t.tracedIn.empty()) p["traced_in"] = t.tracedIn;  // passes traced together
         if (t.pass.kind == PassKind::Occlusion) {
             p["rays_per_hit"] = t.pass.raysPerHit;
             p["distance"] = t.pass.occlusionDistance;
@@ -152,6 +153,7 @@ nlohmann::ordered_json optionsJson(const RenderOptions& o) {
             {"triangle_filter", toString(trace.dacrt.triangleFilter)},
             {"precision", toString(trace.dacrt.precision)},
             {"ray_grouping", toString(trace.dacrt.rayGrouping)},
+            {"pass_tracing", toString(trace.dacrt.passTracing)},
             {"cull", toString(o.cull)},
             {"skip_backfaces", trace.skips.backFaces},
             {"skip_frustum", trace.skips.frustum},

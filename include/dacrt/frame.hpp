@@ -43,6 +43,10 @@ struct PassOutput {
     TraceOutput output;
     std::uint64_t rays = 0;  // rays made
     double ms = 0.0;         // making and tracing them
+    // Empty where the pass was traced on its own; else the name of the last pass it was traced
+    // with (DacrtOptions::passTracing, together): that pass's output carries the shared trace's
+    // time, plan and counters (this one's, where it is that pass), the others their hits and rays.
+    std::string tracedIn;
 };
 
 struct FrameOutput {

@@ -23,6 +23,13 @@ enum class SplitCost { Limits, RaySampling };
 // Batches, as made, in DACRTs of at most kPassBatchRays rays each. Every grouping gives the
 // same visibility: it changes speed only.
 enum class RayGrouping { Slots, Octant, OctantCalls, Batches };
+// How the cpu backends trace a frame's secondary passes (docs/secondary-rays.md): Apart, each
+// pass in its own traces after its own pass cull; Together, every pass's rays merged pixel by
+// pixel into the same traces, which then divide the triangles once for all of them; Auto,
+// together where the passes make fewer rays than the scene has triangles (the triangles'
+// division is then most of a pass's cost), apart elsewhere (a shadow pass's own cull then
+// pays). Both give the same visibility: it changes speed only.
+enum class PassTracing { Auto, Apart, Together };
 enum class DivisionAxis { Best, X, Y, Z };
 // Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks
 // through shared edges; Moller-Trumbore is the classic faster test without that guarantee.
@@ -69,6 +76,7 @@ struct DacrtOptions {
     // Secondary passes on the cpu backends: batches by default (the room's lit frame 0.74x of
     // slots, the Bunny's and the Dragon's passes one batch: docs/benchmarks.md).
     RayGrouping rayGrouping = RayGrouping::Batches;
+    PassTracing passTracing = PassTracing::Auto;
 
     // These options with the leaf limits of `backend` filled in where they are 0.
     DacrtOptions resolvedFor(Backend backend) const {

@@ -653,18 +653,32 @@ TEST(Cli, PlanAndStatsListEverySkipWithItsCounts) {
               counts["triangles"]);
     const CommandResult off = run("render " + scene + " --size 48x32 --plan --no-skip backfaces,frustum");
     EXPECT_NE(off.output.find("skip off (--no-skip)"), std::string::npos) << off.output;
-    // Each secondary pass's own cull: the key light's shadow pass and the occlusion pass.
-    ASSERT_EQ(run("render " + scene + " --size 48x32 --ao 2 --stats " + stats).code, 0);
+    // Each secondary pass's own cull, the passes apart: the key light's shadow pass and the
+    // occlusion pass.
+    ASSERT_EQ(run("render " + scene + " --size 48x32 --ao 2 --pass-tracing apart --stats " + stats).code, 0);
     std::ifstream passStats(stats);
     const nlohmann::json p = nlohmann::json::parse(passStats);
     ASSERT_EQ(p["passes"].size(), 3u);
     for (std::size_t i = 1; i < 3; ++i) {
+        EXPECT_FALSE(p["passes"][i].contains("traced_in"));
         std::map<std::string, std::uint64_t> pass;
         for (const auto& line : p["passes"][i]["work_plan"]) pass[line["name"]] = line["count"];
         ASSERT_TRUE(pass.count("skipped: outside the pass's rays' bounds")) << p["passes"][i].dump();
         EXPECT_EQ(pass["triangles traced"] + pass["skipped: back-facing"] + pass["skipped: outside the pass's rays' bounds"],
                   counts["triangles"]) << p["passes"][i]["name"];
     }
+    // By default a frame of fewer secondary rays than triangles traces its passes together:
+    // each names the last pass, which carries the one trace and its work plan.
+    ASSERT_EQ(run("render " + scene + " --size 48x32 --ao 2 --stats " + stats).code, 0);
+    std::ifstream togetherStats(stats);
+    const nlohmann::json t = nlohmann::json::parse(togetherStats);
+    ASSERT_EQ(t["passes"].size(), 3u);
+    EXPECT_EQ(t["options"]["pass_tracing"], "auto");
+    for (std::size_t i = 1; i < 3; ++i) EXPECT_EQ(t["passes"][i]["traced_in"], "occlusion") << t["passes"][i].dump();
+    EXPECT_EQ(t["passes"][1]["trace_ms"], 0.0);
+    ASSERT_FALSE(t["passes"][2]["work_plan"].empty());
+    EXPECT_EQ(t["passes"][2]["work_plan"][0]["name"], "passes traced together");
+    EXPECT_EQ(t["passes"][2]["work_plan"][0]["count"], 2u);
     // Without --regions a frame this small is one sequential DACRT, and the plan says so.
     const CommandResult small = run("render " + scene + " --size 48x32 --plan");
     EXPECT_NE(small.output.find("sub-scenes"), std::string::npos) << small.output;

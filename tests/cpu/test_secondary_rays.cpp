@@ -399,6 +399,37 @@ TEST(SecondaryRays, GroupingByOctantIsAStablePermutationThatHitsPerSlotUndoes) {
     }
 }
 
+// hitsPerSlot fills slots in one sweep where the rays are in slot order and scatters them
+// otherwise: both give each ray's hit in its slot and kNotTracedPrim in every other slot, from
+// the first slot to the last, with no ray, and with rays that leave slot order part way.
+TEST(SecondaryRays, HitsPerSlotPutsEveryHitInItsSlotInOrderOrNot) {
+    auto slotsWith = [](std::vector<std::uint32_t> slots, std::uint64_t slotCount) {
+        SecondaryRays r;
+        r.slots = std::move(slots);
+        r.rays.resize(r.slots.size());
+        r.slotCount = slotCount;
+        return r;
+    };
+    auto hitsOf = [](const SecondaryRays& r) {
+        std::vector<Hit> hits;
+        for (std::uint32_t slot : r.slots) hits.push_back(Hit{0.5f * float(slot), slot + 1000u, 0.25f, 0.125f});
+        return hits;
+    };
+    const std::vector<std::vector<std::uint32_t>> cases = {
+        {}, {0}, {6}, {0, 1, 2, 3, 4, 5, 6}, {1, 3, 4, 6}, {2, 5, 1, 6}, {0, 4, 3}, {6, 5, 4, 3, 2, 1, 0}};
+    for (const std::vector<std::uint32_t>& slots : cases) {
+        const SecondaryRays rays = slotsWith(slots, 7);
+        const std::vector<Hit> perSlot = hitsPerSlot(rays, hitsOf(rays));
+        ASSERT_EQ(perSlot.size(), 7u);
+        for (std::uint32_t s = 0; s < 7; ++s) {
+            const bool traced = std::find(slots.begin(), slots.end(), s) != slots.end();
+            EXPECT_EQ(perSlot[s].prim, traced ? s + 1000u : kNotTracedPrim) << "slot " << s << " of case " << slots.size();
+            EXPECT_EQ(perSlot[s].t, traced ? 0.5f * float(s) : 0.0f) << "slot " << s;
+            EXPECT_EQ(perSlot[s].u, traced ? 0.25f : 0.0f) << "slot " << s;
+        }
+    }
+}
+
 TEST(SecondaryRays, BatchesAreEqualRunsOfAtMostTheLimit) {
     EXPECT_EQ(rayBatches(10, 4), (std::vector<std::size_t>{0, 3, 6, 10}));
     EXPECT_EQ(rayBatches(8, 4), (std::vector<std::size_t>{0, 4, 8}));

@@ -104,15 +104,20 @@ bool sameHit(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit
 
 }  // namespace
 
-// With their own starts, sharing one, and sharing a segment with no hit yet (the broadcast
-// paths).
+// With their own starts, sharing one, sharing a segment with no hit yet (the broadcast
+// paths), and each with a segment of its own and no hit yet (the hits not read).
 TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
     forEachTarget([] {
       for (const simd::SharedRayFields shared :
-           {simd::SharedRayFields::None, simd::SharedRayFields::Start, simd::SharedRayFields::Segment}) {
+           {simd::SharedRayFields::None, simd::SharedRayFields::Start, simd::SharedRayFields::Segment,
+            simd::SharedRayFields::OwnSegment}) {
         const bool shareStart = shared == simd::SharedRayFields::Start;
         const bool shareSegment = shared == simd::SharedRayFields::Segment;
-        SCOPED_TRACE(shareStart ? "rays share their start" : shareSegment ? "rays share their segment" : "rays start apart");
+        const bool ownSegment = shared == simd::SharedRayFields::OwnSegment;
+        SCOPED_TRACE(shareStart     ? "rays share their start"
+                     : shareSegment ? "rays share their segment"
+                     : ownSegment   ? "rays each of its own segment"
+                                    : "rays start apart");
         Random rng(11);
         PartitionTally tally;
         std::vector<Ray> rays(300);
@@ -129,6 +134,9 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
                     rays[i].tmin = rays[0].tmin;
                     rays[i].tmax = rays[0].tmax;
                 }
+                hits[i] = missHit(rays[i]);
+            } else if (ownSegment) {  // live any-hit rays (a frame's passes together): each its own end
+                rays[i].tmax = rng.uniform() < 0.2 ? kNoHitT : rng.uniformFloat(0.1f, 4.0f);
                 hits[i] = missHit(rays[i]);
             } else if (rng.uniform() < 0.5) {
                 hits[i] = Hit{rng.uniform() < 0.2 ? 0.0f : rng.uniformFloat(0.0f, 4.0f), 1, 0, 0};

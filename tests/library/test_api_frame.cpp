@@ -20,22 +20,30 @@ std::size_t slotsWithRays(const std::vector<RayHit>& hits) {
     }));
 }
 
-// Every grouping of the passes' rays on the cpu backends (--ray-grouping) gives the passes of
-// `expected` (cpu-seq's, slot order) their visibility slot by slot.
+// Every grouping of the passes' rays on the cpu backends (--ray-grouping), and the passes
+// traced together (--pass-tracing), give the passes of `expected` (cpu-seq's, slot order) their
+// visibility slot by slot; passes traced together name the pass that carries their trace.
 void expectEveryGroupingGivesTheseVisibilities(const TraceScene& scene, const RayBatch& rays,
                                                const std::vector<FramePass>& passes, const FrameOutput& expected) {
-    for (const RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls})
-        for (const Backend backend : {Backend::Cpu, Backend::CpuSeq}) {
-            TracerOptions o = test::onBackend(backend, 2);
-            o.trace.dacrt.rayGrouping = grouping;
-            const FrameOutput grouped = Tracer(o).traceFrame(scene, rays, passes);
-            ASSERT_EQ(grouped.passes.size(), expected.passes.size());
-            for (std::size_t k = 0; k < expected.passes.size(); ++k) {
-                EXPECT_EQ(grouped.passes[k].rays, expected.passes[k].rays) << k;
-                EXPECT_TRUE(test::sameVisibility(expected.passes[k].output.hits, grouped.passes[k].output.hits))
-                    << k << ", grouping " << int(grouping) << ", backend " << int(backend);
+    for (const RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls, RayGrouping::Batches})
+        for (const PassTracing tracing : {PassTracing::Apart, PassTracing::Together})
+            for (const Backend backend : {Backend::Cpu, Backend::CpuSeq}) {
+                if (tracing == PassTracing::Together &&
+                    (grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls))
+                    continue;  // refused (checkOptionCombinations)
+                TracerOptions o = test::onBackend(backend, 2);
+                o.trace.dacrt.rayGrouping = grouping;
+                o.trace.dacrt.passTracing = tracing;
+                const FrameOutput grouped = Tracer(o).traceFrame(scene, rays, passes);
+                ASSERT_EQ(grouped.passes.size(), expected.passes.size());
+                for (std::size_t k = 0; k < expected.passes.size(); ++k) {
+                    EXPECT_EQ(grouped.passes[k].rays, expected.passes[k].rays) << k;
+                    EXPECT_TRUE(test::sameVisibility(expected.passes[k].output.hits, grouped.passes[k].output.hits))
+                        << k << ", grouping " << int(grouping) << ", tracing " << int(tracing) << ", backend " << int(backend);
+                    const bool together = tracing == PassTracing::Together && passes.size() > 1;
+                    EXPECT_EQ(grouped.passes[k].tracedIn, together ? passes.back().name : std::string()) << k;
+                }
             }
-        }
 }
 
 TEST(ApiFrame, TracesTheCameraFrameThenItsPasses) {

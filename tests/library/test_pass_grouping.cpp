@@ -1,12 +1,15 @@
-// A secondary pass's rays grouped by octant on the cpu backends (DacrtOptions::rayGrouping):
-// through the dispatcher, as every frame's passes go, each grouping gives brute force's
-// visibility slot by slot.
+// A secondary pass's rays grouped by octant on the cpu backends (DacrtOptions::rayGrouping),
+// and a frame's passes traced together (DacrtOptions::passTracing): through the dispatcher, as
+// every frame's passes go, each gives brute force's visibility slot by slot.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
+#include "cpu/backend_options.hpp"
 #include "cpu/options.hpp"
+#include "core/errors.hpp"
 #include "library/backend_dispatcher.hpp"
+#include "library/frame_passes.hpp"
 #include "support/dispatcher_passes.hpp"
 
 namespace dacrt {
@@ -56,6 +59,90 @@ void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
 TEST(PassGrouping, EveryGroupingGivesBruteForcesVisibility) {
     expectEveryGroupingAgrees(shapesSecondaryPasses());
     expectEveryGroupingAgrees(shapesUnderACeilingPasses());
+}
+
+// Every pass of the set traced together, on cpu-seq and cpu (side by side, and in three
+// regions), as slots and in batches: each pass gets its own rays and, slot by slot, brute
+// force's visibility of it traced alone (the passes' segments end apart: occlusion rays at
+// 0.8 and nowhere, shadow rays at their light).
+void expectTogetherAgrees(const SecondaryPassSet& set) {
+    BackendDispatcher dispatcher({}, {Backend::Cpu});
+    std::vector<SecondaryPass> passes;
+    std::vector<BackendDispatcher::PassTrace> alone;
+    forEachPassAgainstBruteForce(set, dispatcher, [&](const FrameGeometry&, const SecondaryPass& pass,
+                                                      const BackendDispatcher::PassTrace& reference) {
+        passes.push_back(pass);
+        alone.push_back(reference);
+    });
+    ASSERT_GE(passes.size(), 2u);
+    const FrameGeometry primary =
+        frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays, sceneBounds(set.frame.scene.triangles));
+    BackendRequest request;
+    request.trace.dacrt.passTracing = PassTracing::Together;
+    for (RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Batches})
+        for (auto [backend, regions] : {std::pair{Backend::CpuSeq, 0u}, {Backend::Cpu, 0u}, {Backend::Cpu, 3u}}) {
+            SCOPED_TRACE(toString(backend) + ", " + std::to_string(regions) + " regions, grouping " + toString(grouping));
+            request.trace.backend = backend;
+            request.trace.threads = backend == Backend::CpuSeq ? 0 : 2;
+            request.trace.regions = regions;
+            request.trace.dacrt.rayGrouping = grouping;
+            const std::vector<BackendDispatcher::PassTrace> together =
+                dispatcher.traceSecondaryTogether(primary, set.primary.hits, passes, request);
+            ASSERT_EQ(together.size(), passes.size());
+            for (std::size_t p = 0; p < passes.size(); ++p) {
+                EXPECT_EQ(together[p].rays, alone[p].rays) << "pass " << p;
+                EXPECT_TRUE(identicalVisibility(alone[p].result.hits, together[p].result.hits)) << "pass " << p;
+                std::size_t untracedApart = 0;
+                for (std::size_t s = 0; s < alone[p].result.hits.size(); ++s) {
+                    const bool untraced = alone[p].result.hits[s].prim == kNotTracedPrim;
+                    untracedApart += untraced;
+                    EXPECT_EQ(together[p].result.hits[s].prim == kNotTracedPrim, untraced) << "pass " << p << " slot " << s;
+                }
+                EXPECT_GT(untracedApart, 0u);  // the misses' slots, at least
+            }
+            // The shared trace's plan and phases go with the last pass.
+            EXPECT_FALSE(together.back().result.memory.work.empty());
+            EXPECT_TRUE(together.back().result.phases.makeRays.has_value());
+        }
+}
+
+TEST(PassTracing, TogetherGivesEachPassBruteForcesVisibility) {
+    expectTogetherAgrees(shapesSecondaryPasses());
+    expectTogetherAgrees(shapesUnderACeilingPasses());
+}
+
+// Auto traces a frame's passes together where they make fewer rays than the scene has
+// triangles; only the cpu backends do, and only with two passes or more.
+TEST(PassTracing, TheRuleCountsThePassesRaysAgainstTheTriangles) {
+    std::vector<Hit> hits(100, Hit{1.0f, 0, 0.0f, 0.0f});
+    for (std::size_t i = 0; i < 40; ++i) hits[i].prim = kMissPrim;  // 60 surfaces send rays
+    const std::vector<SecondaryPass> passes = {pointShadowPass({0.0f, 1.0f, 0.0f}), occlusionPass(4, 0.5f)};
+    BackendRequest request;
+    request.trace.backend = Backend::Cpu;
+    EXPECT_TRUE(passesTracedTogether(passes, hits, 301, request));  // 60 x (1 + 4) rays
+    EXPECT_FALSE(passesTracedTogether(passes, hits, 300, request));
+    EXPECT_FALSE(passesTracedTogether({passes[1]}, hits, 1000000, request));
+    request.trace.dacrt.rayGrouping = RayGrouping::OctantCalls;
+    EXPECT_FALSE(passesTracedTogether(passes, hits, 1000000, request));
+    request.trace.dacrt.rayGrouping = RayGrouping::Slots;
+    EXPECT_TRUE(passesTracedTogether(passes, hits, 1000000, request));
+    request.trace.dacrt.passTracing = PassTracing::Apart;
+    EXPECT_FALSE(passesTracedTogether(passes, hits, 1000000, request));
+    request.trace.dacrt.passTracing = PassTracing::Together;
+    EXPECT_TRUE(passesTracedTogether(passes, hits, 1, request));
+    request.trace.backend = Backend::CpuSeq;
+    EXPECT_TRUE(passesTracedTogether(passes, hits, 1, request));
+    for (Backend other : {Backend::Brute, Backend::Gpu, Backend::Embree}) {
+        request.trace.backend = other;
+        EXPECT_FALSE(passesTracedTogether(passes, hits, 1000000, request)) << toString(other);
+    }
+    // Together merges the passes' rays pixel by pixel: not with rays grouped by octant.
+    DacrtOptions options;
+    options.passTracing = PassTracing::Together;
+    options.rayGrouping = RayGrouping::Octant;
+    EXPECT_THROW(checkOptionCombinations(options), InputError);
+    options.rayGrouping = RayGrouping::Batches;
+    EXPECT_NO_THROW(checkOptionCombinations(options));
 }
 
 }  // namespace
