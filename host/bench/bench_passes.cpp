@@ -57,7 +57,7 @@ PassFrame secondaryPassFrame(const BenchConfig& c, PassOutput& pass) {
                 name = "not counted: " + name + " repeated by the pass";
             }
     f.hits = std::move(pass.output.hits);
-    f.together = !pass.tracedIn.empty();
+    f.together = pass.tracedIn != PassOutput::kTracedAlone;
     return f;
 }
 

@@ -289,23 +289,35 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     return out;
 }
 
+std::uint64_t BackendDispatcher::slotsTogether(const std::vector<SecondaryPass>& passes, std::uint64_t primaryRays) {
+    std::uint64_t slots = 0;
+    for (const SecondaryPass& pass : passes) {
+        slots += secondarySlots(pass, primaryRays);
+        if (slots > kMaxSecondarySlots)
+            throw InputError("passes traced together: " + std::to_string(primaryRays) +
+                             " pixels make more than the " + std::to_string(kMaxSecondarySlots) +
+                             " rays one trace can hold (32-bit ids); lower --size or --ao, or --pass-tracing apart");
+    }
+    return slots;
+}
+
 std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryTogether(
     const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const std::vector<SecondaryPass>& passes,
     const BackendRequest& request, const PlanHook& onPlan) {
     checkBackendRequest(request);
-    if (passes.size() > kMostPassesTogether) throw InternalError("more passes traced together than a pass index holds");
+    if (passes.empty() || passes.size() > kMostPassesTogether)
+        throw InternalError(std::to_string(passes.size()) + " passes to trace together");
     ThreadPool& threadPool = pool(threadsOf(request.trace));
     // Each pass's making plan (as traceSecondary's), every one checked before anything is made,
     // then the merged copy of their rays.
     std::vector<MemoryPlan> makings;
-    std::uint64_t slots = 0;
-    for (const SecondaryPass& pass : passes) {
-        makings.push_back(makingPlan(pass, primary.rays->size()));
-        slots += secondarySlots(pass, primary.rays->size());
-    }
+    const std::uint64_t slots = slotsTogether(passes, primary.rays->size());
+    for (const SecondaryPass& pass : passes) makings.push_back(makingPlan(pass, primary.rays->size()));
     MemoryPlan merging;
     merging.add("the passes' rays merged pixel by pixel, with their pass and slot (at most)",
                 slots * (sizeof(Ray) + sizeof(std::uint32_t) + sizeof(std::uint16_t)));
+    if (request.trace.dacrt.rayGrouping == RayGrouping::Batches)
+        merging.add("the rays of the groups being traced (at most)", slots * sizeof(Ray));  // one, or one a worker
     merging.addWork("passes traced together", passes.size(),
                     "their rays merged pixel by pixel into the same traces, which divide the triangles once");
     for (const MemoryPlan& plan : makings)
@@ -345,10 +357,12 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
             }
     }
     std::vector<PassTrace> out(passes.size());
+    std::vector<std::uint64_t> slotCount(passes.size());
     for (std::size_t p = 0; p < passes.size(); ++p) {  // each pass's own copy no longer needed
         out[p].rays = made[p].rays.size();
-        std::vector<Ray>().swap(made[p].rays);
+        slotCount[p] = made[p].slotCount;
     }
+    made.clear();
     const double makeMs = msSince(start);
     TraceResult traced;
     if (!rays.empty()) {
@@ -361,8 +375,11 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
                                    : tracePassRays(primary, rays, request, onPlan);
         if (traced.hits.empty()) return {};  // stopped at the plan
     }
+    if (traced.hits.size() != rays.size())
+        throw InternalError("passes traced together: " + std::to_string(traced.hits.size()) + " hits for " +
+                            std::to_string(rays.size()) + " rays");
     const Hit none{0.0f, kNotTracedPrim, 0.0f, 0.0f};
-    for (std::size_t p = 0; p < passes.size(); ++p) out[p].result.hits = mappedArray(made[p].slotCount, none);
+    for (std::size_t p = 0; p < passes.size(); ++p) out[p].result.hits = mappedArray(slotCount[p], none);
     for (std::size_t i = 0; i < traced.hits.size(); ++i) out[passOf[i]].result.hits[slotOf[i]] = traced.hits[i];
     std::vector<Hit> lastHits = std::move(out.back().result.hits);
     out.back().result = std::move(traced);

@@ -84,12 +84,15 @@ public:
     PassTrace traceSecondary(const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const SecondaryPass& pass,
                              const BackendRequest& request, const PlanHook& onPlan = {});
 
-    // Several secondary passes of that frame traced as one (cpu backends, --passes together):
+    // Several secondary passes of that frame traced as one (cpu backends, --pass-tracing together):
     // each pass's rays made as traceSecondary makes them, merged pixel by pixel (a pixel's rays
     // of every pass together, the passes in their order), traced for any hit in one DACRT, and
     // each hit put back in its pass's slot: one PassTrace per pass, its hits and rays; the
     // trace's plan, counters and phases go with the last pass (the passes share them).
+    // Throws InputError where their slots together exceed kMaxSecondarySlots (slotsTogether).
     static constexpr std::size_t kMostPassesTogether = 65536;  // a pass index per ray: 16 bits
+    // The passes' slots together; InputError where they exceed kMaxSecondarySlots (32-bit ids).
+    static std::uint64_t slotsTogether(const std::vector<SecondaryPass>& passes, std::uint64_t primaryRays);
     std::vector<PassTrace> traceSecondaryTogether(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
                                                   const std::vector<SecondaryPass>& passes,
                                                   const BackendRequest& request, const PlanHook& onPlan = {});

@@ -81,6 +81,9 @@ bool passesTracedTogether(const std::vector<SecondaryPass>& passes, const std::v
     if (tracing == PassTracing::Together) return true;  // checkOptionCombinations: not with octant groupings
     if (request.trace.dacrt.rayGrouping != RayGrouping::Batches && request.trace.dacrt.rayGrouping != RayGrouping::Slots)
         return false;
+    std::uint64_t slots = 0;
+    for (const SecondaryPass& pass : passes) slots += secondarySlots(pass, primaryHits.size());
+    if (slots > kMaxSecondarySlots) return false;  // more than one trace's 32-bit ids
     std::uint64_t surfaces = 0, raysPerSurface = 0;
     for (const Hit& h : primaryHits) surfaces += hitSendsRays(h);
     for (const SecondaryPass& pass : passes) raysPerSurface += pass.raysPerHit;
@@ -100,7 +103,7 @@ std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& p
         const double ms = msSince(start);
         for (std::size_t p = 0; p < passes.size(); ++p)
             traced.push_back(TracedPass{passes[p], std::move(t[p].result), t[p].rays, p + 1 == passes.size() ? ms : 0.0,
-                                        passes.back().name});
+                                        passes.size() - 1});
         return traced;
     }
     for (const SecondaryPass& pass : passes) {

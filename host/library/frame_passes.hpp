@@ -24,7 +24,7 @@ struct TracedPass {
     TraceResult result;        // hits: one per slot
     std::uint64_t rays = 0;    // rays made
     double ms = 0.0;           // making and tracing them
-    std::string tracedIn;      // PassOutput::tracedIn
+    std::size_t tracedIn = PassOutput::kTracedAlone;  // as PassOutput's
 };
 
 // Whether the cpu backends trace these passes together (PassTracing; Auto: where they make

@@ -109,7 +109,10 @@ nlohmann::ordered_json passesJson(const RenderedFrame& frame, double primaryMs) 
                                     {"trace_phases", phasesJson(r.timings)},  // a batched pass's: summed
                                     {"counters", countersJson(r.counters)},
                                     {"memory_plan_bytes", memoryJson(r.plan)}};
-        if (!t.tracedIn.empty()) p["traced_in"] = t.tracedIn;  // passes traced together
+        if (t.tracedIn != PassOutput::kTracedAlone) {  // passes traced together: the pass that carries the trace
+            p["traced_in"] = (*frame.passes)[t.tracedIn].pass.name;
+            p["traced_in_index"] = t.tracedIn + 1;  // in this array, after the primary pass
+        }
         if (t.pass.kind == PassKind::Occlusion) {
             p["rays_per_hit"] = t.pass.raysPerHit;
             p["distance"] = t.pass.occlusionDistance;

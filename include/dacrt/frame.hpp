@@ -43,10 +43,12 @@ struct PassOutput {
     TraceOutput output;
     std::uint64_t rays = 0;  // rays made
     double ms = 0.0;         // making and tracing them
-    // Empty where the pass was traced on its own; else the name of the last pass it was traced
-    // with (DacrtOptions::passTracing, together): that pass's output carries the shared trace's
-    // time, plan and counters (this one's, where it is that pass), the others their hits and rays.
-    std::string tracedIn;
+    // kTracedAlone where the pass was traced on its own; else (DacrtOptions::passTracing,
+    // together) the index in FrameOutput::passes of the last pass it was traced with, whose
+    // output carries the shared trace's time, plan and counters (this pass's own index where it
+    // is that pass); the others carry their hits and rays only.
+    static constexpr std::size_t kTracedAlone = ~std::size_t(0);
+    std::size_t tracedIn = kTracedAlone;
 };
 
 struct FrameOutput {

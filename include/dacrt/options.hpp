@@ -28,7 +28,7 @@ enum class RayGrouping { Slots, Octant, OctantCalls, Batches };
 // pixel into the same traces, which then divide the triangles once for all of them; Auto,
 // together where the passes make fewer rays than the scene has triangles (the triangles'
 // division is then most of a pass's cost), apart elsewhere (a shadow pass's own cull then
-// pays). Both give the same visibility: it changes speed only.
+// pays) and under the octant groupings. Both give the same visibility: it changes speed only.
 enum class PassTracing { Auto, Apart, Together };
 enum class DivisionAxis { Best, X, Y, Z };
 // Ray/triangle test of a DACRT leaf. Watertight is exact up to rounding and never leaks

@@ -674,7 +674,10 @@ TEST(Cli, PlanAndStatsListEverySkipWithItsCounts) {
     const nlohmann::json t = nlohmann::json::parse(togetherStats);
     ASSERT_EQ(t["passes"].size(), 3u);
     EXPECT_EQ(t["options"]["pass_tracing"], "auto");
-    for (std::size_t i = 1; i < 3; ++i) EXPECT_EQ(t["passes"][i]["traced_in"], "occlusion") << t["passes"][i].dump();
+    for (std::size_t i = 1; i < 3; ++i) {
+        EXPECT_EQ(t["passes"][i]["traced_in"], "occlusion") << t["passes"][i].dump();
+        EXPECT_EQ(t["passes"][i]["traced_in_index"], 2u) << t["passes"][i].dump();
+    }
     EXPECT_EQ(t["passes"][1]["trace_ms"], 0.0);
     ASSERT_FALSE(t["passes"][2]["work_plan"].empty());
     EXPECT_EQ(t["passes"][2]["work_plan"][0]["name"], "passes traced together");

@@ -41,7 +41,7 @@ void expectEveryGroupingGivesTheseVisibilities(const TraceScene& scene, const Ra
                     EXPECT_TRUE(test::sameVisibility(expected.passes[k].output.hits, grouped.passes[k].output.hits))
                         << k << ", grouping " << int(grouping) << ", tracing " << int(tracing) << ", backend " << int(backend);
                     const bool together = tracing == PassTracing::Together && passes.size() > 1;
-                    EXPECT_EQ(grouped.passes[k].tracedIn, together ? passes.back().name : std::string()) << k;
+                    EXPECT_EQ(grouped.passes[k].tracedIn, together ? passes.size() - 1 : PassOutput::kTracedAlone) << k;
                 }
             }
 }
@@ -109,6 +109,28 @@ TEST(ApiFrame, PlanCallbackSeesEachPassAndMayStop) {
     EXPECT_FALSE(traced.stoppedAtPlan);
     EXPECT_GE(seen.size(), 1 + passes.size());  // a pass may show more than one plan
     EXPECT_EQ(traced.passes.size(), passes.size());
+
+    // A stop at any later plan, the passes apart and together (each pass's making plan, their
+    // merging, the trace's own): the primary pass is kept, no pass is returned.
+    for (const PassTracing tracing : {PassTracing::Apart, PassTracing::Together}) {
+        TracerOptions o = test::onBackend(Backend::Cpu, 2);
+        o.trace.dacrt.passTracing = tracing;
+        Tracer passTracer(o);
+        std::size_t plans = 0;
+        ASSERT_FALSE(passTracer.traceFrame(scene, rays, passes, [&plans](const FramePlan&) { return ++plans, true; })
+                         .stoppedAtPlan);
+        ASSERT_GE(plans, tracing == PassTracing::Together ? 5u : 3u);  // primary, 2 makings, merging, trace
+        for (std::size_t stopAt = 2; stopAt <= plans; ++stopAt) {
+            std::size_t seenPlans = 0;
+            const FrameOutput part = passTracer.traceFrame(scene, rays, passes, [&](const FramePlan&) {
+                return ++seenPlans < stopAt;
+            });
+            EXPECT_TRUE(part.stoppedAtPlan) << "stop at plan " << stopAt << ", tracing " << int(tracing);
+            EXPECT_EQ(seenPlans, stopAt);
+            EXPECT_FALSE(part.primary.hits.empty());
+            EXPECT_LT(part.passes.size(), passes.size()) << "stop at plan " << stopAt;
+        }
+    }
 }
 
 TEST(ApiFrame, PassBoundCountsEveryPossibleRay) {
