@@ -228,25 +228,21 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
         return out;
     }
     out.push_back(baseConfig(b, hardwareThreads));
+    if (b != Backend::Cpu) return out;
+    auto variant = [&](const std::string& name, auto&& set) {
+        BenchConfig c = out.front();
+        c.name = name;
+        c.isDefault = false;
+        set(c.options.trace.dacrt);
+        out.push_back(c);
+    };
     // The secondary rays' order (docs/benchmarks.md, "Rays grouped by octant").
-    if (b == Backend::Cpu)
-        for (RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls}) {
-            BenchConfig c = out.front();
-            c.name = "ray-grouping=" + toString(grouping);
-            c.isDefault = false;
-            c.options.trace.dacrt.rayGrouping = grouping;
-            out.push_back(c);
-        }
+    for (RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls})
+        variant("ray-grouping=" + toString(grouping), [grouping](DacrtOptions& d) { d.rayGrouping = grouping; });
     // The passes apart and together, whichever the default chose (docs/benchmarks.md, "A frame's
     // passes traced together").
-    if (b == Backend::Cpu)
-        for (PassTracing tracing : {PassTracing::Apart, PassTracing::Together}) {
-            BenchConfig c = out.front();
-            c.name = "pass-tracing=" + toString(tracing);
-            c.isDefault = false;
-            c.options.trace.dacrt.passTracing = tracing;
-            out.push_back(c);
-        }
+    for (PassTracing tracing : {PassTracing::Apart, PassTracing::Together})
+        variant("pass-tracing=" + toString(tracing), [tracing](DacrtOptions& d) { d.passTracing = tracing; });
     return out;
 }
 

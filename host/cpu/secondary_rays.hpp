@@ -61,6 +61,13 @@ std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, 
 // Whether a primary ray's hit is a surface that may send secondary rays (not a miss, and traced).
 inline bool hitSendsRays(const Hit& hit) { return hit.prim != kMissPrim && hit.prim != kNotTracedPrim; }
 
+// How many of the primary hits send rays (hitSendsRays).
+inline std::uint64_t surfacesSendingRays(const std::vector<Hit>& primaryHits) {
+    std::uint64_t surfaces = 0;
+    for (const Hit& h : primaryHits) surfaces += hitSendsRays(h);
+    return surfaces;
+}
+
 // The rays primary ray i sends in the pass, in slot order: emit(slot, ray) for each one made
 // (slot i * raysPerHit + k): none from a miss, a shadow ray only where the light can reach the
 // surface, the occlusion samples. primaryRay() returns ray i (a Ray), asked for only where it

@@ -50,8 +50,7 @@ bool usesVulkan(const std::vector<Backend>& backends) {
 // triangles. The pass makes at most raysPerHit rays per surface the primary rays hit.
 bool culledOnTheHost(const SecondaryPass& pass, const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
                      const SkipSwitches& switches) {
-    std::uint64_t surfaces = 0;
-    for (const Hit& h : primaryHits) surfaces += hitSendsRays(h);
+    const std::uint64_t surfaces = surfacesSendingRays(primaryHits);
     // A light's shadow rays share its direction or end at it, and the back-face tests drop
     // single-sided triangles only (glTF's default: the search stops at the first one).
     const bool sharedFacing = pass.kind == shared::kPassShadow &&
@@ -290,14 +289,8 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
 }
 
 std::uint64_t BackendDispatcher::slotsTogether(const std::vector<SecondaryPass>& passes, std::uint64_t primaryRays) {
-    std::uint64_t slots = 0;
-    for (const SecondaryPass& pass : passes) {
-        slots += secondarySlots(pass, primaryRays);
-        if (slots > kMaxSecondarySlots)
-            throw InputError("passes traced together: " + std::to_string(primaryRays) +
-                             " pixels make more than the " + std::to_string(kMaxSecondarySlots) +
-                             " rays one trace can hold (32-bit ids); lower --size or --ao, or --pass-tracing apart");
-    }
+    std::uint64_t slots = 0;  // each pass's at most kMaxSecondarySlots: no overflow for kMostPassesTogether
+    for (const SecondaryPass& pass : passes) slots += secondarySlots(pass, primaryRays);
     return slots;
 }
 
@@ -312,6 +305,10 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
     // then the merged copy of their rays.
     std::vector<MemoryPlan> makings;
     const std::uint64_t slots = slotsTogether(passes, primary.rays->size());
+    if (slots > kMaxSecondarySlots)
+        throw InputError("passes traced together: " + std::to_string(primary.rays->size()) +
+                         " pixels make more than the " + std::to_string(kMaxSecondarySlots) +
+                         " rays one trace can hold (32-bit ids); lower --size or --ao, or --pass-tracing apart");
     for (const SecondaryPass& pass : passes) makings.push_back(makingPlan(pass, primary.rays->size()));
     MemoryPlan merging;
     merging.add("the passes' rays merged pixel by pixel, with their pass and slot (at most)",

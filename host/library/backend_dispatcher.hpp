@@ -89,9 +89,9 @@ public:
     // of every pass together, the passes in their order), traced for any hit in one DACRT, and
     // each hit put back in its pass's slot: one PassTrace per pass, its hits and rays; the
     // trace's plan, counters and phases go with the last pass (the passes share them).
-    // Throws InputError where their slots together exceed kMaxSecondarySlots (slotsTogether).
+    // Throws InputError where their slots together exceed kMaxSecondarySlots (32-bit ids).
     static constexpr std::size_t kMostPassesTogether = 65536;  // a pass index per ray: 16 bits
-    // The passes' slots together; InputError where they exceed kMaxSecondarySlots (32-bit ids).
+    // The passes' slots together (secondarySlots summed).
     static std::uint64_t slotsTogether(const std::vector<SecondaryPass>& passes, std::uint64_t primaryRays);
     std::vector<PassTrace> traceSecondaryTogether(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
                                                   const std::vector<SecondaryPass>& passes,

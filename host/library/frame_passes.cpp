@@ -81,13 +81,11 @@ bool passesTracedTogether(const std::vector<SecondaryPass>& passes, const std::v
     if (tracing == PassTracing::Together) return true;  // checkOptionCombinations: not with octant groupings
     if (request.trace.dacrt.rayGrouping != RayGrouping::Batches && request.trace.dacrt.rayGrouping != RayGrouping::Slots)
         return false;
-    std::uint64_t slots = 0;
-    for (const SecondaryPass& pass : passes) slots += secondarySlots(pass, primaryHits.size());
-    if (slots > kMaxSecondarySlots) return false;  // more than one trace's 32-bit ids
-    std::uint64_t surfaces = 0, raysPerSurface = 0;
-    for (const Hit& h : primaryHits) surfaces += hitSendsRays(h);
+    if (BackendDispatcher::slotsTogether(passes, primaryHits.size()) > kMaxSecondarySlots)
+        return false;  // more than one trace's 32-bit ids
+    std::uint64_t raysPerSurface = 0;
     for (const SecondaryPass& pass : passes) raysPerSurface += pass.raysPerHit;
-    return surfaces * raysPerSurface < triangles;
+    return surfacesSendingRays(primaryHits) * raysPerSurface < triangles;
 }
 
 std::vector<TracedPass> traceSecondaryPasses(const std::vector<SecondaryPass>& passes, const FrameGeometry& primary,
