@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "core/mapped_memory.hpp"
+#include "core/triangle_bounds_lanes.hpp"
 
 namespace dacrt {
 
@@ -69,15 +70,9 @@ void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool
     const std::size_t chunks = (triangles.size() + kChunk - 1) / kChunk;
     std::vector<Box> chunkBox(chunks);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        const std::size_t end = std::min(triangles.size(), (c + 1) * kChunk);
+        const std::size_t begin = c * kChunk, end = std::min(triangles.size(), (c + 1) * kChunk);
         Box b;
-        for (std::size_t i = c * kChunk; i < end; ++i) {
-            const Triangle& t = triangles[i];
-            bounds[i] = triangleBounds(t);
-            b.extend(t.v0);
-            b.extend(t.v1);
-            b.extend(t.v2);
-        }
+        triangleBoundsLanes(triangles.data() + begin, end - begin, bounds.data() + begin, b);
         chunkBox[c] = b;
     });
     box = Box{};

@@ -41,6 +41,18 @@ private:
     bool stopping_ = false;
 };
 
+// Calls body(chunk, begin, end) for the ranges [begin, end) of at most `chunk` consecutive
+// indices that cover [0, n), on the pool (in order on the calling thread without one): for a
+// frame's passes over its rays or hits, which one thread would make serial.
+template <typename Body>
+void forEachChunk(std::size_t n, std::size_t chunk, ThreadPool* pool, Body&& body) {
+    const std::size_t chunks = (n + chunk - 1) / chunk;
+    const auto run = [&](std::size_t c, unsigned) { body(c, c * chunk, std::min(n, (c + 1) * chunk)); };
+    if (pool) pool->parallelFor(chunks, run);
+    else
+        for (std::size_t c = 0; c < chunks; ++c) run(c, 0);
+}
+
 // Calls visit(i) for every i in [0, n), in chunks of `chunk` on the pool (in order on the
 // calling thread without one), each chunk stopping at its first i for which visit returns
 // false; returns the least such i, or n when there is none. What a sequential loop that stops
@@ -48,16 +60,13 @@ private:
 template <typename Visit>
 std::size_t firstFailureInChunks(std::size_t n, std::size_t chunk, ThreadPool* pool, Visit&& visit) {
     std::vector<std::size_t> first((n + chunk - 1) / chunk, n);
-    const auto scan = [&](std::size_t c, unsigned) {
-        for (std::size_t i = c * chunk, end = std::min(n, (c + 1) * chunk); i < end; ++i)
+    forEachChunk(n, chunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
             if (!visit(i)) {
                 first[c] = i;
                 return;
             }
-    };
-    if (pool) pool->parallelFor(first.size(), scan);
-    else
-        for (std::size_t c = 0; c < first.size(); ++c) scan(c, 0);
+    });
     for (const std::size_t i : first)
         if (i < n) return i;
     return n;

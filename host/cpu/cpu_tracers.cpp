@@ -25,17 +25,22 @@ void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
 
 // Every ray's best hit starts at its segment's end (missHit). Returns whether every ray has
 // the first one's segment, bit for bit (TraversalBuffers::raysShareSegment), found in the same
-// pass over the rays.
-bool startHits(const FrameGeometry& g, std::vector<Hit>& hits) {
+// pass over the rays, in chunks side by side on the pool (none: on the calling thread).
+bool startHits(const FrameGeometry& g, std::vector<Hit>& hits, ThreadPool* pool) {
     const std::vector<Ray>& rays = *g.rays;
+    constexpr std::size_t kChunk = 16384;
     reserveMapped(hits, rays.size());
     hits.resize(rays.size());
-    bool shareSegment = !rays.empty();
-    for (std::size_t i = 0; i < hits.size(); ++i) {
-        hits[i] = missHit(rays[i]);
-        shareSegment &= sameSegment(rays[i], rays[0]);
-    }
-    return shareSegment;
+    std::vector<std::uint8_t> shareSegment((rays.size() + kChunk - 1) / kChunk, 1);
+    forEachChunk(rays.size(), kChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        bool share = true;
+        for (std::size_t i = begin; i < end; ++i) {
+            hits[i] = missHit(rays[i]);
+            share &= sameSegment(rays[i], rays[0]);
+        }
+        shareSegment[c] = share;
+    });
+    return !rays.empty() && std::all_of(shareSegment.begin(), shareSegment.end(), [](std::uint8_t s) { return s != 0; });
 }
 
 Box regionBox(const Region& r) {
@@ -84,7 +89,7 @@ public:
         };
         division_ = divideScene(g_, regions, axis, pool_, result_.memory, onPlan, planTracer);
         if (!division_.complete) return false;
-        raysShareSegment_ = startHits(g_, result_.hits);
+        raysShareSegment_ = startHits(g_, result_.hits, &pool_);
         schedule_ = transferSchedule(division_);
         result_.phases.divide = msSince(start);
         result_.counters.raysCulled = division_.culledRays;
@@ -241,7 +246,7 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     planPacketBuffers(g, resolved, scratchIds, 1, result.memory);
     if (onPlan && !onPlan(result.memory)) return result;
 
-    const bool raysShareSegment = startHits(g, result.hits);
+    const bool raysShareSegment = startHits(g, result.hits, nullptr);
     std::vector<std::uint32_t> rayIds(rayCount), triIds;
     std::iota(rayIds.begin(), rayIds.end(), 0u);
     fillTracedTriangleIds(g, triIds);
@@ -297,7 +302,7 @@ TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options,
     if (onPlan && !onPlan(result.memory)) return result;
 
     const auto start = Clock::now();
-    const bool raysShareSegment = startHits(g, result.hits);
+    const bool raysShareSegment = startHits(g, result.hits, &pool);
     std::vector<std::uint32_t> rayIds(rayCount);
     std::iota(rayIds.begin(), rayIds.end(), 0u);
     std::vector<std::vector<std::uint32_t>> triIds(threads), scratch(threads);

@@ -10,6 +10,11 @@
 
 namespace dacrt {
 
+namespace {
+// Rays per chunk of a pass over a frame's rays (768 KiB of them).
+constexpr std::size_t kRayScanChunk = 16384;
+}  // namespace
+
 float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin) {
     float m = 0.0f;
     for (int a = 0; a < 3; ++a)
@@ -17,11 +22,13 @@ float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin) {
     return std::max(m * 0x1p-18f, 0x1p-100f);
 }
 
-bool raysShareStart(const std::vector<Ray>& rays) {
-    return std::all_of(rays.begin(), rays.end(), [&](const Ray& r) {
-        return std::memcmp(&r.origin, &rays.front().origin, sizeof(r.origin)) == 0 &&
-               std::memcmp(&r.tmin, &rays.front().tmin, sizeof(r.tmin)) == 0;
-    });
+bool raysShareStart(const std::vector<Ray>& rays, ThreadPool* pool) {
+    if (rays.empty()) return true;
+    const Ray& first = rays.front();
+    return firstFailureInChunks(rays.size(), kRayScanChunk, pool, [&](std::size_t i) {
+               return std::memcmp(&rays[i].origin, &first.origin, sizeof(first.origin)) == 0 &&
+                      std::memcmp(&rays[i].tmin, &first.tmin, sizeof(first.tmin)) == 0;
+           }) == rays.size();
 }
 
 bool raysShareSegment(const std::vector<Ray>& rays) {
@@ -30,24 +37,41 @@ bool raysShareSegment(const std::vector<Ray>& rays) {
 }
 
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
-                            const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth) {
+                            const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth,
+                            ThreadPool* pool) {
     FrameGeometry g;
     g.triangles = &triangles;
     g.triangleBounds = &bounds;
     g.rays = &rays;
     g.sceneBox = sceneBox;
     g.rayOrigin = rays.empty() ? glm::vec3(0.0f) : rays.front().origin;
-    g.raysShareStart = !rays.empty() && raysShareStart(rays);
+    g.raysShareStart = !rays.empty() && raysShareStart(rays, pool);
     if (g.raysShareStart) {
         g.farthestOrigin = glm::abs(g.rayOrigin);
         g.nearSide = g.rayOrigin;
     } else {
+        // Each chunk's farthest origin and directions, then their maxima and unions: the same
+        // on every thread count.
+        struct Reach {
+            glm::vec3 farthest{0.0f};
+            bool towardLow[3] = {false, false, false}, towardHigh[3] = {false, false, false};
+        };
+        std::vector<Reach> reach((rays.size() + kRayScanChunk - 1) / kRayScanChunk);
+        forEachChunk(rays.size(), kRayScanChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+            Reach& r = reach[c];
+            for (std::size_t i = begin; i < end; ++i)
+                for (int a = 0; a < 3; ++a) {
+                    r.farthest[a] = std::max(r.farthest[a], std::abs(rays[i].origin[a]));
+                    r.towardLow[a] |= rays[i].dir[a] < 0.0f;
+                    r.towardHigh[a] |= rays[i].dir[a] > 0.0f;
+                }
+        });
         bool towardLow[3] = {false, false, false}, towardHigh[3] = {false, false, false};
-        for (const Ray& r : rays)
+        for (const Reach& r : reach)
             for (int a = 0; a < 3; ++a) {
-                g.farthestOrigin[a] = std::max(g.farthestOrigin[a], std::abs(r.origin[a]));
-                towardLow[a] |= r.dir[a] < 0.0f;
-                towardHigh[a] |= r.dir[a] > 0.0f;
+                g.farthestOrigin[a] = std::max(g.farthestOrigin[a], r.farthest[a]);
+                towardLow[a] |= r.towardLow[a];
+                towardHigh[a] |= r.towardHigh[a];
             }
         for (int a = 0; a < 3; ++a) {
             g.nearSide[a] = towardLow[a] ? std::numeric_limits<float>::max() : -std::numeric_limits<float>::max();

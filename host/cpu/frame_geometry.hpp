@@ -9,6 +9,7 @@
 
 #include "core/camera.hpp"
 #include "core/scene.hpp"
+#include "core/thread_pool.hpp"
 
 namespace dacrt {
 
@@ -66,7 +67,8 @@ struct FrameGeometry {
 // Whether every ray has the first ray's origin and tmin, bit for bit (primary rays do): the
 // kernels (SIMD filters, compute shaders) then take them once instead of loading them per
 // ray, with the per-ray arithmetic unchanged.
-bool raysShareStart(const std::vector<Ray>& rays);
+// pool: the chunks of the scan side by side (none: on the calling thread).
+bool raysShareStart(const std::vector<Ray>& rays, ThreadPool* pool = nullptr);
 // Whether ray a has b's tmin and tmax, bit for bit (inline: startHits asks it of every ray).
 inline bool sameSegment(const Ray& a, const Ray& b) {
     return std::memcmp(&a.tmin, &b.tmin, sizeof(a.tmin)) == 0 && std::memcmp(&a.tmax, &b.tmax, sizeof(a.tmax)) == 0;
@@ -85,8 +87,10 @@ float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin);
 // origins and child order (NearSide where one exists, else PerRay), and the filter margin
 // derived from them.
 // imageWidth: the rays' row length when they are an image's pixels (packets group them in
-// tiles), else 0.
+// tiles), else 0. pool: the passes over the rays in chunks side by side (none: on the
+// calling thread).
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
-                            const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth = 0);
+                            const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth = 0,
+                            ThreadPool* pool = nullptr);
 
 }  // namespace dacrt

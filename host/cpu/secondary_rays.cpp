@@ -118,9 +118,9 @@ std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& 
     return slots;
 }
 
-FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles,
-                             const std::vector<Bounds>& bounds, const std::vector<Ray>& rays, const Box& sceneBox) {
-    FrameGeometry g = frameGeometry(triangles, bounds, rays, sceneBox);
+FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
+                             const std::vector<Ray>& rays, const Box& sceneBox, ThreadPool* pool) {
+    FrameGeometry g = frameGeometry(triangles, bounds, rays, sceneBox, 0, pool);
     g.query = HitQuery::Any;
     return g;
 }

@@ -159,8 +159,9 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
 std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced);
 
 // The frame a pass's rays are traced as: any hit (frameGeometry finds their child order:
-// shadow rays to a directional light share a direction, the others go every way).
-FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles,
-                             const std::vector<Bounds>& bounds, const std::vector<Ray>& rays, const Box& sceneBox);
+// shadow rays to a directional light share a direction, the others go every way). pool: its
+// passes over the rays side by side (none: on the calling thread).
+FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
+                             const std::vector<Ray>& rays, const Box& sceneBox, ThreadPool* pool = nullptr);
 
 }  // namespace dacrt

@@ -3,6 +3,7 @@
 #include <dacrt/plan_text.hpp>
 
 #include "core/mapped_memory.hpp"
+#include "core/thread_pool.hpp"
 #include "cpu/phase_times.hpp"
 #include "gpu/stage_clocks.hpp"
 
@@ -52,13 +53,16 @@ TraceCounters countersOf(const TraceResult& result) {
     return c;
 }
 
-std::vector<RayHit> hitsOf(const std::vector<Hit>& hits, const std::vector<std::uint32_t>& callerIds) {
+std::vector<RayHit> hitsOf(const std::vector<Hit>& hits, const std::vector<std::uint32_t>& callerIds, ThreadPool* pool) {
     std::vector<RayHit> out;
-    reserveMapped(out, hits.size());
-    for (const Hit& h : hits) {
-        const bool named = h.prim != kMissPrim && h.prim != kUnnamedHitPrim && h.prim != kNotTracedPrim;
-        out.push_back(RayHit{named && !callerIds.empty() ? callerIds[h.prim] : h.prim, h.t, h.u, h.v});
-    }
+    resizeMapped(out, hits.size());
+    forEachChunk(hits.size(), 16384, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            const Hit& h = hits[i];
+            const bool named = h.prim != kMissPrim && h.prim != kUnnamedHitPrim && h.prim != kNotTracedPrim;
+            out[i] = RayHit{named && !callerIds.empty() ? callerIds[h.prim] : h.prim, h.t, h.u, h.v};
+        }
+    });
     return out;
 }
 
@@ -99,9 +103,10 @@ FramePlan framePlanOf(const MemoryPlan& plan) {
     return out;
 }
 
-TraceOutput traceOutputOf(const TraceResult& result, const std::vector<std::uint32_t>& callerIds, double totalMs) {
+TraceOutput traceOutputOf(const TraceResult& result, const std::vector<std::uint32_t>& callerIds, double totalMs,
+                          ThreadPool* pool) {
     TraceOutput out;
-    out.hits = hitsOf(result.hits, callerIds);
+    out.hits = hitsOf(result.hits, callerIds, pool);
     out.timings = timingsOf(result.phases, totalMs);
     out.counters = countersOf(result);
     out.plan = framePlanOf(result.memory);

@@ -11,10 +11,14 @@
 
 namespace dacrt {
 
+class ThreadPool;
+
 // callerIds: the caller's id of each traced triangle (TraceScene::Impl); empty: the same ids.
 // totalMs: the whole call, measured around the trace. Throws InternalError on a phase that
-// TraceTimings has no field for.
-TraceOutput traceOutputOf(const TraceResult& result, const std::vector<std::uint32_t>& callerIds, double totalMs);
+// TraceTimings has no field for. pool: the hits converted in chunks side by side (none: on
+// the calling thread).
+TraceOutput traceOutputOf(const TraceResult& result, const std::vector<std::uint32_t>& callerIds, double totalMs,
+                          ThreadPool* pool = nullptr);
 
 FramePlan framePlanOf(const MemoryPlan& plan);
 MemoryPlan memoryPlanOf(const FramePlan& plan);

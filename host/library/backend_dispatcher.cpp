@@ -389,9 +389,10 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
 
 namespace {
 
-// The frame a secondary pass's rays (or a group of them) are traced as.
-FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>& rays) {
-    FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays, primary.sceneBox);
+// The frame a secondary pass's rays (or a group of them) are traced as. pool: its passes over
+// the rays side by side (none for a group traced on one worker).
+FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>& rays, ThreadPool* pool = nullptr) {
+    FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays, primary.sceneBox, pool);
     g.trianglesVersion = primary.trianglesVersion;
     g.sceneId = primary.sceneId;
     return g;
@@ -430,7 +431,7 @@ void addGroup(TraceResult& whole, TraceResult&& part, std::size_t passRays) {
 
 TraceResult BackendDispatcher::tracePassRays(const FrameGeometry& primary, const std::vector<Ray>& rays,
                                              const BackendRequest& request, const PlanHook& onPlan) {
-    const FrameGeometry g = passGeometry(primary, rays);
+    const FrameGeometry g = passGeometry(primary, rays, &pool(threadsOf(request.trace)));
     return isPeer(request.trace.backend) ? traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass)
                                          : traceCulled(g, request, onPlan);
 }
@@ -500,7 +501,7 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
     const auto start = Clock::now();
     ThreadPool& threadPool = pool(threadsOf(request.trace));
     if (passCullTests(rays, primary.triangles->size(), primary.sceneBox, request.trace.skips))
-        cullForPass(passGeometry(primary, rays), request.trace.skips, threadPool, passCull_);
+        cullForPass(passGeometry(primary, rays, &threadPool), request.trace.skips, threadPool, passCull_);
     else
         cullNothing(passCull_);
     MemoryPlan cullPlan;

@@ -43,6 +43,9 @@ struct Tracer::Impl {
 
 namespace {
 
+// The trace's threads, which also take the passes over its rays and hits (one for cpu-seq).
+ThreadPool& tracePool(Tracer::Impl& t) { return t.dispatcher.pool(BackendDispatcher::threadsOf(t.request.trace)); }
+
 // The frame of a batch: a camera's keeps its image width and view frustum (the frustum skip);
 // any-hit rays are traced as a secondary pass's are. dacrt's backends read the triangles'
 // bounds, made here on the trace's threads: dacrt keeps no structure between traces, so each
@@ -52,12 +55,12 @@ FrameGeometry frameOf(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch
                       double& boundsMs) {
     const auto start = Clock::now();
     Box box = s.box;
+    ThreadPool& pool = tracePool(t);
     if (isPeer(t.request.trace.backend)) t.bounds.clear();
-    else triangleBoundsInParallel(s.scene.triangles, t.dispatcher.pool(BackendDispatcher::threadsOf(t.request.trace)),
-                                  t.bounds, box);
+    else triangleBoundsInParallel(s.scene.triangles, pool, t.bounds, box);
     boundsMs = isPeer(t.request.trace.backend) ? 0.0 : msSince(start);
-    FrameGeometry g = query == HitQuery::Any ? secondaryFrame(s.scene.triangles, t.bounds, r.rays, box)
-                                             : frameGeometry(s.scene.triangles, t.bounds, r.rays, box, r.imageWidth);
+    FrameGeometry g = query == HitQuery::Any ? secondaryFrame(s.scene.triangles, t.bounds, r.rays, box, &pool)
+                                             : frameGeometry(s.scene.triangles, t.bounds, r.rays, box, r.imageWidth, &pool);
     if (query == HitQuery::Closest) g.frustum = r.frustum;
     g.trianglesVersion = s.scene.trianglesVersion;
     g.sceneId = s.id;
@@ -81,7 +84,7 @@ TraceOutput traced(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch::I
         return true;
     };
     const TraceResult result = withBoundsPhase(t.dispatcher.trace(g, t.request, fitsInMemory), boundsMs);
-    return traceOutputOf(result, s.callerIds, msSince(start));
+    return traceOutputOf(result, s.callerIds, msSince(start), &tracePool(t));
 }
 
 // The caller's plan callback as the backends call it.
@@ -90,10 +93,10 @@ PlanHook planHookOf(const PlanCallback& onPlan) {
     return [&onPlan](const MemoryPlan& plan) { return onPlan(framePlanOf(plan)); };
 }
 
-std::vector<PassOutput> passOutputsOf(std::vector<TracedPass> traced, const TraceScene::Impl& s) {
+std::vector<PassOutput> passOutputsOf(std::vector<TracedPass> traced, const TraceScene::Impl& s, ThreadPool& pool) {
     std::vector<PassOutput> out;
     for (TracedPass& t : traced)
-        out.push_back({framePassOf(t.pass), traceOutputOf(t.result, s.callerIds, t.ms), t.rays, t.ms, t.tracedIn});
+        out.push_back({framePassOf(t.pass), traceOutputOf(t.result, s.callerIds, t.ms, &pool), t.rays, t.ms, t.tracedIn});
     return out;
 }
 
@@ -133,10 +136,11 @@ FrameOutput Tracer::traceFrame(const TraceScene& scene, const RayBatch& cameraRa
     const TraceResult primary = withBoundsPhase(impl_->dispatcher.trace(g, request, hook, onProgress), boundsMs);
     out.stoppedAtPlan = primary.hits.empty();
     if (out.stoppedAtPlan) return out;
-    out.primary = traceOutputOf(primary, s.callerIds, msSince(start));
+    out.primary = traceOutputOf(primary, s.callerIds, msSince(start), &tracePool(*impl_));
     std::vector<SecondaryPass> secondary;
     for (const FramePass& pass : passes) secondary.push_back(secondaryPassOf(pass));
-    out.passes = passOutputsOf(traceSecondaryPasses(secondary, g, primary.hits, impl_->dispatcher, request, hook), s);
+    out.passes = passOutputsOf(traceSecondaryPasses(secondary, g, primary.hits, impl_->dispatcher, request, hook), s,
+                               tracePool(*impl_));
     out.stoppedAtPlan = out.passes.size() < passes.size();
     return out;
 }
