@@ -1,5 +1,5 @@
 #pragma once
-// A frame's triangle bounds, one triangle per 4-lane vector (Google Highway, chosen at run
+// A frame's triangle bounds, one vertex per 4-lane vector (Google Highway, chosen at run
 // time): each lane the scalar code's compare and select (glm::min and glm::max), in the same
 // order, so the same bits, the sign of a zero included.
 #include <cstddef>

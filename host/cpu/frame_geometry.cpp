@@ -11,7 +11,7 @@
 namespace dacrt {
 
 namespace {
-// Rays per chunk of a pass over a frame's rays (768 KiB of them).
+// Rays per chunk of a pass over a frame's rays (1 MiB of them).
 constexpr std::size_t kRayScanChunk = 16384;
 }  // namespace
 
@@ -38,14 +38,15 @@ bool raysShareSegment(const std::vector<Ray>& rays) {
 
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
                             const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth,
-                            ThreadPool* pool) {
+                            ThreadPool* pool, bool uniformRays) {
     FrameGeometry g;
     g.triangles = &triangles;
     g.triangleBounds = &bounds;
     g.rays = &rays;
     g.sceneBox = sceneBox;
     g.rayOrigin = rays.empty() ? glm::vec3(0.0f) : rays.front().origin;
-    g.raysShareStart = !rays.empty() && raysShareStart(rays, pool);
+    g.uniformByConstruction = uniformRays && !rays.empty();
+    g.raysShareStart = g.uniformByConstruction || (!rays.empty() && raysShareStart(rays, pool));
     if (g.raysShareStart) {
         g.farthestOrigin = glm::abs(g.rayOrigin);
         g.nearSide = g.rayOrigin;
@@ -58,13 +59,14 @@ FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::v
         };
         std::vector<Reach> reach((rays.size() + kRayScanChunk - 1) / kRayScanChunk);
         forEachChunk(rays.size(), kRayScanChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
-            Reach& r = reach[c];
+            Reach r;  // written to reach[c] once: neighbouring chunks' entries share cache lines
             for (std::size_t i = begin; i < end; ++i)
                 for (int a = 0; a < 3; ++a) {
                     r.farthest[a] = std::max(r.farthest[a], std::abs(rays[i].origin[a]));
                     r.towardLow[a] |= rays[i].dir[a] < 0.0f;
                     r.towardHigh[a] |= rays[i].dir[a] > 0.0f;
                 }
+            reach[c] = r;
         });
         bool towardLow[3] = {false, false, false}, towardHigh[3] = {false, false, false};
         for (const Reach& r : reach)

@@ -46,6 +46,10 @@ struct FrameGeometry {
     HitQuery query = HitQuery::Closest;
     float margin = 0.0f;    // filter widening, see filterMargin()
     bool raysShareStart = false;  // see raysShareStart()
+    // Every ray has the first one's origin, tmin and tmax, bit for bit, by the way they were
+    // made (a pinhole camera's: RayBatch::Impl::pinholeRays): raysShareStart is set without a
+    // scan, and the hits' start fills every ray's missHit without reading the rays.
+    bool uniformByConstruction = false;
     std::uint32_t imageWidth = 0;  // rays are an image's pixels, row by row, this many a row (0: unknown)
     // Primary rays of one camera: the pyramid they lie in (the view-frustum skip needs it).
     std::optional<ViewFrustum> frustum;
@@ -88,9 +92,10 @@ float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin);
 // derived from them.
 // imageWidth: the rays' row length when they are an image's pixels (packets group them in
 // tiles), else 0. pool: the passes over the rays in chunks side by side (none: on the
-// calling thread).
+// calling thread). uniformRays: the caller made the rays with one origin, tmin and tmax
+// (FrameGeometry::uniformByConstruction); nothing checks it.
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
                             const std::vector<Ray>& rays, const Box& sceneBox, std::uint32_t imageWidth = 0,
-                            ThreadPool* pool = nullptr);
+                            ThreadPool* pool = nullptr, bool uniformRays = false);
 
 }  // namespace dacrt

@@ -47,6 +47,10 @@ struct RayBatch::Impl {
     std::vector<Ray> rays;
     std::uint32_t imageWidth = 0;        // a camera's: its pixels in a row (0: not an image)
     std::optional<ViewFrustum> frustum;  // a perspective camera's
+    // A perspective camera's rays (PixelRays): the eye for every origin, tmin 0 and tmax
+    // unbounded, bit for bit, by construction; the trace then scans them for none of it
+    // (FrameGeometry::uniformByConstruction). The batch is immutable, so it stays true.
+    bool pinholeRays = false;
 
     static RayBatch wrap(std::unique_ptr<Impl> impl) { return RayBatch(std::move(impl)); }
     static const Impl& of(const RayBatch& rays) { return *rays.impl_; }

@@ -390,7 +390,7 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
 namespace {
 
 // The frame a secondary pass's rays (or a group of them) are traced as. pool: its passes over
-// the rays side by side (none for a group traced on one worker).
+// the rays side by side (none for a group traced on one worker of the pool, inside its loop).
 FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>& rays, ThreadPool* pool = nullptr) {
     FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays, primary.sceneBox, pool);
     g.trianglesVersion = primary.trianglesVersion;
@@ -518,8 +518,8 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
         if (groups[k] == groups[k + 1]) continue;
         reserveMapped(grouping_.group, groups[k + 1] - groups[k]);
         grouping_.group.assign(rays.begin() + std::ptrdiff_t(groups[k]), rays.begin() + std::ptrdiff_t(groups[k + 1]));
-        TraceResult part = traceAfterSkips(passGeometry(primary, grouping_.group), passCull_.skips, cullPlan, cullMs,
-                                           request, onPlan, {});
+        TraceResult part = traceAfterSkips(passGeometry(primary, grouping_.group, &threadPool), passCull_.skips,
+                                           cullPlan, cullMs, request, onPlan, {});
         cullMs = 0.0;  // counted once, with the first group
         if (part.hits.empty()) return {};  // stopped at the plan
         addGroup(whole, std::move(part), rays.size());

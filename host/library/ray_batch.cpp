@@ -121,6 +121,7 @@ RayBatch RayBatch::fromCamera(const TraceScene& scene, const CameraSpec& camera,
     impl->rays = primaryRays(view, width, height);
     impl->imageWidth = std::uint32_t(width);
     impl->frustum = viewFrustum(view, width, height);
+    impl->pinholeRays = impl->frustum.has_value();
     return RayBatch(std::move(impl));
 }
 

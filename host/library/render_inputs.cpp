@@ -35,6 +35,7 @@ RayBatch adoptCameraRays(std::vector<Ray> rays, std::uint32_t imageWidth, std::o
     impl->rays = std::move(rays);
     impl->imageWidth = imageWidth;
     impl->frustum = frustum;
+    impl->pinholeRays = frustum.has_value();
     return RayBatch::Impl::wrap(std::move(impl));
 }
 

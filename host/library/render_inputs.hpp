@@ -28,8 +28,10 @@ const Box& boxOf(const TraceScene& scene);
 // gpu uploads them again: a new trianglesVersion). The box is its triangles'.
 void replaceScene(TraceScene& scene, Scene posed);
 
-// A camera's primary rays, one per pixel, row-major: imageWidth pixels a row; the frustum
-// (a perspective camera's) for the skip of the triangles outside it.
+// A camera's primary rays (primaryRays'), one per pixel, row-major: imageWidth pixels a row;
+// the frustum (a perspective camera's) for the skip of the triangles outside it. With a
+// frustum the rays are taken as PixelRays makes a perspective camera's: one origin, tmin and
+// tmax (RayBatch::Impl::pinholeRays).
 RayBatch adoptCameraRays(std::vector<Ray> rays, std::uint32_t imageWidth, std::optional<ViewFrustum> frustum);
 const std::vector<Ray>& raysOf(const RayBatch& rays);
 // The rays moved out of the batch, for their memory to hold the next frame's.

@@ -60,7 +60,8 @@ FrameGeometry frameOf(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch
     else triangleBoundsInParallel(s.scene.triangles, pool, t.bounds, box);
     boundsMs = isPeer(t.request.trace.backend) ? 0.0 : msSince(start);
     FrameGeometry g = query == HitQuery::Any ? secondaryFrame(s.scene.triangles, t.bounds, r.rays, box, &pool)
-                                             : frameGeometry(s.scene.triangles, t.bounds, r.rays, box, r.imageWidth, &pool);
+                                             : frameGeometry(s.scene.triangles, t.bounds, r.rays, box, r.imageWidth, &pool,
+                                                             r.pinholeRays);
     if (query == HitQuery::Closest) g.frustum = r.frustum;
     g.trianglesVersion = s.scene.trianglesVersion;
     g.sceneId = s.id;

@@ -1,10 +1,12 @@
 // A frame's passes over its triangles and rays, made faster, give the sequential code's bits:
 // the triangle bounds in lanes (triangle_bounds_lanes.hpp) on every SIMD target this machine
 // runs, signed zeros and ties included, and the bounds, the rays' shared start and reach
-// (frameGeometry) and the hits' start (through a trace) on one thread and on two.
+// (frameGeometry) with the pool and without, and the hits' start (through a trace on two
+// threads) as brute force sees the rays.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "core/camera.hpp"
@@ -14,6 +16,7 @@
 #include "core/triangle_bounds_lanes.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/simd_kernels.hpp"
+#include "support/simd_targets.hpp"
 #include "support/frames.hpp"
 
 namespace dacrt {
@@ -49,18 +52,7 @@ std::vector<Triangle> tyingTriangles(std::size_t count, std::uint64_t seed) {
     return triangles;
 }
 
-class FrameScansOnEveryTarget : public ::testing::Test {
-protected:
-    template <typename Body>
-    void forEachTarget(Body body) {
-        for (const std::string& t : simd::availableTargets()) {
-            SCOPED_TRACE("target " + t);
-            simd::forceTarget(t);
-            body();
-        }
-    }
-    void TearDown() override { simd::forceTarget(""); }
-};
+using FrameScansOnEveryTarget = test::OnEveryTarget;
 
 TEST_F(FrameScansOnEveryTarget, TriangleBoundsInLanesAreTheScalarLoops) {
     const std::vector<Triangle> triangles = tyingTriangles(5000, 20261206);
@@ -95,9 +87,9 @@ TEST_F(FrameScansOnEveryTarget, TriangleBoundsInLanesExtendTheGivenBox) {
     });
 }
 
-// Three chunks and a part (the parallel bounds take 16,384 triangles a chunk, the rays' scans
-// as many rays), on one thread and on two.
-TEST(FrameScans, BoundsAndRaysScannedSideBySideAreTheSequentialOnes) {
+// Three chunks and a part (the parallel bounds take 16,384 triangles a chunk), on one thread
+// and on two.
+TEST(FrameScans, BoundsComputedSideBySideAreTheSequentialOnes) {
     const std::vector<Triangle> triangles = tyingTriangles(3 * 16384 + 1000, 77);
     const std::vector<Bounds> expected = allTriangleBounds(triangles);
     const Box expectedBox = sceneBounds(triangles);
@@ -110,33 +102,79 @@ TEST(FrameScans, BoundsAndRaysScannedSideBySideAreTheSequentialOnes) {
         EXPECT_EQ(std::memcmp(bounds.data(), expected.data(), bounds.size() * sizeof(Bounds)), 0);
         EXPECT_TRUE(sameBox(box, expectedBox));
     }
+}
 
-    // Rays from one point, then the same rays with one origin moved in the last chunk and one
-    // tmin changed in the first: the shared start found or refused on every pool, and the
-    // rays' reach (farthest origin, child order) the sequential one.
+// Rays from one point, then the same rays with one origin moved in the last chunk or one tmin
+// changed in the first: the shared start found or refused with and without the pool. Rays
+// from many points into the positive octant, one of them in the last chunk turned back along
+// x or not: the reach (farthest origin, near side, child order) what a plain loop gives.
+TEST(FrameScans, RaysScannedSideBySideGiveThePlainLoopsAnswers) {
+    const std::vector<Triangle> triangles = tyingTriangles(100, 78);
+    const std::vector<Bounds> bounds = allTriangleBounds(triangles);
+    const Box sceneBox = sceneBounds(triangles);
+    ThreadPool two(2);
     std::vector<Ray> rays(3 * 16384 + 500);
     Random random(3);
     for (Ray& r : rays) r = makeRay(glm::vec3(0.25f, -1.0f, 2.0f), glm::dvec3(random.onSphere()), 0.0f);
-    const Box sceneBox = sceneBounds(triangles);
-    for (ThreadPool* pool : {static_cast<ThreadPool*>(nullptr), &one, &two}) {
+    for (ThreadPool* pool : {static_cast<ThreadPool*>(nullptr), &two}) {
         EXPECT_TRUE(raysShareStart(rays, pool));
-        EXPECT_TRUE(frameGeometry(triangles, expected, rays, sceneBox, 0, pool).raysShareStart);
+        EXPECT_TRUE(frameGeometry(triangles, bounds, rays, sceneBox, 0, pool).raysShareStart);
     }
     std::vector<Ray> moved = rays;
     moved[moved.size() - 3].origin.x = -4.0f;
     std::vector<Ray> later = rays;
     later[5].tmin = 0x1p-20f;
-    const FrameGeometry sequential = frameGeometry(triangles, expected, moved, sceneBox);
-    for (ThreadPool* pool : {&one, &two}) {
+    for (ThreadPool* pool : {static_cast<ThreadPool*>(nullptr), &two}) {
         EXPECT_FALSE(raysShareStart(moved, pool));
         EXPECT_FALSE(raysShareStart(later, pool));
-        const FrameGeometry g = frameGeometry(triangles, expected, moved, sceneBox, 0, pool);
+    }
+
+    std::vector<Ray> spread;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const glm::dvec3 d = glm::abs(glm::dvec3(random.onSphere())) + glm::dvec3(0.01);
+        spread.push_back(makeRay(random.vec3(-3.0f, 3.0f), d));
+    }
+    spread[spread.size() - 2].origin = glm::vec3(1.0f, -7.5f, 0.0f);
+    std::vector<Ray> turned = spread;
+    turned[turned.size() - 5] = makeRay(turned[turned.size() - 5].origin, glm::dvec3(-1.0, 0.2, 0.3));
+    glm::vec3 farthest(0.0f);
+    for (const Ray& r : spread) farthest = glm::max(farthest, glm::abs(r.origin));
+    ASSERT_EQ(farthest.y, 7.5f);
+    for (ThreadPool* pool : {static_cast<ThreadPool*>(nullptr), &two}) {
+        const FrameGeometry g = frameGeometry(triangles, bounds, spread, sceneBox, 0, pool);
         EXPECT_FALSE(g.raysShareStart);
-        EXPECT_TRUE(sameBytes(g.farthestOrigin, sequential.farthestOrigin));
-        EXPECT_TRUE(sameBytes(g.nearSide, sequential.nearSide));
-        EXPECT_EQ(g.order, sequential.order);
-        EXPECT_EQ(g.margin, sequential.margin);
-        EXPECT_EQ(g.farthestOrigin.x, 4.0f);
+        EXPECT_TRUE(sameBytes(g.farthestOrigin, farthest));
+        EXPECT_EQ(g.order, ChildOrder::NearSide);  // every ray toward high x, y and z
+        EXPECT_EQ(g.nearSide, glm::vec3(-std::numeric_limits<float>::max()));
+        EXPECT_EQ(g.margin, filterMargin(sceneBox, farthest));
+        const FrameGeometry t = frameGeometry(triangles, bounds, turned, sceneBox, 0, pool);
+        EXPECT_EQ(t.order, ChildOrder::PerRay);  // x both ways
+        EXPECT_EQ(t.nearSide, glm::vec3(0.0f));
+    }
+}
+
+// What the library takes on trust for a perspective camera's rays (RayBatch::Impl::pinholeRays,
+// FrameGeometry::uniformByConstruction): one origin, tmin and tmax, bit for bit, whatever the
+// camera, the image size or the pixel offset (antialiasing samples), as a scan finds them.
+TEST(FrameScans, APerspectiveCamerasRaysShareTheirStartAndSegment) {
+    Random random(20261206);
+    ThreadPool two(2);
+    std::vector<Ray> rays;
+    for (int k = 0; k < 40; ++k) {
+        Camera c;
+        c.eye = random.inBox(-50.0, 50.0);
+        c.forward = glm::normalize(glm::dvec3(random.onSphere()));
+        glm::dvec3 upHint = glm::dvec3(random.onSphere());
+        if (std::abs(glm::dot(upHint, c.forward)) > 0.99) upHint = glm::dvec3(c.forward.y, c.forward.z, c.forward.x);
+        c.up = glm::normalize(upHint - glm::dot(upHint, c.forward) * c.forward);
+        c.yfovRadians = random.uniform(0.1, 2.5);
+        const int width = 1 + int(random.index(90)), height = 1 + int(random.index(70));
+        ASSERT_TRUE(viewFrustum(c, width, height).has_value());
+        primaryRays(c, width, height, two, rays, glm::dvec2(random.uniform(), random.uniform()));
+        ASSERT_TRUE(raysShareStart(rays)) << "camera " << k;
+        ASSERT_TRUE(raysShareSegment(rays)) << "camera " << k;
+        EXPECT_EQ(rays.front().tmin, 0.0f);
+        EXPECT_EQ(rays.front().tmax, kNoHitT);
     }
 }
 

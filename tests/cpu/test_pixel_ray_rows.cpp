@@ -14,6 +14,7 @@
 #include "core/pixel_ray_rows.hpp"
 #include "core/random.hpp"
 #include "cpu/simd_kernels.hpp"
+#include "support/simd_targets.hpp"
 
 namespace dacrt {
 namespace {
@@ -47,20 +48,7 @@ void expectRowsArePixelRays(const Camera& camera, int width, int height, glm::dv
         }
 }
 
-// Every available SIMD target in turn (simd::forceTarget chooses Highway's target for every
-// dispatched function, the rows' too), then the best again.
-class PixelRayRowsOnEveryTarget : public ::testing::Test {
-protected:
-    template <typename Body>
-    void forEachTarget(Body body) {
-        for (const std::string& t : simd::availableTargets()) {
-            SCOPED_TRACE("target " + t);
-            simd::forceTarget(t);
-            body();
-        }
-    }
-    void TearDown() override { simd::forceTarget(""); }
-};
+using PixelRayRowsOnEveryTarget = test::OnEveryTarget;
 
 Camera perspective(glm::dvec3 eye, glm::dvec3 forward, glm::dvec3 upHint, double fovDegrees) {
     Camera c;

@@ -17,6 +17,7 @@
 #include "cpu/frame_geometry.hpp"
 #include "cpu/predicates.hpp"
 #include "cpu/simd_kernels.hpp"
+#include "support/simd_targets.hpp"
 #include "cpu/traversal.hpp"
 #include "cpu/triangle_skips.hpp"
 
@@ -24,22 +25,7 @@ using namespace dacrt;
 
 namespace {
 
-// Every available target in turn, then the best again.
-class EveryTarget : public ::testing::Test {
-protected:
-    template <typename Body>
-    void forEachTarget(Body body) {
-        const std::vector<std::string> targets = simd::availableTargets();
-        ASSERT_FALSE(targets.empty());
-        for (const std::string& t : targets) {
-            SCOPED_TRACE("target " + t);
-            simd::forceTarget(t);
-            ASSERT_EQ(simd::activeTarget(), t);
-            body();
-        }
-    }
-    void TearDown() override { simd::forceTarget(""); }
-};
+using EveryTarget = test::OnEveryTarget;
 
 // Coordinates drawn from a few values on purpose: equal coordinates (a ray origin on a cell
 // face, bounds touching a cell) and zero direction components are where a kernel that
