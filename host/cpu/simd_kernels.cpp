@@ -82,16 +82,17 @@ HWY_INLINE VF loadPerLane(const float* base, const std::uint32_t* idLanes, std::
     return hn::Load(df, lanes);
 }
 
-// Floats offset to offset + 3 of each lane's record of 16 floats (base[id * 16 + offset + k] in
-// fields[k]), with one 128-bit load per lane and a 4x4 transpose in each block, where a vector
-// holds whole blocks of four lanes: a quarter of the loads of loadPerLane, whose inserts were
-// most of the ray filter's instructions.
-template <std::size_t kOffset>
+// Floats offset to offset + 3 of each lane's record of kStride floats (base[id * kStride +
+// offset + k] in fields[k]: a Ray's 16, a Triangle's 12), with one 128-bit load per lane and a
+// 4x4 transpose in each block, where a vector holds whole blocks of four lanes: a quarter of
+// the loads of loadPerLane, whose inserts were most of the ray filter's instructions.
+template <std::size_t kOffset, std::size_t kStride = 16>
 HWY_INLINE void loadQuadPerLane(const float* base, const std::uint32_t* idLanes, VF fields[4]) {
+    static_assert(kOffset + 4 <= kStride);
 #if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL || HWY_TARGET == HWY_AVX2
     const DF df;
     const hn::Repartition<double, DF> dd;
-    auto quad = [&](std::size_t lane) { return _mm_loadu_ps(base + std::size_t(idLanes[lane]) * 16 + kOffset); };
+    auto quad = [&](std::size_t lane) { return _mm_loadu_ps(base + std::size_t(idLanes[lane]) * kStride + kOffset); };
     // blocks[j]'s block k holds lane 4k + j's four floats.
     VF blocks[4];
     for (std::size_t j = 0; j < 4; ++j) {
@@ -113,7 +114,7 @@ HWY_INLINE void loadQuadPerLane(const float* base, const std::uint32_t* idLanes,
     fields[2] = hn::BitCast(df, hn::InterleaveLower(t1, t3));
     fields[3] = hn::BitCast(df, hn::InterleaveUpper(dd, t1, t3));
 #else
-    for (std::size_t k = 0; k < 4; ++k) fields[k] = loadPerLane<16>(base, idLanes, kOffset + k);
+    for (std::size_t k = 0; k < 4; ++k) fields[k] = loadPerLane<kStride>(base, idLanes, kOffset + k);
 #endif
 }
 
@@ -579,20 +580,22 @@ void ClassifyFacing(const Triangle* triangles, std::uint32_t count, const glm::v
     constexpr float u = 0x1p-24f;
     const VF errorScale = hn::Set(df, 32.0f * u), tiny = hn::Set(df, 1e-10f), margin = hn::Set(df, 1.001f);
     const VF perEdge = hn::Set(df, 480.0f * u), perReach = hn::Set(df, 200.0f * u * u);
-    // Consecutive triangles, so plain loads into lanes: gathers are the slower way here
-    // (AMD Zen 5: this kernel ran 1.5x faster on SSE4's emulated gathers than on AVX-512's).
-    alignas(64) float soa[10][64];
+    // Each lane's triangle by 16-byte quarters (v0 and cullBackFace, v1 and padding, v2 and
+    // padding), transposed in blocks: gathers are the slower way here (AMD Zen 5: this kernel
+    // ran 1.5x faster on SSE4's emulated gathers than on AVX-512's), and a copy float by float
+    // into lanes took more instructions than the tests.
+    alignas(64) std::uint32_t ids[64];
     for (std::uint32_t j = 0; j < count; j += std::uint32_t(n)) {
         const std::uint32_t here = std::min<std::uint32_t>(std::uint32_t(n), count - j);
-        for (std::uint32_t l = 0; l < n; ++l) {
-            const float* t = tri + std::size_t(j + std::min(l, here - 1)) * 12;
-            for (int f = 0; f < 3; ++f) soa[f][l] = t[f], soa[3 + f][l] = t[4 + f], soa[6 + f][l] = t[8 + f];
-            soa[9][l] = t[3];
-        }
+        for (std::uint32_t l = 0; l < n; ++l) ids[l] = j + std::min(l, here - 1);
+        VF quarters[3][4];
+        loadQuadPerLane<0, 12>(tri, ids, quarters[0]);
+        loadQuadPerLane<4, 12>(tri, ids, quarters[1]);
+        loadQuadPerLane<8, 12>(tri, ids, quarters[2]);
         VF v[3][3];
         for (int k = 0; k < 3; ++k)
-            for (int c = 0; c < 3; ++c) v[k][c] = hn::Load(df, soa[3 * k + c]);
-        const auto single = hn::RebindMask(df, hn::BitCast(du, hn::Load(df, soa[9])) != hn::Zero(du));
+            for (int c = 0; c < 3; ++c) v[k][c] = quarters[k][c];
+        const auto single = hn::RebindMask(df, hn::BitCast(du, quarters[0][3]) != hn::Zero(du));
         VF a[3], b[3], c[3], e1[3], e2[3], e3[3];
         for (int k = 0; k < 3; ++k) {
             a[k] = hn::Sub(v[0][k], o[k]);

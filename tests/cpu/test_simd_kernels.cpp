@@ -543,6 +543,34 @@ TEST_F(EveryTarget, FacingVerdictsNeverContradictTheFloat64Skip) {
     });
 }
 
+TEST_F(EveryTarget, FacingVerdictsDoNotDependOnTheLane) {
+    // Each triangle classified alone (every lane holding it) and among its neighbours, at each
+    // lane position and in a short last group: the same verdict, so the lanes take their own
+    // triangle's floats and cullBackFace word.
+    forEachTarget([] {
+        Random rng(11);
+        const glm::vec3 origin = rng.vec3(-2.0f, 2.0f);
+        std::vector<Triangle> tris(16 * 5 + 7);
+        for (Triangle& t : tris) {
+            const glm::vec3 centre = rng.vec3(-5.0f, 5.0f);
+            t.v0 = centre + rng.vec3(-1.0f, 1.0f);
+            t.v1 = centre + rng.vec3(-1.0f, 1.0f);
+            t.v2 = centre + rng.vec3(-1.0f, 1.0f);
+            t.cullBackFace = rng.uniform() < 0.8 ? 1u : 0u;
+        }
+        std::vector<std::uint8_t> together(tris.size());
+        simd::classifyFacing(tris.data(), std::uint32_t(tris.size()), origin, together.data());
+        std::size_t decided = 0;
+        for (std::size_t i = 0; i < tris.size(); ++i) {
+            std::uint8_t alone = 0xFF;
+            simd::classifyFacing(&tris[i], 1, origin, &alone);
+            ASSERT_EQ(together[i], alone) << "triangle " << i;
+            decided += alone != simd::kUndecided;
+        }
+        EXPECT_GT(decided, tris.size() / 2);
+    });
+}
+
 namespace {
 
 // A pass cull's grid of any shape: its axes a rotation of the scene's, 1 to 128 cells along
