@@ -64,16 +64,11 @@ std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles) {
 
 void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool& pool, std::vector<Bounds>& bounds,
                               Box& box) {
-    constexpr std::size_t kChunk = 16384;
     reserveMapped(bounds, triangles.size());
     bounds.resize(triangles.size());
-    const std::size_t chunks = (triangles.size() + kChunk - 1) / kChunk;
-    std::vector<Box> chunkBox(chunks);
-    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        const std::size_t begin = c * kChunk, end = std::min(triangles.size(), (c + 1) * kChunk);
-        Box b;
-        triangleBoundsLanes(triangles.data() + begin, end - begin, bounds.data() + begin, b);
-        chunkBox[c] = b;
+    std::vector<Box> chunkBox((triangles.size() + kFrameScanChunk - 1) / kFrameScanChunk);
+    forEachChunk(triangles.size(), kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        triangleBoundsLanes(triangles.data() + begin, end - begin, bounds.data() + begin, chunkBox[c]);
     });
     box = Box{};
     for (const Box& b : chunkBox) {

@@ -41,6 +41,10 @@ private:
     bool stopping_ = false;
 };
 
+// Elements per chunk of a frame's passes over its rays, hits or triangles (1 MiB of 64-byte
+// rays): enough work per hand-out, and chunks enough to share among the threads.
+constexpr std::size_t kFrameScanChunk = 16384;
+
 // Calls body(chunk, begin, end) for the ranges [begin, end) of at most `chunk` consecutive
 // indices that cover [0, n), on the pool (in order on the calling thread without one): for a
 // frame's passes over its rays or hits, which one thread would make serial.

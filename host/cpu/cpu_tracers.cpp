@@ -28,18 +28,17 @@ void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
 // pass over the rays, in chunks side by side on the pool (none: on the calling thread).
 bool startHits(const FrameGeometry& g, std::vector<Hit>& hits, ThreadPool* pool) {
     const std::vector<Ray>& rays = *g.rays;
-    constexpr std::size_t kChunk = 16384;
     reserveMapped(hits, rays.size());
     hits.resize(rays.size());
     if (g.uniformByConstruction) {  // one segment: every start the first ray's, the rays unread
         const Hit start = missHit(rays[0]);
-        forEachChunk(rays.size(), kChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
+        forEachChunk(rays.size(), kFrameScanChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
             std::fill(hits.begin() + std::ptrdiff_t(begin), hits.begin() + std::ptrdiff_t(end), start);
         });
         return true;
     }
-    std::vector<std::uint8_t> shareSegment((rays.size() + kChunk - 1) / kChunk, 1);
-    forEachChunk(rays.size(), kChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    std::vector<std::uint8_t> shareSegment((rays.size() + kFrameScanChunk - 1) / kFrameScanChunk, 1);
+    forEachChunk(rays.size(), kFrameScanChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
         bool share = true;
         for (std::size_t i = begin; i < end; ++i) {
             hits[i] = missHit(rays[i]);

@@ -10,10 +10,6 @@
 
 namespace dacrt {
 
-namespace {
-// Rays per chunk of a pass over a frame's rays (1 MiB of them).
-constexpr std::size_t kRayScanChunk = 16384;
-}  // namespace
 
 float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin) {
     float m = 0.0f;
@@ -25,7 +21,7 @@ float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin) {
 bool raysShareStart(const std::vector<Ray>& rays, ThreadPool* pool) {
     if (rays.empty()) return true;
     const Ray& first = rays.front();
-    return firstFailureInChunks(rays.size(), kRayScanChunk, pool, [&](std::size_t i) {
+    return firstFailureInChunks(rays.size(), kFrameScanChunk, pool, [&](std::size_t i) {
                return std::memcmp(&rays[i].origin, &first.origin, sizeof(first.origin)) == 0 &&
                       std::memcmp(&rays[i].tmin, &first.tmin, sizeof(first.tmin)) == 0;
            }) == rays.size();
@@ -57,8 +53,8 @@ FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::v
             glm::vec3 farthest{0.0f};
             bool towardLow[3] = {false, false, false}, towardHigh[3] = {false, false, false};
         };
-        std::vector<Reach> reach((rays.size() + kRayScanChunk - 1) / kRayScanChunk);
-        forEachChunk(rays.size(), kRayScanChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        std::vector<Reach> reach((rays.size() + kFrameScanChunk - 1) / kFrameScanChunk);
+        forEachChunk(rays.size(), kFrameScanChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
             Reach r;  // written to reach[c] once: neighbouring chunks' entries share cache lines
             for (std::size_t i = begin; i < end; ++i)
                 for (int a = 0; a < 3; ++a) {

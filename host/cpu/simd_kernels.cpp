@@ -592,9 +592,7 @@ void ClassifyFacing(const Triangle* triangles, std::uint32_t count, const glm::v
         loadQuadPerLane<0, 12>(tri, ids, quarters[0]);
         loadQuadPerLane<4, 12>(tri, ids, quarters[1]);
         loadQuadPerLane<8, 12>(tri, ids, quarters[2]);
-        VF v[3][3];
-        for (int k = 0; k < 3; ++k)
-            for (int c = 0; c < 3; ++c) v[k][c] = quarters[k][c];
+        const VF(&v)[3][4] = quarters;  // v[k][0..2]: vertex k's x, y, z
         const auto single = hn::RebindMask(df, hn::BitCast(du, quarters[0][3]) != hn::Zero(du));
         VF a[3], b[3], c[3], e1[3], e2[3], e3[3];
         for (int k = 0; k < 3; ++k) {

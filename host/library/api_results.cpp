@@ -56,7 +56,7 @@ TraceCounters countersOf(const TraceResult& result) {
 std::vector<RayHit> hitsOf(const std::vector<Hit>& hits, const std::vector<std::uint32_t>& callerIds, ThreadPool* pool) {
     std::vector<RayHit> out;
     resizeMapped(out, hits.size());
-    forEachChunk(hits.size(), 16384, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
+    forEachChunk(hits.size(), kFrameScanChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
             const Hit& h = hits[i];
             const bool named = h.prim != kMissPrim && h.prim != kUnnamedHitPrim && h.prim != kNotTracedPrim;
