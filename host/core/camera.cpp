@@ -125,6 +125,22 @@ std::optional<ViewFrustum> viewFrustum(const Camera& camera, int width, int heig
     f.apex = glm::dvec3(glm::vec3(camera.eye));
     f.inward = {glm::normalize(x * camera.forward + right), glm::normalize(x * camera.forward - right),
                 glm::normalize(y * camera.forward + camera.up), glm::normalize(y * camera.forward - camera.up)};
+    f.forward = camera.forward;
+    f.up = camera.up;
+    f.halfHeight = y;
+    f.rows = height;
+    return f;
+}
+
+ViewFrustum rowsFrustum(const ViewFrustum& frustum, int firstRow, int endRow) {
+    // PixelRays' rows span sy = (1 - 2 (row + offset) / rows) halfHeight, offset in [0, 1]: from
+    // `top` at firstRow's upper edge down to `bottom` at the last row's lower edge. n . d is
+    // affine in sy, so those edges bound it, as viewFrustum's do.
+    const double top = (1.0 - 2.0 * firstRow / frustum.rows) * frustum.halfHeight;
+    const double bottom = (1.0 - 2.0 * endRow / frustum.rows) * frustum.halfHeight;
+    ViewFrustum f = frustum;
+    f.inward[2] = glm::normalize(frustum.up - bottom * frustum.forward);
+    f.inward[3] = glm::normalize(top * frustum.forward - frustum.up);
     return f;
 }
 

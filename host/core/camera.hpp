@@ -41,12 +41,21 @@ std::vector<Camera> makeCameras(const Scene& scene, const Box& bounds, const Cam
 // any point of a pixel (primaryRays' offset in [0, 1]^2): planes through the rays' float32
 // origin, unit normals pointing inward. Exact in real arithmetic (the pixel rectangle's edges);
 // the rays' rounding to float32 moves them at most 2^-23 outside, which users must allow for.
+// inward: the left, right, bottom and top planes. The camera's basis and the rows it was made
+// for let rowsFrustum narrow it to a band of the image's rows.
 struct ViewFrustum {
     glm::dvec3 apex{0.0};
     std::array<glm::dvec3, 4> inward{};
+    glm::dvec3 forward{0.0}, up{0.0};
+    double halfHeight = 0.0;  // tan(yfov / 2): the top row's edge is forward + halfHeight up
+    int rows = 0;             // the image's height in pixels
 };
 // Empty for an orthographic camera, whose rays share no apex.
 std::optional<ViewFrustum> viewFrustum(const Camera& camera, int width, int height);
+// The pyramid the primary rays of pixel rows [firstRow, endRow) lie in, for any point of their
+// pixels: `frustum` with its bottom and top planes through those rows' outer edges (the same
+// bound, in real arithmetic, as the whole image's).
+ViewFrustum rowsFrustum(const ViewFrustum& frustum, int firstRow, int endRow);
 
 // Canonical float32 ray from an origin and a direction of any length: normalized in double,
 // rounded to float, components below 2^-64 flushed to zero (so 1/dir <= 2^64), and the

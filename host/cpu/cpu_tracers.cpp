@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "cpu/backend_options.hpp"
-#include "cpu/ray_grouping.hpp"
+#include "cpu/image_bands.hpp"
 #include "cpu/traversal.hpp"
 #include "core/errors.hpp"
 #include "core/mapped_memory.hpp"
@@ -225,14 +225,13 @@ void fillTracedTriangleIds(const FrameGeometry& g, std::vector<std::uint32_t>& i
     for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = g.tracedTriangle(i);
 }
 
-// One sequential DACRT of the rays rayIds[0, rayCount) over every traced triangle, from the
-// scene box down; culled and finished rays counted.
+// One sequential DACRT of the rays rayIds[0, rayCount) over the triangles triIds[0, triCount),
+// from the scene box down; culled and finished rays counted.
 void traceRayIds(const FrameGeometry& g, const DacrtOptions& options, const TraversalBuffers& buffers,
-                 std::uint32_t rayCount, Counters& counters) {
+                 std::uint32_t rayCount, std::uint32_t triCount, Counters& counters) {
     DacrtTraversal traversal(g, options, buffers, counters);
     std::uint32_t finished = 0;  // the pivot: rays before it are finished
-    const std::uint32_t crossing =
-        traversal.trace(g.sceneBox, finished, rayCount, 0, std::uint32_t(g.tracedTriangleCount()));
+    const std::uint32_t crossing = traversal.trace(g.sceneBox, finished, rayCount, 0, triCount);
     counters.raysCulled += rayCount - crossing;
     counters.finishedStep1 += finished;
 }
@@ -261,26 +260,8 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     traceRayIds(g, options,
                 {result.hits.data(), rayIds.data(), triIds.data(), scratchIds ? scratch.data() : nullptr,
                  packets.forWorker(0), raysShareSegment},
-                rayCount, result.counters);
+                rayCount, triCount, result.counters);
     return result;
-}
-
-std::vector<std::uint32_t> imageBands(const FrameGeometry& g, unsigned workers) {
-    const std::uint32_t rays = std::uint32_t(g.rays->size());
-    if (!g.imageWidth || g.query != HitQuery::Closest || workers < 2 || rays % g.imageWidth != 0) return {};
-    // Whole rows of tiles: a band's packets are the image's own (buildPackets tiles by ray id).
-    const std::uint32_t tileRows = (rays / g.imageWidth + kPacketTile - 1) / kPacketTile;
-    const std::vector<std::size_t> batches = rayBatches(tileRows, std::max<std::size_t>(
-                                                                      1, passBatchRays(g.triangles->size()) /
-                                                                             (std::size_t(g.imageWidth) * kPacketTile)),
-                                                        workers);
-    // More batches than tile rows (a short image, many workers) leave some empty: dropped.
-    std::vector<std::uint32_t> starts;
-    for (std::size_t b : batches) {
-        const std::uint32_t start = std::min(rays, std::uint32_t(b) * kPacketTile * g.imageWidth);
-        if (starts.empty() || start != starts.back()) starts.push_back(start);
-    }
-    return starts.size() > 2 ? starts : std::vector<std::uint32_t>{};
 }
 
 TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options, ThreadPool& pool,
@@ -299,7 +280,10 @@ TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options,
     const std::uint64_t scratchIds = usesSimd(g, resolved) ? partitionScratchIds(widest, triCount) : 0;
     planFrameInputs(g, result.memory);
     result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
-    result.memory.add("triangle ids (per thread)", std::uint64_t(triCount) * 4 * busy);
+    // Each band's own triangle ids (bandTriangleIds: at most every traced one a band), and the
+    // bands each traced triangle reaches.
+    result.memory.add("triangle ids (per band, at most)", std::uint64_t(triCount) * 4 * bandCount);
+    result.memory.add("bands of each triangle", std::uint64_t(triCount) * 4);
     if (scratchIds) result.memory.add("partition scratch (per thread)", scratchIds * 4 * busy);
     planPacketBuffers(g, resolved, scratchIds, threads, result.memory);
     result.memory.work.push_back({"image bands side by side", bandCount,
@@ -311,17 +295,16 @@ TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options,
     const bool raysShareSegment = startHits(g, result.hits, &pool);
     std::vector<std::uint32_t> rayIds(rayCount);
     std::iota(rayIds.begin(), rayIds.end(), 0u);
-    std::vector<std::vector<std::uint32_t>> triIds(threads), scratch(threads);
+    // The traversal permutes its band's ids.
+    std::vector<std::vector<std::uint32_t>> triIds = bandTriangleIds(g, bands, pool), scratch(threads);
     PacketStorage packets(g, resolved, scratchIds, threads);
     std::vector<Counters> counters(threads);
     pool.parallelFor(bandCount, [&](std::size_t b, unsigned w) {
-        // The traversal permutes its triangle ids: each band starts from the traced ones.
-        fillTracedTriangleIds(g, triIds[w]);
         scratch[w].resize(scratchIds);
         traceRayIds(g, options,
-                    {result.hits.data(), rayIds.data() + bands[b], triIds[w].data(),
+                    {result.hits.data(), rayIds.data() + bands[b], triIds[b].data(),
                      scratchIds ? scratch[w].data() : nullptr, packets.forWorker(w), raysShareSegment},
-                    bands[b + 1] - bands[b], counters[w]);
+                    bands[b + 1] - bands[b], std::uint32_t(triIds[b].size()), counters[w]);
     });
     for (const Counters& c : counters) {
         result.counters.add(c);

@@ -25,15 +25,9 @@ TraceResult traceSequential(const FrameGeometry& geometry, const DacrtOptions& o
 TraceResult traceParallel(const FrameGeometry& geometry, const TraceOptions& options, ThreadPool& pool,
                           const PlanHook& onPlan = {});
 
-// A closest-hit frame of an image's rays in bands of whole rows of 8x8 tiles, for `workers`
-// workers: where each band starts, then the end (rayBatches of passBatchRays' size, as a
-// multiple of the workers, in tile rows). Empty where the frame is no such image, a worker
-// is alone, or one band would hold it.
-std::vector<std::uint32_t> imageBands(const FrameGeometry& geometry, unsigned workers);
-
-// The bands side by side: each a sequential DACRT over every traced triangle, its rays the
-// band's ids into the frame's arrays (packets and hits are the frame's), on one worker at a
-// time. Exact as traceSequential is: no division, no transfer rounds. The cpu backend's
+// The bands side by side (imageBands, image_bands.hpp): each a sequential DACRT over the
+// traced triangles its rays can reach (bandTriangleIds), its rays the band's ids into the
+// frame's arrays (packets and hits are the frame's), on one worker at a time. Exact as traceSequential is: no division, no transfer rounds. The cpu backend's
 // primary frames where --regions is not given (docs/cpu-reference.md, "Image bands").
 TraceResult traceImageBands(const FrameGeometry& geometry, const DacrtOptions& options, ThreadPool& pool,
                             const std::vector<std::uint32_t>& bands, const PlanHook& onPlan = {});

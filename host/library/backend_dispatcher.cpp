@@ -12,6 +12,7 @@
 #include "core/timing.hpp"
 #include "cpu/backend_options.hpp"
 #include "cpu/cpu_tracers.hpp"
+#include "cpu/image_bands.hpp"
 #include "cpu/pass_cull.hpp"
 #include "cpu/triangle_skips.hpp"
 #include "gpu/device_defaults.hpp"

@@ -7,6 +7,7 @@
 #include "core/gltf_loader.hpp"
 #include "core/procedural.hpp"
 #include "cpu/cpu_tracers.hpp"
+#include "cpu/image_bands.hpp"
 #include "cpu/traversal.hpp"
 #include "support/frames.hpp"
 

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cpu/cpu_tracers.hpp"
+#include "cpu/image_bands.hpp"
 #include "gpu/device_defaults.hpp"
 #include "support/dispatcher_passes.hpp"
 #include "support/frames.hpp"

@@ -1,0 +1,200 @@
+#include "cpu/image_bands.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <string>
+
+#include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
+
+#include "core/errors.hpp"
+#include "cpu/ray_grouping.hpp"
+#include "cpu/ray_packet.hpp"
+#include "cpu/triangle_skips.hpp"
+
+namespace dacrt {
+namespace {
+
+// Enough for a row's share to within a few per cent on 60 rows of tiles (640x480), and few
+// enough that the sample costs a small part of a band's own pass over the triangles.
+constexpr std::size_t kSampledTriangles = 8192;
+// Rays of a row tested against the scene box: the share of the row's rays the DACRT works on
+// (those that miss the box end at its first filter).
+constexpr std::uint32_t kSampledRaysPerRow = 16;
+// What a ray that reaches the scene box weighs against a triangle: from outside the box, a
+// twentieth (packets filter the rays 64 at a time down the tree, and most of the rays that reach
+// the box of a model, the Bunny or the Dragon, miss the model and leave the tree early); from
+// inside, one (every ray meets the scene, a room's walls, and pays its leaf tests, so a scene of
+// few triangles seen from inside is cut in nearly equal rows). Of 1, 0.25, 0.1, 0.05 and 0.02 for
+// the rays from outside, a twentieth left the Bunny's and the Dragon's bands nearest to equal
+// times (docs/benchmarks.md, "Image bands of equal work").
+constexpr double kRayWorkFromOutside = 0.05, kRayWorkFromInside = 1.0;
+
+// Whether the segment [tmin, tmax] of a ray crosses box b: a slab test, an estimate only (no
+// margin, no tie rules).
+bool crossesBox(const Ray& ray, const Box& b) {
+    float enter = ray.tmin, exit = ray.tmax;
+    for (int a = 0; a < 3; ++a) {
+        if (ray.dir[a] == 0.0f) {
+            if (ray.origin[a] < b.lo[a] || ray.origin[a] > b.hi[a]) return false;
+            continue;
+        }
+        float t0 = (b.lo[a] - ray.origin[a]) / ray.dir[a], t1 = (b.hi[a] - ray.origin[a]) / ray.dir[a];
+        if (t0 > t1) std::swap(t0, t1);
+        enter = std::max(enter, t0);
+        exit = std::min(exit, t1);
+    }
+    return enter <= exit;
+}
+
+std::uint32_t imageRows(const FrameGeometry& g) { return std::uint32_t(g.rays->size() / g.imageWidth); }
+
+// The frame's view frustum where it is the pyramid of these rays' rows (the camera's image).
+const ViewFrustum* rowsOfRays(const FrameGeometry& g) {
+    return g.frustum && g.imageWidth && g.frustum->rows > 0 && std::uint32_t(g.frustum->rows) == imageRows(g)
+               ? &*g.frustum
+               : nullptr;
+}
+
+}  // namespace
+
+std::vector<double> tileRowWork(const FrameGeometry& g) {
+    const ViewFrustum* f = rowsOfRays(g);
+    if (!f) return {};
+    const std::uint32_t width = g.imageWidth, height = imageRows(g);
+    const std::uint32_t tileRows = (height + kPacketTile - 1) / kPacketTile;
+    std::vector<double> work(tileRows, 0.0);
+    // Triangles: each sampled one's bounds centre in the row of tiles it projects into (sy =
+    // (1 - 2 row / rows) halfHeight, as PixelRays makes the rows), as stride triangles.
+    const std::size_t traced = g.tracedTriangleCount();
+    const std::size_t stride = std::max<std::size_t>(1, traced / kSampledTriangles);
+    for (std::size_t i = 0; i < traced; i += stride) {
+        const Bounds& b = (*g.triangleBounds)[g.tracedTriangle(i)];
+        const glm::dvec3 toCentre = 0.5 * (glm::dvec3(b.lo) + glm::dvec3(b.hi)) - f->apex;
+        const double depth = glm::dot(toCentre, f->forward);
+        if (!(depth > 0.0)) continue;
+        const double row = 0.5 * (1.0 - glm::dot(toCentre, f->up) / (depth * f->halfHeight)) * height;
+        if (!(row >= 0.0 && row < double(height))) continue;
+        work[std::size_t(row) / kPacketTile] += double(stride);
+    }
+    // Rays: each row's that reach the scene box, from a sample of its middle pixel row.
+    const glm::vec3 eye(f->apex);
+    const bool inside = glm::all(glm::greaterThanEqual(eye, g.sceneBox.lo)) && glm::all(glm::lessThanEqual(eye, g.sceneBox.hi));
+    const double rayWork = inside ? kRayWorkFromInside : kRayWorkFromOutside;
+    for (std::uint32_t r = 0; r < tileRows; ++r) {
+        const std::uint32_t y = std::min(height - 1, r * kPacketTile + kPacketTile / 2);
+        const std::uint32_t rowRays = (std::min(height, (r + 1) * kPacketTile) - r * kPacketTile) * width;
+        std::uint32_t crossing = 0;
+        for (std::uint32_t s = 0; s < kSampledRaysPerRow; ++s)
+            crossing += crossesBox((*g.rays)[std::size_t(y) * width + (2 * s + 1) * width / (2 * kSampledRaysPerRow)],
+                                   g.sceneBox);
+        work[r] += rayWork * double(rowRays) * crossing / kSampledRaysPerRow;
+    }
+    if (!std::any_of(work.begin(), work.end(), [](double w) { return w > 0.0; })) return {};
+    return work;
+}
+
+std::vector<std::uint32_t> bandsOfEqualWork(const std::vector<double>& rowWork, std::size_t bands) {
+    const std::size_t rows = rowWork.size();
+    bands = std::min(bands, rows);
+    std::vector<double> before(rows + 1, 0.0);  // before[r]: the work of rows [0, r)
+    for (std::size_t r = 0; r < rows; ++r) before[r + 1] = before[r] + rowWork[r];
+    std::vector<std::uint32_t> starts{0};
+    for (std::size_t b = 1; b < bands; ++b) {
+        const double target = before[rows] * double(b) / double(bands);
+        // The first start whose rows before it reach the target, or the one before it where
+        // that is nearer; each band at least one row, and a row left for each band after.
+        const std::size_t lowest = starts.back() + 1, highest = rows - (bands - b);
+        std::size_t r = std::size_t(std::lower_bound(before.begin() + std::ptrdiff_t(lowest),
+                                                     before.begin() + std::ptrdiff_t(highest) + 1, target) -
+                                    before.begin());
+        r = std::min(r, highest);
+        if (r > lowest && target - before[r - 1] < before[r] - target) --r;
+        starts.push_back(std::uint32_t(r));
+    }
+    starts.push_back(std::uint32_t(rows));
+    return starts;
+}
+
+std::vector<std::uint32_t> imageBands(const FrameGeometry& g, unsigned workers) {
+    const std::uint32_t rays = std::uint32_t(g.rays->size());
+    if (!g.imageWidth || g.query != HitQuery::Closest || workers < 2 || rays % g.imageWidth != 0) return {};
+    // Whole rows of tiles: a band's packets are the image's own (buildPackets tiles by ray id).
+    const std::uint32_t tileRows = (imageRows(g) + kPacketTile - 1) / kPacketTile;
+    const std::size_t mostTileRows =
+        std::max<std::size_t>(1, passBatchRays(g.triangles->size()) / (std::size_t(g.imageWidth) * kPacketTile));
+    const std::size_t bands = std::min<std::size_t>(rayBatches(tileRows, mostTileRows, workers).size() - 1, tileRows);
+    if (bands < 2) return {};
+    const std::vector<double> work = tileRowWork(g);
+    std::vector<std::uint32_t> starts = bandsOfEqualWork(work.empty() ? std::vector<double>(tileRows, 1.0) : work, bands);
+    for (std::uint32_t& s : starts) s = std::min(rays, s * kPacketTile * g.imageWidth);
+    return starts;
+}
+
+BandEdges::BandEdges(const ViewFrustum& frustum, const std::vector<std::uint32_t>& startRows)
+    : apex_(glm::vec3(frustum.apex)) {
+    if (startRows.size() < 2 || startRows.size() - 1 > kMostBands)
+        throw InternalError("BandEdges: " + std::to_string(startRows.size()) + " band starts, at most " +
+                            std::to_string(kMostBands + 1) + " allowed");
+    // rowsFrustum's bottom plane of the rows above each inner start is that start's edge.
+    for (std::size_t k = 1; k + 1 < startRows.size(); ++k)
+        up_[edges_++] = glm::vec3(rowsFrustum(frustum, 0, int(startRows[k])).inward[2]);
+}
+
+std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, const std::vector<std::uint32_t>& bands,
+                                                        ThreadPool& pool) {
+    const std::size_t bandCount = bands.size() - 1, traced = g.tracedTriangleCount();
+    std::vector<std::vector<std::uint32_t>> ids(bandCount);
+    const ViewFrustum* f = rowsOfRays(g);
+    if (!f || bandCount > BandEdges::kMostBands) {
+        for (std::vector<std::uint32_t>& band : ids) {
+            band.resize(traced);
+            forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t, std::size_t begin, std::size_t end) {
+                for (std::size_t i = begin; i < end; ++i) band[i] = g.tracedTriangle(i);
+            });
+        }
+        return ids;
+    }
+    std::vector<std::uint32_t> startRows;
+    for (std::uint32_t start : bands) startRows.push_back(start / g.imageWidth);
+    const BandEdges edges(*f, startRows);
+    // Each traced triangle's bands, and how many each chunk gives each band.
+    const std::size_t chunks = (traced + kFrameScanChunk - 1) / kFrameScanChunk;
+    std::vector<std::uint32_t> reached(traced);
+    std::vector<std::uint32_t> counts(chunks * bandCount, 0);
+    forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        // Counted locally: neighbouring chunks' counts share cache lines.
+        std::uint32_t count[BandEdges::kMostBands] = {};
+        // The traced ids skip about half the bounds, and the test leaves few loads in flight:
+        // each is asked for kPrefetchAhead triangles early.
+        constexpr std::size_t kPrefetchAhead = 32;
+        for (std::size_t i = begin; i < end; ++i) {
+            if (i + kPrefetchAhead < end) __builtin_prefetch(&(*g.triangleBounds)[g.tracedTriangle(i + kPrefetchAhead)]);
+            const std::uint32_t mask = edges.bandsOf((*g.triangleBounds)[g.tracedTriangle(i)]);
+            reached[i] = mask;
+            // Without a branch on the mask: a straddling triangle's bands are unpredictable.
+            for (std::size_t b = 0; b < bandCount; ++b) count[b] += (mask >> b) & 1u;
+        }
+        std::copy(count, count + bandCount, &counts[c * bandCount]);
+    });
+    // Chunk c's triangles of band b go after those of the chunks before it.
+    std::vector<std::size_t> offset(chunks * bandCount);
+    for (std::size_t b = 0; b < bandCount; ++b) {
+        std::size_t total = 0;
+        for (std::size_t c = 0; c < chunks; ++c) offset[c * bandCount + b] = total, total += counts[c * bandCount + b];
+        ids[b].resize(total);
+    }
+    forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        std::size_t next[BandEdges::kMostBands];
+        std::copy(&offset[c * bandCount], &offset[c * bandCount] + bandCount, next);
+        for (std::size_t i = begin; i < end; ++i)
+            for (std::uint32_t m = reached[i]; m; m &= m - 1) {
+                const int b = std::countr_zero(m);
+                ids[std::size_t(b)][next[b]++] = g.tracedTriangle(i);
+            }
+    });
+    return ids;
+}
+
+}  // namespace dacrt
