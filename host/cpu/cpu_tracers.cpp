@@ -281,9 +281,10 @@ TraceResult traceImageBands(const FrameGeometry& g, const DacrtOptions& options,
     planFrameInputs(g, result.memory);
     result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
     // Each band's own triangle ids (bandTriangleIds: at most every traced one a band), and the
-    // bands each traced triangle reaches.
+    // bands each traced triangle reaches (with each chunk's count and offset a band).
     result.memory.add("triangle ids (per band, at most)", std::uint64_t(triCount) * 4 * bandCount);
-    result.memory.add("bands of each triangle", std::uint64_t(triCount) * 4);
+    result.memory.add("bands of each triangle", std::uint64_t(triCount) * 8 +
+                                                    (triCount / kFrameScanChunk + 1) * bandCount * 12);
     if (scratchIds) result.memory.add("partition scratch (per thread)", scratchIds * 4 * busy);
     planPacketBuffers(g, resolved, scratchIds, threads, result.memory);
     result.memory.work.push_back({"image bands side by side", bandCount,

@@ -1,7 +1,6 @@
 #include "cpu/image_bands.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <string>
 
@@ -50,9 +49,11 @@ bool crossesBox(const Ray& ray, const Box& b) {
 
 std::uint32_t imageRows(const FrameGeometry& g) { return std::uint32_t(g.rays->size() / g.imageWidth); }
 
-// The frame's view frustum where it is the pyramid of these rays' rows (the camera's image).
+// The frame's view frustum where it is the pyramid of these rays' rows: the camera's image,
+// its rays from the frustum's apex.
 const ViewFrustum* rowsOfRays(const FrameGeometry& g) {
-    return g.frustum && g.imageWidth && g.frustum->rows > 0 && std::uint32_t(g.frustum->rows) == imageRows(g)
+    return g.frustum && g.imageWidth && g.frustum->rows > 0 && std::uint32_t(g.frustum->rows) == imageRows(g) &&
+                   g.raysShareStart && g.rayOrigin == glm::vec3(g.frustum->apex)
                ? &*g.frustum
                : nullptr;
 }
@@ -69,7 +70,11 @@ std::vector<double> tileRowWork(const FrameGeometry& g) {
     // (1 - 2 row / rows) halfHeight, as PixelRays makes the rows), as stride triangles.
     const std::size_t traced = g.tracedTriangleCount();
     const std::size_t stride = std::max<std::size_t>(1, traced / kSampledTriangles);
+    // The samples are far apart in memory: each is asked for kPrefetchAhead samples early.
+    constexpr std::size_t kPrefetchAhead = 16;
     for (std::size_t i = 0; i < traced; i += stride) {
+        if (i + kPrefetchAhead * stride < traced)
+            __builtin_prefetch(&(*g.triangleBounds)[g.tracedTriangle(i + kPrefetchAhead * stride)]);
         const Bounds& b = (*g.triangleBounds)[g.tracedTriangle(i)];
         const glm::dvec3 toCentre = 0.5 * (glm::dvec3(b.lo) + glm::dvec3(b.hi)) - f->apex;
         const double depth = glm::dot(toCentre, f->forward);
@@ -117,15 +122,22 @@ std::vector<std::uint32_t> bandsOfEqualWork(const std::vector<double>& rowWork, 
     return starts;
 }
 
-std::vector<std::uint32_t> imageBands(const FrameGeometry& g, unsigned workers) {
+std::size_t imageBandCount(const FrameGeometry& g, unsigned workers) {
     const std::uint32_t rays = std::uint32_t(g.rays->size());
-    if (!g.imageWidth || g.query != HitQuery::Closest || workers < 2 || rays % g.imageWidth != 0) return {};
+    if (!g.imageWidth || g.query != HitQuery::Closest || workers < 2 || rays % g.imageWidth != 0) return 0;
     // Whole rows of tiles: a band's packets are the image's own (buildPackets tiles by ray id).
     const std::uint32_t tileRows = (imageRows(g) + kPacketTile - 1) / kPacketTile;
     const std::size_t mostTileRows =
         std::max<std::size_t>(1, passBatchRays(g.triangles->size()) / (std::size_t(g.imageWidth) * kPacketTile));
     const std::size_t bands = std::min<std::size_t>(rayBatches(tileRows, mostTileRows, workers).size() - 1, tileRows);
-    if (bands < 2) return {};
+    return bands < 2 ? 0 : bands;
+}
+
+std::vector<std::uint32_t> imageBands(const FrameGeometry& g, unsigned workers) {
+    const std::size_t bands = imageBandCount(g, workers);
+    if (bands == 0) return {};
+    const std::uint32_t rays = std::uint32_t(g.rays->size());
+    const std::uint32_t tileRows = (imageRows(g) + kPacketTile - 1) / kPacketTile;
     const std::vector<double> work = tileRowWork(g);
     std::vector<std::uint32_t> starts = bandsOfEqualWork(work.empty() ? std::vector<double>(tileRows, 1.0) : work, bands);
     for (std::uint32_t& s : starts) s = std::min(rays, s * kPacketTile * g.imageWidth);
@@ -134,12 +146,9 @@ std::vector<std::uint32_t> imageBands(const FrameGeometry& g, unsigned workers) 
 
 BandEdges::BandEdges(const ViewFrustum& frustum, const std::vector<std::uint32_t>& startRows)
     : apex_(glm::vec3(frustum.apex)) {
-    if (startRows.size() < 2 || startRows.size() - 1 > kMostBands)
-        throw InternalError("BandEdges: " + std::to_string(startRows.size()) + " band starts, at most " +
-                            std::to_string(kMostBands + 1) + " allowed");
     // rowsFrustum's bottom plane of the rows above each inner start is that start's edge.
     for (std::size_t k = 1; k + 1 < startRows.size(); ++k)
-        up_[edges_++] = glm::vec3(rowsFrustum(frustum, 0, int(startRows[k])).inward[2]);
+        up_.push_back(glm::vec3(rowsFrustum(frustum, 0, int(startRows[k])).inward[2]));
 }
 
 std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, const std::vector<std::uint32_t>& bands,
@@ -147,7 +156,7 @@ std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, 
     const std::size_t bandCount = bands.size() - 1, traced = g.tracedTriangleCount();
     std::vector<std::vector<std::uint32_t>> ids(bandCount);
     const ViewFrustum* f = rowsOfRays(g);
-    if (!f || bandCount > BandEdges::kMostBands) {
+    if (!f) {
         for (std::vector<std::uint32_t>& band : ids) {
             band.resize(traced);
             forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t, std::size_t begin, std::size_t end) {
@@ -157,26 +166,30 @@ std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, 
         return ids;
     }
     std::vector<std::uint32_t> startRows;
-    for (std::uint32_t start : bands) startRows.push_back(start / g.imageWidth);
+    for (std::uint32_t start : bands) {
+        // A band's rows are whole: a partial row would lie beyond the band's bottom edge.
+        if (start % g.imageWidth != 0)
+            throw InternalError("bandTriangleIds: band start " + std::to_string(start) + " inside a row of " +
+                                std::to_string(g.imageWidth) + " rays");
+        startRows.push_back(start / g.imageWidth);
+    }
     const BandEdges edges(*f, startRows);
     // Each traced triangle's bands, and how many each chunk gives each band.
     const std::size_t chunks = (traced + kFrameScanChunk - 1) / kFrameScanChunk;
-    std::vector<std::uint32_t> reached(traced);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> reached(traced);
     std::vector<std::uint32_t> counts(chunks * bandCount, 0);
     forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
         // Counted locally: neighbouring chunks' counts share cache lines.
-        std::uint32_t count[BandEdges::kMostBands] = {};
+        std::vector<std::uint32_t> count(bandCount, 0);
         // The traced ids skip about half the bounds, and the test leaves few loads in flight:
         // each is asked for kPrefetchAhead triangles early.
         constexpr std::size_t kPrefetchAhead = 32;
         for (std::size_t i = begin; i < end; ++i) {
             if (i + kPrefetchAhead < end) __builtin_prefetch(&(*g.triangleBounds)[g.tracedTriangle(i + kPrefetchAhead)]);
-            const std::uint32_t mask = edges.bandsOf((*g.triangleBounds)[g.tracedTriangle(i)]);
-            reached[i] = mask;
-            // Without a branch on the mask: a straddling triangle's bands are unpredictable.
-            for (std::size_t b = 0; b < bandCount; ++b) count[b] += (mask >> b) & 1u;
+            const auto [first, last] = reached[i] = edges.bandsOf((*g.triangleBounds)[g.tracedTriangle(i)]);
+            for (std::uint32_t b = first; b <= last; ++b) ++count[b];
         }
-        std::copy(count, count + bandCount, &counts[c * bandCount]);
+        std::copy(count.begin(), count.end(), &counts[c * bandCount]);
     });
     // Chunk c's triangles of band b go after those of the chunks before it.
     std::vector<std::size_t> offset(chunks * bandCount);
@@ -186,13 +199,9 @@ std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, 
         ids[b].resize(total);
     }
     forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
-        std::size_t next[BandEdges::kMostBands];
-        std::copy(&offset[c * bandCount], &offset[c * bandCount] + bandCount, next);
+        std::vector<std::size_t> next(&offset[c * bandCount], &offset[c * bandCount] + bandCount);
         for (std::size_t i = begin; i < end; ++i)
-            for (std::uint32_t m = reached[i]; m; m &= m - 1) {
-                const int b = std::countr_zero(m);
-                ids[std::size_t(b)][next[b]++] = g.tracedTriangle(i);
-            }
+            for (std::uint32_t b = reached[i].first; b <= reached[i].second; ++b) ids[b][next[b]++] = g.tracedTriangle(i);
     });
     return ids;
 }

@@ -6,8 +6,8 @@
 // lying mostly in the image's lower half; and a band whose rows crossed the DACRT's first
 // split filtered the far side's triangles down several levels for a few rows of rays.
 
-#include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <glm/common.hpp>
@@ -17,12 +17,15 @@
 
 namespace dacrt {
 
-// A closest-hit frame of an image's rays in bands of whole rows of 8x8 tiles, for `workers`
-// workers: where each band starts, then the end. As many bands as rayBatches gives for batches
-// of passBatchRays' size, as a multiple of the workers, in tile rows (at most one a row);
-// each band as near an equal share of tileRowWork as whole rows allow, equal rows where that
-// is empty. Empty where the frame is no such image, a worker is alone, or one band would hold
-// it.
+// How many bands imageBands cuts the frame into for `workers` workers (0 where it does not):
+// as many as rayBatches gives for batches of passBatchRays' size, as a multiple of the workers,
+// in tile rows, at most one a row of tiles.
+std::size_t imageBandCount(const FrameGeometry& geometry, unsigned workers);
+
+// A closest-hit frame of an image's rays in imageBandCount bands of whole rows of 8x8 tiles:
+// where each band starts, then the end, each band as near an equal share of tileRowWork as
+// whole rows allow, equal rows where that is empty. Empty where the frame is no such image, a
+// worker is alone, or one band would hold it.
 std::vector<std::uint32_t> imageBands(const FrameGeometry& geometry, unsigned workers);
 
 // The bands' edges between one another, as planes through a perspective camera's apex: which
@@ -32,41 +35,44 @@ std::vector<std::uint32_t> imageBands(const FrameGeometry& geometry, unsigned wo
 // distance's L1 norm, which float32's few roundings of the sum, at most 10 u of it, cannot
 // bring under the L2 bound): then every vertex lies outside that edge as outsideFrustum asks,
 // and no ray of the band can hit the triangle. The image's own top and bottom edges are the
-// view frustum skip's, not tested here.
+// view frustum skip's, not tested here. The bands' triangles are part of the bands, which
+// --no-skip subscenes turns off; --no-skip frustum does not.
 class BandEdges {
 public:
-    static constexpr std::size_t kMostBands = 32;  // a band a bit of bandsOf
-    // startRows: each band's first pixel row, then the image's rows (frustum.rows); at most
-    // kMostBands bands (InternalError beyond).
+    // startRows: each band's first pixel row, then the image's rows (frustum.rows).
     BandEdges(const ViewFrustum& frustum, const std::vector<std::uint32_t>& startRows);
-    // Bit b set: a ray of band b may hit a triangle within these bounds.
-    std::uint32_t bandsOf(const Bounds& b) const {
+    // The first and the last band whose rays may hit a triangle within these bounds (first >
+    // last: none). Every band between them is taken too: a box beyond an edge on both sides of
+    // a band (behind the camera) may leave bands out between two it reaches.
+    std::pair<std::uint32_t, std::uint32_t> bandsOf(const Bounds& b) const {
         const glm::vec3 lo = b.lo - apex_, hi = b.hi - apex_;
         const glm::vec3 far = glm::max(glm::abs(lo), glm::abs(hi));
         const float slack = 0x1p-11f * (far.x + far.y + far.z);
-        std::uint32_t mask = edges_ + 1 == kMostBands ? ~0u : (1u << (edges_ + 1)) - 1u;
-        for (std::size_t k = 0; k < edges_; ++k) {
+        std::uint32_t first = std::uint32_t(up_.size()) + 1, last = 0;
+        bool reachesPrevious = true;  // band 0 has no top edge but the image's
+        for (std::uint32_t k = 0; k < up_.size(); ++k) {
             const glm::vec3 atLo = up_[k] * lo, atHi = up_[k] * hi;
             // The largest and smallest n . (corner - apex) over the box's corners: no vertex
             // lies farther towards band k, or towards band k + 1.
             const glm::vec3 most = glm::max(atLo, atHi), least = glm::min(atLo, atHi);
-            if (most.x + most.y + most.z < -slack) mask &= ~(1u << k);             // below band k
-            if (least.x + least.y + least.z > slack) mask &= ~(1u << (k + 1));     // above band k + 1
+            const bool reachesK = reachesPrevious && !(most.x + most.y + most.z < -slack);  // not below band k
+            if (reachesK) first = std::min(first, k), last = k;
+            reachesPrevious = !(least.x + least.y + least.z > slack);  // band k + 1: not above its top
         }
-        return mask;
+        if (reachesPrevious) first = std::min(first, std::uint32_t(up_.size())), last = std::uint32_t(up_.size());
+        return {first, last};
     }
 
 private:
     glm::vec3 apex_;
-    // up_[k]: the edge between bands k and k + 1, its normal towards band k.
-    std::array<glm::vec3, kMostBands - 1> up_{};
-    std::size_t edges_ = 0;
+    std::vector<glm::vec3> up_;  // up_[k]: the edge between bands k and k + 1, its normal towards band k
 };
 
-// For each band (imageBands' starts, in rays, then the end), the traced triangles its rays can
-// reach (BandEdges), ascending: one pass over the traced triangles' bounds in chunks on the
-// pool, then the bands' lists. Every traced triangle in each band where the frame has no view
-// frustum of its rows or the bands are more than BandEdges::kMostBands.
+// For each band (imageBands' starts, in rays, whole image rows, then the end), the traced
+// triangles its rays can reach (BandEdges), ascending: one pass over the traced triangles'
+// bounds in chunks on the pool, then the bands' lists. Every traced triangle in each band where
+// the frame has no view frustum of its rays' rows from their shared origin. InternalError where
+// a start is inside a row.
 std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& geometry,
                                                         const std::vector<std::uint32_t>& bands, ThreadPool& pool);
 

@@ -90,7 +90,7 @@ BackendRequest gpuPassRequest(const BackendRequest& request, const gpu::DeviceIn
 
 // A gpu primary frame's request on a device that takes a CPU's defaults, where neither the
 // regions nor the ray groups were asked for (nor the sub-scenes, --no-skip subscenes) and the
-// cpu backend would cut the image into at least two bands a core (imageBands: a scene of few
+// cpu backend would cut the image into at least two bands a core (imageBandCount: a scene of few
 // triangles for its rays, as the room): one region with as many ray groups as bands (the
 // kernel's even groups of its rays), so that no ray waits for a transfer round. Where the
 // bands are fewer, the regions stay: a work item's own pass over every triangle costs the
@@ -99,7 +99,7 @@ BackendRequest gpuPrimaryRequest(const BackendRequest& request, const gpu::Devic
                                  const FrameGeometry& geometry) {
     if (!shapeLeftToACpuDevice(request, device) || !request.trace.skips.subScenes) return request;
     const unsigned cores = gpu::defaultGpuRegions(device, request.gpuTuning.profile);
-    const std::size_t bands = std::max<std::size_t>(imageBands(geometry, cores).size(), 1) - 1;
+    const std::size_t bands = imageBandCount(geometry, cores);
     return bands < 2 * std::size_t(cores) ? request : asOneRegion(request, bands);
 }
 
