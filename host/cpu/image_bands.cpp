@@ -26,8 +26,9 @@ constexpr std::uint32_t kSampledRaysPerRow = 16;
 // the box of a model, the Bunny or the Dragon, miss the model and leave the tree early); from
 // inside, one (every ray meets the scene, a room's walls, and pays its leaf tests, so a scene of
 // few triangles seen from inside is cut in nearly equal rows). Of 1, 0.25, 0.1, 0.05 and 0.02 for
-// the rays from outside, a twentieth left the Bunny's and the Dragon's bands nearest to equal
-// times (docs/benchmarks.md, "Image bands of equal work").
+// the rays from outside, a twentieth left the Bunny's bands nearest to equal times; the
+// Dragon's triangles outweigh its rays at any of them (docs/benchmarks.md, "Image bands of
+// equal work").
 constexpr double kRayWorkFromOutside = 0.05, kRayWorkFromInside = 1.0;
 
 // Whether the segment [tmin, tmax] of a ray crosses box b: a slab test, an estimate only (no
