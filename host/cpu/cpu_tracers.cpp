@@ -219,12 +219,6 @@ TraceResult traceBrute(const FrameGeometry& g, ThreadPool& pool, const PlanHook&
 
 namespace {
 
-// The traced triangles' ids, for a traversal to permute.
-void fillTracedTriangleIds(const FrameGeometry& g, std::vector<std::uint32_t>& ids) {
-    ids.resize(g.tracedTriangleCount());
-    for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = g.tracedTriangle(i);
-}
-
 // One sequential DACRT of the rays rayIds[0, rayCount) over the triangles triIds[0, triCount),
 // from the scene box down; culled and finished rays counted.
 void traceRayIds(const FrameGeometry& g, const DacrtOptions& options, const TraversalBuffers& buffers,

@@ -27,8 +27,9 @@ TraceResult traceParallel(const FrameGeometry& geometry, const TraceOptions& opt
 
 // The bands side by side (imageBands, image_bands.hpp): each a sequential DACRT over the
 // traced triangles its rays can reach (bandTriangleIds), its rays the band's ids into the
-// frame's arrays (packets and hits are the frame's), on one worker at a time. Exact as traceSequential is: no division, no transfer rounds. The cpu backend's
-// primary frames where --regions is not given (docs/cpu-reference.md, "Image bands").
+// frame's arrays (packets and hits are the frame's), on one worker at a time. Exact as
+// traceSequential is: no division, no transfer rounds. The cpu backend's primary frames where
+// --regions is not given (docs/cpu-reference.md, "Image bands").
 TraceResult traceImageBands(const FrameGeometry& geometry, const DacrtOptions& options, ThreadPool& pool,
                             const std::vector<std::uint32_t>& bands, const PlanHook& onPlan = {});
 

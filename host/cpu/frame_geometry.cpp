@@ -10,7 +10,6 @@
 
 namespace dacrt {
 
-
 float filterMargin(const Box& sceneBox, const glm::vec3& farthestOrigin) {
     float m = 0.0f;
     for (int a = 0; a < 3; ++a)
@@ -30,6 +29,13 @@ bool raysShareStart(const std::vector<Ray>& rays, ThreadPool* pool) {
 bool raysShareSegment(const std::vector<Ray>& rays) {
     return !rays.empty() &&
            std::all_of(rays.begin(), rays.end(), [&](const Ray& r) { return sameSegment(r, rays.front()); });
+}
+
+void fillTracedTriangleIds(const FrameGeometry& g, std::vector<std::uint32_t>& ids, ThreadPool* pool) {
+    ids.resize(g.tracedTriangleCount());
+    forEachChunk(ids.size(), kFrameScanChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) ids[i] = g.tracedTriangle(i);
+    });
 }
 
 FrameGeometry frameGeometry(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,

@@ -80,6 +80,10 @@ inline bool sameSegment(const Ray& a, const Ray& b) {
 // Whether every ray has the first one's tmin and tmax, bit for bit (false without rays).
 bool raysShareSegment(const std::vector<Ray>& rays);
 
+// ids = the traced triangles' ids in order (g.tracedTriangle(i)), for a traversal to permute;
+// in chunks side by side on the pool (none: on the calling thread).
+void fillTracedTriangleIds(const FrameGeometry& g, std::vector<std::uint32_t>& ids, ThreadPool* pool = nullptr);
+
 // Widening applied to every box before a ray or triangle filter, so that rounding in the
 // intersection test can never move a hit out of the cells that test it. See
 // docs/correctness.md for the derivation: 64 units in the last place of the largest

@@ -8,6 +8,7 @@
 #include <glm/vector_relational.hpp>
 
 #include "core/errors.hpp"
+#include "cpu/predicates.hpp"
 #include "cpu/ray_grouping.hpp"
 #include "cpu/ray_packet.hpp"
 #include "cpu/triangle_skips.hpp"
@@ -31,24 +32,8 @@ constexpr std::uint32_t kSampledRaysPerRow = 16;
 // equal work").
 constexpr double kRayWorkFromOutside = 0.05, kRayWorkFromInside = 1.0;
 
-// Whether the segment [tmin, tmax] of a ray crosses box b: a slab test, an estimate only (no
-// margin, no tie rules).
-bool crossesBox(const Ray& ray, const Box& b) {
-    float enter = ray.tmin, exit = ray.tmax;
-    for (int a = 0; a < 3; ++a) {
-        if (ray.dir[a] == 0.0f) {
-            if (ray.origin[a] < b.lo[a] || ray.origin[a] > b.hi[a]) return false;
-            continue;
-        }
-        float t0 = (b.lo[a] - ray.origin[a]) / ray.dir[a], t1 = (b.hi[a] - ray.origin[a]) / ray.dir[a];
-        if (t0 > t1) std::swap(t0, t1);
-        enter = std::max(enter, t0);
-        exit = std::min(exit, t1);
-    }
-    return enter <= exit;
-}
-
 std::uint32_t imageRows(const FrameGeometry& g) { return std::uint32_t(g.rays->size() / g.imageWidth); }
+std::uint32_t tileRows(const FrameGeometry& g) { return (imageRows(g) + kPacketTile - 1) / kPacketTile; }
 
 // The frame's view frustum where it is the pyramid of these rays' rows: the camera's image,
 // its rays from the frustum's apex.
@@ -65,8 +50,7 @@ std::vector<double> tileRowWork(const FrameGeometry& g) {
     const ViewFrustum* f = rowsOfRays(g);
     if (!f) return {};
     const std::uint32_t width = g.imageWidth, height = imageRows(g);
-    const std::uint32_t tileRows = (height + kPacketTile - 1) / kPacketTile;
-    std::vector<double> work(tileRows, 0.0);
+    std::vector<double> work(tileRows(g), 0.0);
     // Triangles: each sampled one's bounds centre in the row of tiles it projects into (sy =
     // (1 - 2 row / rows) halfHeight, as PixelRays makes the rows), as stride triangles.
     const std::size_t traced = g.tracedTriangleCount();
@@ -88,13 +72,14 @@ std::vector<double> tileRowWork(const FrameGeometry& g) {
     const glm::vec3 eye(f->apex);
     const bool inside = glm::all(glm::greaterThanEqual(eye, g.sceneBox.lo)) && glm::all(glm::lessThanEqual(eye, g.sceneBox.hi));
     const double rayWork = inside ? kRayWorkFromInside : kRayWorkFromOutside;
-    for (std::uint32_t r = 0; r < tileRows; ++r) {
+    for (std::uint32_t r = 0; r < work.size(); ++r) {
         const std::uint32_t y = std::min(height - 1, r * kPacketTile + kPacketTile / 2);
         const std::uint32_t rowRays = (std::min(height, (r + 1) * kPacketTile) - r * kPacketTile) * width;
         std::uint32_t crossing = 0;
-        for (std::uint32_t s = 0; s < kSampledRaysPerRow; ++s)
-            crossing += crossesBox((*g.rays)[std::size_t(y) * width + (2 * s + 1) * width / (2 * kSampledRaysPerRow)],
-                                   g.sceneBox);
+        for (std::uint32_t s = 0; s < kSampledRaysPerRow; ++s) {
+            const Ray& ray = (*g.rays)[std::size_t(y) * width + (2 * s + 1) * width / (2 * kSampledRaysPerRow)];
+            crossing += shared::rayMayCrossCell(ray, g.sceneBox.lo, g.sceneBox.hi, ray.tmax);
+        }
         work[r] += rayWork * double(rowRays) * crossing / kSampledRaysPerRow;
     }
     if (!std::any_of(work.begin(), work.end(), [](double w) { return w > 0.0; })) return {};
@@ -127,10 +112,10 @@ std::size_t imageBandCount(const FrameGeometry& g, unsigned workers) {
     const std::uint32_t rays = std::uint32_t(g.rays->size());
     if (!g.imageWidth || g.query != HitQuery::Closest || workers < 2 || rays % g.imageWidth != 0) return 0;
     // Whole rows of tiles: a band's packets are the image's own (buildPackets tiles by ray id).
-    const std::uint32_t tileRows = (imageRows(g) + kPacketTile - 1) / kPacketTile;
+    const std::size_t rows = tileRows(g);
     const std::size_t mostTileRows =
         std::max<std::size_t>(1, passBatchRays(g.triangles->size()) / (std::size_t(g.imageWidth) * kPacketTile));
-    const std::size_t bands = std::min<std::size_t>(rayBatches(tileRows, mostTileRows, workers).size() - 1, tileRows);
+    const std::size_t bands = std::min<std::size_t>(rayBatches(rows, mostTileRows, workers).size() - 1, rows);
     return bands < 2 ? 0 : bands;
 }
 
@@ -138,9 +123,8 @@ std::vector<std::uint32_t> imageBands(const FrameGeometry& g, unsigned workers) 
     const std::size_t bands = imageBandCount(g, workers);
     if (bands == 0) return {};
     const std::uint32_t rays = std::uint32_t(g.rays->size());
-    const std::uint32_t tileRows = (imageRows(g) + kPacketTile - 1) / kPacketTile;
     const std::vector<double> work = tileRowWork(g);
-    std::vector<std::uint32_t> starts = bandsOfEqualWork(work.empty() ? std::vector<double>(tileRows, 1.0) : work, bands);
+    std::vector<std::uint32_t> starts = bandsOfEqualWork(work.empty() ? std::vector<double>(tileRows(g), 1.0) : work, bands);
     for (std::uint32_t& s : starts) s = std::min(rays, s * kPacketTile * g.imageWidth);
     return starts;
 }
@@ -158,12 +142,7 @@ std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, 
     std::vector<std::vector<std::uint32_t>> ids(bandCount);
     const ViewFrustum* f = rowsOfRays(g);
     if (!f) {
-        for (std::vector<std::uint32_t>& band : ids) {
-            band.resize(traced);
-            forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t, std::size_t begin, std::size_t end) {
-                for (std::size_t i = begin; i < end; ++i) band[i] = g.tracedTriangle(i);
-            });
-        }
+        for (std::vector<std::uint32_t>& band : ids) fillTracedTriangleIds(g, band, &pool);
         return ids;
     }
     std::vector<std::uint32_t> startRows;
