@@ -6,7 +6,9 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "cpu/predicates.hpp"
 #include "cpu/ray_packet.hpp"
@@ -231,6 +233,53 @@ std::uint32_t PartitionRays(const Ray* rays, const Hit* hits, std::uint32_t* ids
     return partitionRays<SharedRayFields::None>(rays, hits, ids, count, cell, scratch);
 }
 
+// DacrtTraversal's end of a leaf, lane by lane: a ray with a hit ends if it seeks any hit or
+// if shared::hitEndsInBox holds (its t no later than the widened exit from box). The ending
+// rays are swapped to the front one at a time in id order, as the scalar loop swaps them: a
+// swap at position k moves only positions at or before k, so each vector's answers, taken
+// before its swaps, are the ones the scalar loop reaches.
+std::uint32_t EndRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count, const Box& box,
+                              bool anyHit) {
+    const DF df;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    const float* ray = reinterpret_cast<const float*>(rays);
+    const float* hit = reinterpret_cast<const float*>(hits);
+    const VU miss = hn::Set(du, kMissPrim);
+    const VF slabSlack = hn::Set(df, shared::kSlabSlack);
+    static_assert(HWY_LANES(float) <= 16, "the ending lanes are read as 16 mask bits");
+    alignas(64) std::uint32_t idLanes[64];
+    std::uint32_t ended = 0;
+    for (std::uint32_t k = 0; k < count; k += std::uint32_t(n)) {
+        const std::uint32_t lanes = std::min(std::uint32_t(n), count - k);
+        for (std::size_t l = 0; l < n; ++l) idLanes[l] = ids[k + std::min(std::uint32_t(l), lanes - 1)];
+        VF best[4];
+        loadQuadPerLane<0, 4>(hit, idLanes, best);  // t, prim, u, v
+        MF ends = hn::And(hn::RebindMask(df, hn::BitCast(du, best[1]) != miss), hn::FirstN(df, lanes));
+        if (!anyHit && !hn::AllFalse(df, ends)) {
+            // shared::rayBoxInterval's far end: origin at floats 0-2 of a Ray, invDir at 8-10.
+            VF start[4], invDir[4];
+            loadQuadPerLane<0>(ray, idLanes, start);
+            loadQuadPerLane<8>(ray, idLanes, invDir);
+            VF xn, xf, yn, yf, zn, zf;
+            slabInterval(start[0], invDir[0], box.lo.x, box.hi.x, xn, xf);
+            slabInterval(start[1], invDir[1], box.lo.y, box.hi.y, yn, yf);
+            slabInterval(start[2], invDir[2], box.lo.z, box.hi.z, zn, zf);
+            const VF tFar = minLike(xf, minLike(yf, zf));
+            const VF farHigh = hn::Add(tFar, hn::Mul(hn::Abs(tFar), slabSlack));
+            ends = hn::And(ends, best[0] <= farHigh);
+        }
+        std::uint8_t bits[8] = {};
+        hn::StoreMaskBits(df, ends, bits);
+        for (std::uint32_t m = std::uint32_t(bits[0]) | std::uint32_t(bits[1]) << 8; m; m &= m - 1) {
+            const std::uint32_t at = k + std::uint32_t(__builtin_ctz(m));
+            std::swap(ids[at], ids[ended]);
+            ++ended;
+        }
+    }
+    return ended;
+}
+
 template <bool kLowSide, bool kReaching>
 HWY_INLINE std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
                                                   int axis, float bound, std::uint32_t* scratch) {
@@ -417,20 +466,16 @@ HWY_INLINE void widenedBoundsOf(const LeafTriangles& batch, float widening, Wide
         }
 }
 
-// The triangles of batch whose widened bounds the group may cross (packetMayCrossCell,
-// ray_packet.cpp: the same products, minima and maxima lane by lane), in order, into
-// narrowed. Returns how many. Each kept vector is stored whole at the count so far, which is
-// at most the vector's own first lane j, so no store passes lane j + n <= kLeafBatch.
+// The lanes of batch whose widened bounds the group may cross (packetMayCrossCell,
+// ray_packet.cpp: the same products, minima and maxima lane by lane), in order, into kept.
+// Returns how many. Each vector of lane numbers is stored whole at the count so far, which is
+// at most its own first lane j, so no store passes lane j + n <= kLeafBatch.
 HWY_INLINE std::uint32_t narrowToGroup(const LeafTriangles& batch, const WidenedBounds& b, const RayPacket& group,
-                                       const glm::vec3& origin, float tmin, LeafTriangles& narrowed) {
+                                       const glm::vec3& origin, float tmin, std::uint32_t* kept) {
     const DF df;
     const DU du;
     const std::size_t n = hn::Lanes(df);
     std::uint32_t count = 0;
-    auto keep = [&](auto mask, const auto* from, auto* to) {
-        const VU v = hn::Load(du, reinterpret_cast<const std::uint32_t*>(from));
-        hn::StoreU(compressIds(v, mask), du, reinterpret_cast<std::uint32_t*>(to) + count);
-    };
     for (std::size_t j = 0; j < batch.count; j += n) {
         VF tNear = hn::Set(df, -kNoHitT), tFar = hn::Set(df, kNoHitT);
         for (int a = 0; a < 3; ++a) {
@@ -443,15 +488,188 @@ HWY_INLINE std::uint32_t narrowToGroup(const LeafTriangles& batch, const Widened
         }
         const MF may = hn::And(hn::And(tNear <= tFar, tFar >= hn::Set(df, tmin)), hn::FirstN(df, batch.count - j));
         if (hn::AllFalse(df, may)) continue;
-        const auto mask = hn::RebindMask(du, may);
-        for (int k = 0; k < 3; ++k)
-            for (int c = 0; c < 3; ++c) keep(mask, &batch.vertex[k][c][j], narrowed.vertex[k][c]);
-        keep(mask, &batch.prim[j], narrowed.prim);
-        keep(mask, &batch.cullBackFace[j], narrowed.cullBackFace);
+        const VU lanes = hn::Add(hn::Iota(du, 0), hn::Set(du, std::uint32_t(j)));
+        hn::StoreU(compressIds(lanes, hn::RebindMask(du, may)), du, kept + count);
         count += std::uint32_t(hn::CountTrue(df, may));
     }
-    narrowed.count = count;
     return count;
+}
+
+// The batch's vertices less the rays' shared origin, and each triangle's projection slack:
+// the parts of the watertight test that do not depend on the ray's direction, computed once
+// for every group, with the same operations intersectRay applies per ray.
+struct BatchFromOrigin {
+    alignas(64) float vertex[3][3][kLeafBatch];
+    alignas(64) float slack[kLeafBatch];
+};
+
+HWY_INLINE void batchFromOrigin(const LeafTriangles& batch, const glm::vec3& origin, BatchFromOrigin& from) {
+    const DF df;
+    const std::size_t n = hn::Lanes(df);
+    const VF o[3] = {hn::Set(df, origin.x), hn::Set(df, origin.y), hn::Set(df, origin.z)};
+    const VF projectionSlack = hn::Set(df, shared::kProjectionSlack);
+    for (std::size_t j = 0; j < batch.count; j += n) {
+        VF a[3], b[3], c[3];
+        for (int k = 0; k < 3; ++k) {
+            a[k] = hn::Sub(hn::Load(df, &batch.vertex[0][k][j]), o[k]);
+            b[k] = hn::Sub(hn::Load(df, &batch.vertex[1][k][j]), o[k]);
+            c[k] = hn::Sub(hn::Load(df, &batch.vertex[2][k][j]), o[k]);
+            hn::Store(a[k], df, &from.vertex[0][k][j]);
+            hn::Store(b[k], df, &from.vertex[1][k][j]);
+            hn::Store(c[k], df, &from.vertex[2][k][j]);
+        }
+        const VF reach = hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
+                                 hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
+                                         hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
+        hn::Store(hn::Mul(reach, projectionSlack), df, &from.slack[j]);
+    }
+}
+
+// A lane per ray: each ray's best hit so far, as the tie rule compares it.
+struct BestInLanes {
+    VF t, u, v;
+    VU prim;
+};
+
+// intersectRay with the rays in lanes and the kept triangles one at a time: a group's rays
+// share their origin, so a triangle's vertices less the origin and its slack are one value
+// for every lane, and only the ray's axes, shear and best hit differ from lane to lane. Each
+// lane computes what intersectRay computes for its ray, operation for operation.
+// pick(vertex, k, j) is coordinate k (0: kx, 1: ky, 2: kz) of triangle j's vertex, lane by
+// lane. Where a group keeps few of a batch's triangles (most leaves), a lane per ray does a
+// vector of work per triangle kept, where a lane per triangle did a vector per ray.
+template <class Pick>
+HWY_INLINE void testKeptTriangles(const LeafTriangles& batch, const BatchFromOrigin& from, const std::uint32_t* kept,
+                                  std::uint32_t keptCount, const VF (&shear)[4], VF tmin, MF valid, Pick pick,
+                                  BestInLanes& best) {
+    const DF df;
+    const DU du;
+    const DI di;
+    const VF zero = hn::Zero(df);
+    const VF sx = shear[0], sy = shear[1], sz = shear[2];
+    const VU flip = hn::Set(du, 0x80000000u);
+    for (std::uint32_t i = 0; i < keptCount; ++i) {
+        const std::uint32_t j = kept[i];
+        const VF akx = pick(0, 0, j), aky = pick(0, 1, j), akz = pick(0, 2, j);
+        const VF bkx = pick(1, 0, j), bky = pick(1, 1, j), bkz = pick(1, 2, j);
+        const VF ckx = pick(2, 0, j), cky = pick(2, 1, j), ckz = pick(2, 2, j);
+        const VF ax = hn::Sub(akx, hn::Mul(sx, akz)), ay = hn::Sub(aky, hn::Mul(sy, akz));
+        const VF bx = hn::Sub(bkx, hn::Mul(sx, bkz)), by = hn::Sub(bky, hn::Mul(sy, bkz));
+        const VF cx = hn::Sub(ckx, hn::Mul(sx, ckz)), cy = hn::Sub(cky, hn::Mul(sy, ckz));
+        const VF eu = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
+        const VF ev = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
+        const VF ew = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+        const MF anyNegative = hn::Or(hn::Or(eu < zero, ev < zero), ew < zero);
+        const MF anyPositive = hn::Or(hn::Or(eu > zero, ev > zero), ew > zero);
+        MF m = hn::AndNot(hn::And(anyNegative, anyPositive), valid);
+        const VF det = hn::Add(hn::Add(eu, ev), ew);
+        m = hn::AndNot(det == zero, m);
+        if (batch.cullBackFace[j] != 0u) m = hn::AndNot(det < zero, m);  // shared::backFaceIsCulled
+        if (hn::AllFalse(df, m)) continue;
+        const VF slack = hn::Set(df, from.slack[j]);
+        const VF negSlack = hn::Neg(slack);
+        const MF outside = hn::Or(hn::Or(hn::Min(ax, hn::Min(bx, cx)) > slack, hn::Max(ax, hn::Max(bx, cx)) < negSlack),
+                                  hn::Or(hn::Min(ay, hn::Min(by, cy)) > slack, hn::Max(ay, hn::Max(by, cy)) < negSlack));
+        m = hn::AndNot(outside, m);
+        if (hn::AllFalse(df, m)) continue;
+        const VF az = hn::Mul(sz, akz), bz = hn::Mul(sz, bkz), cz = hn::Mul(sz, ckz);
+        const VF tScaled = hn::Add(hn::Add(hn::Mul(eu, az), hn::Mul(ev, bz)), hn::Mul(ew, cz));
+        const MF front = det > zero;
+        const MF behind = hn::Or(hn::And(front, tScaled <= zero), hn::AndNot(front, tScaled >= zero));
+        m = hn::AndNot(behind, m);
+        const VF t = hn::Div(tScaled, det);
+        m = hn::And(m, t > tmin);
+        if (hn::AllFalse(df, m)) continue;
+        // The no-area rule, last of the conjunction, only where the rest says hit.
+        if (triangleHasNoArea(batch, j)) continue;
+        // shared::hitPrecedes, lane by lane, the ids compared as unsigned (kMissPrim the largest).
+        const VU prim = hn::Set(du, batch.prim[j]);
+        const auto idBefore = hn::BitCast(di, hn::Xor(prim, flip)) < hn::BitCast(di, hn::Xor(best.prim, flip));
+        const MF precedes = hn::Or(t < best.t, hn::And(t == best.t, hn::RebindMask(df, idBefore)));
+        const MF update = hn::And(m, precedes);
+        best.t = hn::IfThenElse(update, t, best.t);
+        best.u = hn::IfThenElse(update, hn::Div(ev, det), best.u);
+        best.v = hn::IfThenElse(update, hn::Div(ew, det), best.v);
+        best.prim = hn::IfThenElse(hn::RebindMask(du, update), prim, best.prim);
+    }
+}
+
+// The kept triangles against the group's rays, a vector of rays at a time. Where every ray of
+// a vector has the same axes (a coherent group's usual case) the coordinates are picked once
+// for all lanes; otherwise lane by lane.
+HWY_INLINE void intersectGroupInLanes(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
+                                      const LeafTriangles& batch, const BatchFromOrigin& from,
+                                      const std::uint32_t* kept, std::uint32_t keptCount, float rayTmin) {
+    const DF df;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    const float* rayFloats = reinterpret_cast<const float*>(rays);
+    const float* hitFloats = reinterpret_cast<const float*>(hits);
+    const VF tmin = hn::Set(df, rayTmin);
+    const VU three = hn::Set(du, 3u);
+    alignas(64) std::uint32_t ids[64];
+    alignas(64) float bestLanes[4][64];
+    auto coordinate = [&](int vertex, int axis, std::uint32_t j) { return from.vertex[vertex][axis][j]; };
+    for (std::uint32_t r = 0; r < rayCount; r += std::uint32_t(n)) {
+        const std::uint32_t lanes = std::min(std::uint32_t(n), rayCount - r);
+        for (std::size_t l = 0; l < n; ++l) ids[l] = rayIds[r + std::min(std::uint32_t(l), lanes - 1)];
+        // Floats 4-7 of a Ray: the direction and the packed axes; 12-14 the shear.
+        VF dirAndAxes[4], shear[4], hit[4];
+        loadQuadPerLane<4>(rayFloats, ids, dirAndAxes);
+        loadQuadPerLane<12>(rayFloats, ids, shear);
+        loadQuadPerLane<0, 4>(hitFloats, ids, hit);  // t, prim, u, v
+        BestInLanes best{hit[0], hit[2], hit[3], hn::BitCast(du, hit[1])};
+        const MF valid = hn::FirstN(df, lanes);
+        const VU axes = hn::BitCast(du, dirAndAxes[3]);
+        const std::uint32_t firstAxes = hn::GetLane(axes);
+        auto fixed = [&](auto kx, auto ky, auto kz) {
+            constexpr int axis[3] = {decltype(kx)::value, decltype(ky)::value, decltype(kz)::value};
+            testKeptTriangles(batch, from, kept, keptCount, shear, tmin, valid,
+                              [&](int vertex, int k, std::uint32_t j) { return hn::Set(df, coordinate(vertex, axis[k], j)); },
+                              best);
+        };
+        using I0 = std::integral_constant<int, 0>;
+        using I1 = std::integral_constant<int, 1>;
+        using I2 = std::integral_constant<int, 2>;
+        // ids past `lanes` repeat the last ray, so every lane is a ray of the group.
+        if (hn::AllTrue(du, axes == hn::Set(du, firstAxes))) {
+            switch (firstAxes) {
+                case packedAxes(1, 2, 0): fixed(I1{}, I2{}, I0{}); break;
+                case packedAxes(2, 1, 0): fixed(I2{}, I1{}, I0{}); break;
+                case packedAxes(2, 0, 1): fixed(I2{}, I0{}, I1{}); break;
+                case packedAxes(0, 2, 1): fixed(I0{}, I2{}, I1{}); break;
+                case packedAxes(0, 1, 2): fixed(I0{}, I1{}, I2{}); break;
+                case packedAxes(1, 0, 2): fixed(I1{}, I0{}, I2{}); break;
+                default: HWY_ABORT("ray axes %u: makeRay and segmentRay make only six", firstAxes);
+            }
+        } else {
+            // Lane masks choosing coordinate 0, 1 or else 2 for kx, ky and kz.
+            MF is0[3], is1[3];
+            for (int k = 0; k < 3; ++k) {
+                const VU axis = hn::And(hn::ShiftRightSame(axes, 2 * k), three);
+                is0[k] = hn::RebindMask(df, axis == hn::Zero(du));
+                is1[k] = hn::RebindMask(df, axis == hn::Set(du, 1u));
+            }
+            testKeptTriangles(batch, from, kept, keptCount, shear, tmin, valid,
+                              [&](int vertex, int k, std::uint32_t j) {
+                                  return hn::IfThenElse(is0[k], hn::Set(df, coordinate(vertex, 0, j)),
+                                                        hn::IfThenElse(is1[k], hn::Set(df, coordinate(vertex, 1, j)),
+                                                                       hn::Set(df, coordinate(vertex, 2, j))));
+                              },
+                              best);
+        }
+        hn::Store(best.t, df, bestLanes[0]);
+        hn::Store(hn::BitCast(df, best.prim), df, bestLanes[1]);
+        hn::Store(best.u, df, bestLanes[2]);
+        hn::Store(best.v, df, bestLanes[3]);
+        for (std::uint32_t l = 0; l < lanes; ++l) {
+            Hit& h = hits[ids[l]];
+            h.t = bestLanes[0][l];
+            std::memcpy(&h.prim, &bestLanes[1][l], sizeof(h.prim));
+            h.u = bestLanes[2][l];
+            h.v = bestLanes[3][l];
+        }
+    }
 }
 
 // startPacketBounds and addToPacketBounds over rays[rayIds[0, count)], lanes at a time: on the
@@ -495,19 +713,28 @@ RayPacket BoundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32
 }
 
 std::uint64_t IntersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                                     const LeafTriangles& batch, float widening, LeafTriangles& narrowed) {
+                                     const LeafTriangles& batch, float widening) {
     WidenedBounds bounds;
     widenedBoundsOf(batch, widening, bounds);
     const glm::vec3 origin = rays[0].origin;  // every ray's (SharedRayFields::Start)
     const float tmin = rays[0].tmin;
+    BatchFromOrigin from;
+    batchFromOrigin(batch, origin, from);
+    alignas(64) std::uint32_t kept[kLeafBatch];
     std::uint64_t skipped = 0;
     for (std::uint32_t g = 0; g < rayCount; g += kLeafGroupRays) {
         const std::uint32_t groupRays = std::min(kLeafGroupRays, rayCount - g);
+        // The next group's rays and hits asked for: a large leaf's rays are scattered over
+        // more than the caches hold, and each group waited on its own misses.
+        for (std::uint32_t k = g + kLeafGroupRays; k < std::min(g + 2 * kLeafGroupRays, rayCount); ++k) {
+            __builtin_prefetch(rays + rayIds[k]);
+            __builtin_prefetch(hits + rayIds[k]);
+        }
         const RayPacket group = boundsOfGroup(rays, rayIds + g, groupRays);
-        const std::uint32_t kept = narrowToGroup(batch, bounds, group, origin, tmin, narrowed);
-        skipped += std::uint64_t(groupRays) * (batch.count - kept);
-        if (kept == 0) continue;
-        intersectRays(rays, hits, rayIds + g, groupRays, kept == batch.count ? batch : narrowed);
+        const std::uint32_t keptCount = narrowToGroup(batch, bounds, group, origin, tmin, kept);
+        skipped += std::uint64_t(groupRays) * (batch.count - keptCount);
+        if (keptCount == 0) continue;
+        intersectGroupInLanes(rays, hits, rayIds + g, groupRays, batch, from, kept, keptCount, tmin);
     }
     return skipped;
 }
@@ -639,6 +866,7 @@ HWY_AFTER_NAMESPACE();
 namespace dacrt::simd {
 
 HWY_EXPORT(PartitionRays);
+HWY_EXPORT(EndRaysHitInBox);
 HWY_EXPORT(PartitionTrianglesOnFace);
 HWY_EXPORT(IntersectBatch);
 HWY_EXPORT(IntersectBatchInGroups);
@@ -689,6 +917,11 @@ void classifyFacing(const Triangle* triangles, std::uint32_t count, const glm::v
     HWY_DYNAMIC_DISPATCH(ClassifyFacing)(triangles, count, origin, verdict);
 }
 
+std::uint32_t endRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count, const Box& box,
+                              bool anyHit) {
+    return HWY_DYNAMIC_DISPATCH(EndRaysHitInBox)(rays, hits, ids, count, box, anyHit);
+}
+
 std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
                                         const Box& cell, SharedRayFields shared, std::uint32_t* scratch) {
     return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, hits, ids, count, cell, shared, scratch);
@@ -714,8 +947,8 @@ RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32
 }
 
 std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                                     const LeafTriangles& batch, float widening, LeafTriangles& narrowed) {
-    return HWY_DYNAMIC_DISPATCH(IntersectBatchInGroups)(rays, hits, rayIds, rayCount, batch, widening, narrowed);
+                                     const LeafTriangles& batch, float widening) {
+    return HWY_DYNAMIC_DISPATCH(IntersectBatchInGroups)(rays, hits, rayIds, rayCount, batch, widening);
 }
 
 std::string activeTarget() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CompiledTarget)()); }

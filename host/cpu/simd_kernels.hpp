@@ -43,6 +43,12 @@ enum class SharedRayFields : std::uint8_t { None, Start, Segment, OwnSegment };
 std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count,
                                         const Box& cell, SharedRayFields shared, std::uint32_t* scratch);
 
+// The rays of ids[0, count) whose hits end them in box (a hit at all where anyHit, else
+// shared::hitEndsInBox) swapped to the front, one at a time in order, exactly as
+// DacrtTraversal's scalar loop swaps them. Returns how many.
+std::uint32_t endRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count, const Box& box,
+                              bool anyHit);
+
 // The same partition for triangles whose bounds are known to overlap a cell that differs
 // from this one only in one face, on `axis`: what shared::boundsOverlap with this cell
 // answers then is the one comparison that face adds, lo[axis] <= bound for a new high face
@@ -81,13 +87,13 @@ RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32
 // intersectBatch for rays that share their start (SharedRayFields::Start: every ray has
 // rays[0]'s origin and tmin), in groups of up to kLeafGroupRays consecutive ids: each group
 // tests only the triangles whose bounds, widened by `widening` (twice the filter margin),
-// packetMayCrossCell (ray_packet.hpp) says the group may cross, gathered into narrowed. The
-// same hits as intersectBatch: a triangle the test reports a hit on lies within the margin of
-// its bounds on the ray's segment (docs/correctness.md, "Leaf groups"). Returns the ray/triangle
-// tests skipped.
+// packetMayCrossCell (ray_packet.hpp) says the group may cross, one triangle at a time with
+// the group's rays in lanes. The same hits as intersectBatch: a triangle the test reports a
+// hit on lies within the margin of its bounds on the ray's segment (docs/correctness.md,
+// "Leaf groups"). Returns the ray/triangle tests skipped.
 constexpr std::uint32_t kLeafGroupRays = 16;
 std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                                     const LeafTriangles& batch, float widening, LeafTriangles& narrowed);
+                                     const LeafTriangles& batch, float widening);
 
 // The regions of a scene division as the ray binning reads them (scene_division.cpp): `count`
 // (at least 1) slabs along `axis` between ascending boundaries boundary[0] .. boundary[count]

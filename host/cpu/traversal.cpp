@@ -322,9 +322,26 @@ std::uint32_t DacrtTraversal::buildPackets(std::uint32_t begin, std::uint32_t en
     auto tileOf = [&](std::uint32_t id) { return (id / imageWidth_ / kPacketTile) * tilesX + (id % imageWidth_) / kPacketTile; };
     std::uint32_t* start = packet_.tileCounts;  // start[t]: where tile t's rays begin
     std::fill(start, start + tiles_ + 1, 0u);
-    for (std::uint32_t k = begin; k < end; ++k) ++start[tileOf(rayIds_[k]) + 1];
+    // Both passes go run by run of consecutive ids within a tile's row (up to eight pixels):
+    // one division a run, and a count or slot kept in a register through it, where each ray
+    // divided and waited on the store of the one before it to the same counter.
+    auto forEachRun = [&](auto&& onRun) {
+        for (std::uint32_t k = begin; k < end;) {
+            const std::uint32_t id = rayIds_[k];
+            const std::uint32_t x = id % imageWidth_;
+            const std::uint32_t idsLeftInTileRow = std::min(kPacketTile - x % kPacketTile, imageWidth_ - x);
+            std::uint32_t runEnd = k + 1;
+            while (runEnd < end && runEnd - k < idsLeftInTileRow && rayIds_[runEnd] == id + (runEnd - k)) ++runEnd;
+            onRun(tileOf(id), k, runEnd);
+            k = runEnd;
+        }
+    };
+    forEachRun([&](std::uint32_t tile, std::uint32_t runBegin, std::uint32_t runEnd) { start[tile + 1] += runEnd - runBegin; });
     for (std::uint32_t t = 0; t < tiles_; ++t) start[t + 1] += start[t];
-    for (std::uint32_t k = begin; k < end; ++k) packet_.packetRays[start[tileOf(rayIds_[k])]++] = rayIds_[k];
+    forEachRun([&](std::uint32_t tile, std::uint32_t runBegin, std::uint32_t runEnd) {
+        std::copy(rayIds_ + runBegin, rayIds_ + runEnd, packet_.packetRays + start[tile]);
+        start[tile] += runEnd - runBegin;
+    });
     // start[t] is now where tile t's rays end.
     std::uint32_t packets = 0, tileBegin = 0;
     for (std::uint32_t t = 0; t < tiles_; tileBegin = start[t], ++t) {
@@ -423,7 +440,7 @@ void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::ui
         simd::gatherLeafTriangles(triangles_, triIds_ + j, std::min(triEnd - j, simd::kLeafBatch), batch_);
         if (groups)
             counters_.rayTriangleTestsSkipped += simd::intersectBatchInGroups(
-                rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_, 2.0f * margin_, narrowed_);
+                rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_, 2.0f * margin_);
         else
             simd::intersectBatch(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_);
     }
@@ -431,6 +448,10 @@ void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::ui
 }
 
 void DacrtTraversal::endRaysHitInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd) {
+    if (simd_) {
+        terminated += simd::endRaysHitInBox(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, box, anyHit_);
+        return;
+    }
     for (std::uint32_t k = terminated; k < rayEnd; ++k) {
         const std::uint32_t rayId = rayIds_[k];
         if (hits_[rayId].prim != kMissPrim &&

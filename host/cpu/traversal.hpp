@@ -165,7 +165,6 @@ private:
     std::uint32_t imageWidth_;
     std::uint32_t tiles_;  // the default options (bounds filter, watertight float32 test) on SIMD kernels
     simd::LeafTriangles batch_;
-    simd::LeafTriangles narrowed_{};  // a group's triangles of batch_ (intersectBatchInGroups)
     Counters& counters_;
 };
 

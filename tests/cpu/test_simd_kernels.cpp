@@ -151,6 +151,55 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
     });
 }
 
+// The end of a leaf: the rays whose hits end them, moved by the scalar loop's swaps (the same
+// ids in the same order, not only the same set), for closest and any hits, with hits on the
+// box's far faces (where the widened exit decides) and no hits among them.
+TEST_F(EveryTarget, LeafEndMovesTheRaysTheScalarLoopMoves) {
+    forEachTarget([] {
+        Random rng(31);
+        std::uint32_t moved = 0, stayed = 0, decidedByTheExit = 0;
+        for (int trial = 0; trial < 600; ++trial) {
+            const Box box = randomCell(rng);
+            const bool anyHit = rng.uniform() < 0.2;
+            std::vector<Ray> rays(100);
+            std::vector<Hit> hits(rays.size(), missHit());
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                rays[i] = randomRay(rng);
+                if (rng.uniform() < 0.2) continue;  // no hit
+                const shared::RayInterval r = shared::rayBoxInterval(rays[i], box.lo, box.hi);
+                // Near the widened exit on either side, else anywhere on the ray.
+                const float exit = r.tFar;
+                const double pick = rng.uniform();
+                float t = pick < 0.3   ? exit
+                          : pick < 0.5 ? std::nextafter(exit, kNoHitT)
+                          : pick < 0.6 ? std::nextafter(exit, -kNoHitT)
+                                       : rng.uniformFloat(0.0f, 4.0f);
+                if (!std::isfinite(t)) t = rng.uniformFloat(0.0f, 4.0f);
+                hits[i] = Hit{t, std::uint32_t(rng.index(50)), 0.25f, 0.5f};
+            }
+            const std::uint32_t count = std::uint32_t(rng.index(70));
+            std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(rays.size()), count), expected = ids;
+            std::uint32_t expectedEnded = 0;
+            for (std::uint32_t k = 0; k < count; ++k) {  // DacrtTraversal::endRaysHitInBox's scalar loop
+                const std::uint32_t id = expected[k];
+                const bool hitAtAll = hits[id].prim != kMissPrim;
+                const bool endsInBox = shared::hitEndsInBox(rays[id], box.lo, box.hi, hits[id].t);
+                if (hitAtAll && !anyHit && endsInBox != (hits[id].t <= shared::rayBoxIntervalRounded(rays[id], box.lo, box.hi).tFar))
+                    ++decidedByTheExit;
+                if (hitAtAll && (anyHit || endsInBox)) std::swap(expected[k], expected[expectedEnded++]);
+            }
+            const std::uint32_t ended = simd::endRaysHitInBox(rays.data(), hits.data(), ids.data(), count, box, anyHit);
+            ASSERT_EQ(ended, expectedEnded) << "trial " << trial;
+            ASSERT_EQ(ids, expected) << "trial " << trial;
+            moved += ended;
+            stayed += count - ended;
+        }
+        EXPECT_GT(moved, 2000u);  // both answers are common, so both are compared
+        EXPECT_GT(stayed, 2000u);
+        EXPECT_GT(decidedByTheExit, 20u) << "hits just past the rounded exit must be among them";
+    });
+}
+
 // Children of a cell the triangles overlap: the one-face test answers boundsOverlap.
 TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCellAndItsComplement) {
     forEachTarget([] {
@@ -428,13 +477,12 @@ TEST_F(EveryTarget, LeafGroupsGiveTheBatchsHitsBitForBit) {
             std::vector<Hit> got = expected, unwidened = expected;
             for (std::uint32_t id : leaf.rayIds)
                 for (std::uint32_t prim : leaf.triIds) testTriangle(leaf.rays[id], leaf.tris[prim], prim, expected[id]);
-            simd::LeafTriangles batch, narrowed{};
+            simd::LeafTriangles batch;
             simd::gatherLeafTriangles(leaf.tris.data(), leaf.triIds.data(), std::uint32_t(leaf.triIds.size()), batch);
             const std::uint32_t rayCount = std::uint32_t(leaf.rayIds.size());
             skipped += simd::intersectBatchInGroups(leaf.rays.data(), got.data(), leaf.rayIds.data(), rayCount, batch,
-                                                    2.0f * leaf.margin, narrowed);
-            simd::intersectBatchInGroups(leaf.rays.data(), unwidened.data(), leaf.rayIds.data(), rayCount, batch, 0.0f,
-                                         narrowed);
+                                                    2.0f * leaf.margin);
+            simd::intersectBatchInGroups(leaf.rays.data(), unwidened.data(), leaf.rayIds.data(), rayCount, batch, 0.0f);
             tests += std::uint64_t(rayCount) * leaf.triIds.size();
             for (std::size_t i = 0; i < leaf.rays.size(); ++i) {
                 ASSERT_TRUE(sameHit(got[i], expected[i]))
