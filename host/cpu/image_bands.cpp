@@ -11,6 +11,7 @@
 #include "cpu/predicates.hpp"
 #include "cpu/ray_grouping.hpp"
 #include "cpu/ray_packet.hpp"
+#include "cpu/simd_kernels.hpp"
 #include "cpu/triangle_skips.hpp"
 
 namespace dacrt {
@@ -136,6 +137,11 @@ BandEdges::BandEdges(const ViewFrustum& frustum, const std::vector<std::uint32_t
         up_.push_back(glm::vec3(rowsFrustum(frustum, 0, int(startRows[k])).inward[2]));
 }
 
+void BandEdges::bandsOfEach(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count, std::uint32_t* first,
+                            std::uint32_t* last) const {
+    simd::bandsOfBounds(bounds, ids, count, apex_, up_.data(), std::uint32_t(up_.size()), first, last);
+}
+
 std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, const std::vector<std::uint32_t>& bands,
                                                         ThreadPool& pool) {
     const std::size_t bandCount = bands.size() - 1, traced = g.tracedTriangleCount();
@@ -156,19 +162,17 @@ std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, 
     const BandEdges edges(*f, startRows);
     // Each traced triangle's bands, and how many each chunk gives each band.
     const std::size_t chunks = (traced + kFrameScanChunk - 1) / kFrameScanChunk;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> reached(traced);
+    std::vector<std::uint32_t> firstBand(traced), lastBand(traced);
     std::vector<std::uint32_t> counts(chunks * bandCount, 0);
+    const std::uint32_t* tracedIds = g.tracedTriangles ? g.tracedTriangles->data() : nullptr;
     forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        edges.bandsOfEach(tracedIds ? g.triangleBounds->data() : g.triangleBounds->data() + begin,
+                          tracedIds ? tracedIds + begin : nullptr, std::uint32_t(end - begin), &firstBand[begin],
+                          &lastBand[begin]);
         // Counted locally: neighbouring chunks' counts share cache lines.
         std::vector<std::uint32_t> count(bandCount, 0);
-        // The traced ids skip about half the bounds, and the test leaves few loads in flight:
-        // each is asked for kPrefetchAhead triangles early.
-        constexpr std::size_t kPrefetchAhead = 32;
-        for (std::size_t i = begin; i < end; ++i) {
-            if (i + kPrefetchAhead < end) __builtin_prefetch(&(*g.triangleBounds)[g.tracedTriangle(i + kPrefetchAhead)]);
-            const auto [first, last] = reached[i] = edges.bandsOf((*g.triangleBounds)[g.tracedTriangle(i)]);
-            for (std::uint32_t b = first; b <= last; ++b) ++count[b];
-        }
+        for (std::size_t i = begin; i < end; ++i)
+            for (std::uint32_t b = firstBand[i]; b <= lastBand[i]; ++b) ++count[b];
         std::copy(count.begin(), count.end(), &counts[c * bandCount]);
     });
     // Chunk c's triangles of band b go after those of the chunks before it.
@@ -181,7 +185,7 @@ std::vector<std::vector<std::uint32_t>> bandTriangleIds(const FrameGeometry& g, 
     forEachChunk(traced, kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
         std::vector<std::size_t> next(&offset[c * bandCount], &offset[c * bandCount] + bandCount);
         for (std::size_t i = begin; i < end; ++i)
-            for (std::uint32_t b = reached[i].first; b <= reached[i].second; ++b) ids[b][next[b]++] = g.tracedTriangle(i);
+            for (std::uint32_t b = firstBand[i]; b <= lastBand[i]; ++b) ids[b][next[b]++] = g.tracedTriangle(i);
     });
     return ids;
 }

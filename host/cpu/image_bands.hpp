@@ -62,6 +62,10 @@ public:
         if (reachesPrevious) first = std::min(first, std::uint32_t(up_.size())), last = std::uint32_t(up_.size());
         return {first, last};
     }
+    // bandsOf for the bounds of ids[0, count) (bounds[0, count) where ids is null), in SIMD
+    // lanes (simd::bandsOfBounds): the same answers, into first and last.
+    void bandsOfEach(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count, std::uint32_t* first,
+                     std::uint32_t* last) const;
 
 private:
     glm::vec3 apex_;

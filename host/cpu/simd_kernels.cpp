@@ -856,6 +856,67 @@ void ClassifyFacing(const Triangle* triangles, std::uint32_t count, const glm::v
     }
 }
 
+// BandEdges::bandsOf (image_bands.hpp) lane by lane: the same float operations on each lane's
+// bounds in the same order. Max and Min where bandsOf takes glm::max and glm::min: they differ
+// at most in a zero's sign, which changes no sum's comparison with the slack.
+void BandsOfBounds(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count, const glm::vec3& apex,
+                   const glm::vec3* up, std::uint32_t edges, std::uint32_t* first, std::uint32_t* last) {
+    const DF df;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    const float* b = reinterpret_cast<const float*>(bounds);
+    const VF apexLanes[3] = {hn::Set(df, apex.x), hn::Set(df, apex.y), hn::Set(df, apex.z)};
+    const VF slackScale = hn::Set(df, 0x1p-11f);
+    alignas(64) std::uint32_t idLanes[64], firstLanes[64], lastLanes[64];
+    for (std::uint32_t i = 0; i < count; i += std::uint32_t(n)) {
+        const std::uint32_t lanes = std::min(std::uint32_t(n), count - i);
+        for (std::size_t l = 0; l < n; ++l) {
+            const std::uint32_t k = i + std::min(std::uint32_t(l), lanes - 1);
+            idLanes[l] = ids ? ids[k] : k;
+        }
+        // The bounds four vectors ahead asked for: through a list of ids the loads skip about
+        // half the array, which the hardware's prefetch does not follow.
+        if (ids)
+            for (std::uint32_t k = i + 4 * std::uint32_t(n); k < std::min(count, i + 5 * std::uint32_t(n)); ++k)
+                __builtin_prefetch(bounds + ids[k]);
+        // A Bounds is 8 floats: lo and a pad, hi and a pad.
+        VF loFields[4], hiFields[4];
+        loadQuadPerLane<0, 8>(b, idLanes, loFields);
+        loadQuadPerLane<4, 8>(b, idLanes, hiFields);
+        VF lo[3], hi[3], far[3];
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = hn::Sub(loFields[a], apexLanes[a]);
+            hi[a] = hn::Sub(hiFields[a], apexLanes[a]);
+            far[a] = hn::Max(hn::Abs(lo[a]), hn::Abs(hi[a]));
+        }
+        const VF slack = hn::Mul(slackScale, hn::Add(hn::Add(far[0], far[1]), far[2]));
+        const VF negSlack = hn::Neg(slack);
+        VU firstBand = hn::Set(du, edges + 1), lastBand = hn::Zero(du);
+        MF reachesPrevious = hn::FirstN(df, n);  // band 0 has no top edge but the image's
+        for (std::uint32_t k = 0; k < edges; ++k) {
+            VF most[3], least[3];
+            for (int a = 0; a < 3; ++a) {
+                const VF u = hn::Set(df, up[k][a]);
+                const VF atLo = hn::Mul(u, lo[a]), atHi = hn::Mul(u, hi[a]);
+                most[a] = hn::Max(atLo, atHi);
+                least[a] = hn::Min(atLo, atHi);
+            }
+            const MF reachesK = hn::AndNot(hn::Add(hn::Add(most[0], most[1]), most[2]) < negSlack, reachesPrevious);
+            const auto reachesKU = hn::RebindMask(du, reachesK);
+            firstBand = hn::IfThenElse(reachesKU, hn::Min(firstBand, hn::Set(du, k)), firstBand);
+            lastBand = hn::IfThenElse(reachesKU, hn::Set(du, k), lastBand);
+            reachesPrevious = hn::Not(hn::Add(hn::Add(least[0], least[1]), least[2]) > slack);
+        }
+        const auto lastReached = hn::RebindMask(du, reachesPrevious);
+        firstBand = hn::IfThenElse(lastReached, hn::Min(firstBand, hn::Set(du, edges)), firstBand);
+        lastBand = hn::IfThenElse(lastReached, hn::Set(du, edges), lastBand);
+        hn::Store(firstBand, du, firstLanes);
+        hn::Store(lastBand, du, lastLanes);
+        std::copy(firstLanes, firstLanes + lanes, first + i);
+        std::copy(lastLanes, lastLanes + lanes, last + i);
+    }
+}
+
 std::int64_t CompiledTarget() { return HWY_TARGET; }
 
 }  // namespace HWY_NAMESPACE
@@ -873,6 +934,7 @@ HWY_EXPORT(IntersectBatchInGroups);
 HWY_EXPORT(BoundsOfRays);
 HWY_EXPORT(GatherLeafTriangles);
 HWY_EXPORT(CompiledTarget);
+HWY_EXPORT(BandsOfBounds);
 HWY_EXPORT(ClassifyFacing);
 HWY_EXPORT(FirstRegions);
 
@@ -915,6 +977,11 @@ void firstRegionsOfRays(const Ray* rays, std::size_t count, const RegionSlabs& s
 
 void classifyFacing(const Triangle* triangles, std::uint32_t count, const glm::vec3& origin, std::uint8_t* verdict) {
     HWY_DYNAMIC_DISPATCH(ClassifyFacing)(triangles, count, origin, verdict);
+}
+
+void bandsOfBounds(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count, const glm::vec3& apex,
+                   const glm::vec3* up, std::uint32_t edges, std::uint32_t* first, std::uint32_t* last) {
+    HWY_DYNAMIC_DISPATCH(BandsOfBounds)(bounds, ids, count, apex, up, edges, first, last);
 }
 
 std::uint32_t endRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count, const Box& box,

@@ -95,6 +95,12 @@ constexpr std::uint32_t kLeafGroupRays = 16;
 std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                                      const LeafTriangles& batch, float widening);
 
+// For the bounds of ids[0, count) (bounds[0, count) where ids is null), the first and the
+// last of the bands between `edges` band edges that BandEdges::bandsOf finds (image_bands.hpp:
+// the edges' normals up[0, edges) through apex), into first[0, count) and last[0, count).
+void bandsOfBounds(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count, const glm::vec3& apex,
+                   const glm::vec3* up, std::uint32_t edges, std::uint32_t* first, std::uint32_t* last);
+
 // The regions of a scene division as the ray binning reads them (scene_division.cpp): `count`
 // (at least 1) slabs along `axis` between ascending boundaries boundary[0] .. boundary[count]
 // (the scene box's faces on that axis at the ends), their boxes widened by the filter margin,

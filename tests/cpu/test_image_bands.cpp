@@ -11,6 +11,7 @@
 #include "cpu/traversal.hpp"
 #include "cpu/triangle_skips.hpp"
 #include "support/frames.hpp"
+#include "support/simd_targets.hpp"
 
 using namespace dacrt;
 using namespace dacrt::test;
@@ -125,6 +126,80 @@ TEST(ImageBands, ARowsDropIsNeverATriangleARayOfTheRowsHits) {
             }
     }
     EXPECT_GT(nearMisses, 0u) << "the rows next to the band hit some of what it drops";
+}
+
+// The lanes' bands (BandEdges::bandsOfEach, every compiled instruction set) are bandsOf's for
+// every box: boxes about the edges of many bands at every depth, boxes behind the camera (which
+// can lie beyond edges on both sides), through a list of ids and without one, every tail length.
+TEST_F(OnEveryTarget, BandsInLanesAreTheScalarBands) {
+    const Camera camera = tiltedCamera();
+    const int w = 48, h = 64;
+    const ViewFrustum f = *viewFrustum(camera, w, h);
+    const std::vector<std::uint32_t> startRows = {0, 5, 8, 20, 21, 40, 63, std::uint32_t(h)};
+    const BandEdges edges(f, startRows);
+    const glm::dvec3 right = glm::normalize(glm::cross(camera.forward, camera.up));
+    const double y = std::tan(0.5 * camera.yfovRadians), x = y * w / h;
+    forEachTarget([&] {
+        Random rng(33);
+        std::vector<Bounds> bounds;
+        for (int i = 0; i < 5000; ++i) {
+            const double depth = (i % 7 == 0 ? -1.0 : 1.0) * std::pow(10.0, rng.uniform(-1.0, 2.0));
+            const int edgeRow = i % 2 ? int(startRows[1 + rng.index(startRows.size() - 2)]) : int(rng.uniform(0.0, h));
+            const double sy = (1.0 - 2.0 * edgeRow / h) * y, sx = rng.uniform(-x, x);
+            const glm::dvec3 c = camera.eye + depth * (camera.forward + sx * right + sy * camera.up);
+            const double size = std::abs(depth) * std::pow(10.0, rng.uniform(-6.0, -0.5));
+            const glm::vec3 p(c + size * rng.inBox(-1, 1)), q(c + size * rng.inBox(-1, 1));
+            Bounds b{};
+            b.lo = glm::min(p, q);
+            b.hi = glm::max(p, q);
+            bounds.push_back(b);
+        }
+        // Boxes at a band edge's threshold: a box moved along the edge's normal, by bisection,
+        // to the last float step where bandsOf's answer changes, and the box on each side of it.
+        // One rounding more or less in a lane's sums changes some of their answers.
+        std::size_t thresholds = 0;
+        for (int i = 0; i < 400; ++i) {
+            const std::uint32_t k = 1 + std::uint32_t(rng.index(startRows.size() - 2));
+            const glm::dvec3 normal = rowsFrustum(f, 0, int(startRows[k])).inward[2];
+            const double depth = std::pow(10.0, rng.uniform(-1.0, 2.0));
+            const double sy = (1.0 - 2.0 * double(startRows[k]) / h) * y, sx = rng.uniform(-x, x);
+            const glm::dvec3 c = camera.eye + depth * (camera.forward + sx * right + sy * camera.up);
+            const glm::dvec3 half = depth * std::pow(10.0, rng.uniform(-5.0, -1.0)) * rng.inBox(0.1, 1);
+            auto boxAt = [&](double t) {
+                Bounds b{};
+                b.lo = glm::vec3(c - half + t * normal);
+                b.hi = glm::vec3(c + half + t * normal);
+                return b;
+            };
+            double a = -4.0 * glm::length(half) - 1e-3 * depth, z = -a;
+            if (edges.bandsOf(boxAt(a)) == edges.bandsOf(boxAt(z))) continue;
+            for (int step = 0; step < 80; ++step) {
+                const double m = 0.5 * (a + z);
+                (edges.bandsOf(boxAt(m)) == edges.bandsOf(boxAt(a)) ? a : z) = m;
+            }
+            bounds.push_back(boxAt(a));
+            bounds.push_back(boxAt(z));
+            ++thresholds;
+        }
+        EXPECT_GT(thresholds, 300u);
+        std::vector<std::uint32_t> ids;
+        for (std::uint32_t i = 0; i < bounds.size(); i += 1 + std::uint32_t(rng.index(3))) ids.push_back(i);
+        std::size_t several = 0, one = 0;  // every box reaches a band: the image's own edges are not tested
+        for (const bool throughIds : {false, true})
+            for (std::uint32_t count : {std::uint32_t(throughIds ? ids.size() : bounds.size()), 1u, 7u, 17u, 33u}) {
+                std::vector<std::uint32_t> first(count), last(count);
+                edges.bandsOfEach(bounds.data(), throughIds ? ids.data() : nullptr, count, first.data(), last.data());
+                for (std::uint32_t i = 0; i < count; ++i) {
+                    const auto [f0, l0] = edges.bandsOf(bounds[throughIds ? ids[i] : i]);
+                    ASSERT_EQ(first[i], f0) << "box " << i << (throughIds ? " by id" : "");
+                    ASSERT_EQ(last[i], l0) << "box " << i << (throughIds ? " by id" : "");
+                    one += f0 == l0;
+                    several += f0 < l0;
+                }
+            }
+        EXPECT_GT(one, 1000u);
+        EXPECT_GT(several, 1000u);
+    });
 }
 
 TEST(ImageBands, SplitTheEstimatedWorkIntoEqualShares) {
