@@ -385,9 +385,13 @@ void DacrtTraversal::flushPackets(const Box& box, std::uint32_t packetBegin, std
     std::uint32_t count = 0;
     for (std::uint32_t i = packetBegin; i < packetEnd; ++i) {
         const RayPacket& p = packet_.packets[packet_.packetIds[i]];
+        // Every id written, the count moved past the unfinished ones only: whether a ray is
+        // finished is a coin toss that the branch predictor loses. The slot at the count is
+        // inside the buffer: the count is at most the number of ids read before it.
         for (std::uint32_t k = p.begin; k < p.end; ++k) {
             const std::uint32_t id = packet_.packetRays[k];
-            if (!packet_.rayDone[id]) packet_.flushRays[count++] = id;
+            packet_.flushRays[count] = id;
+            count += packet_.rayDone[id] == 0;
         }
     }
     if (count == 0) return;
