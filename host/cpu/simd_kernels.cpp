@@ -337,6 +337,49 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     }
 }
 
+// shared::intersectWatertight's tests after the move to the ray's origin, lanes at a time, on
+// the vertices less the origin in the ray's axes order (p[0] = a[kx], p[1] = a[ky], p[2] =
+// a[kz]): the edge test first, the rest only where some lane passes it. live holds the lanes
+// to test (the triangles, or the rays, there are); cull the lanes whose back faces are culled;
+// slackOf() the projection slack, asked for only past the edge test. False where no lane hits;
+// else live the lanes that hit, with their t, their edge values ev and ew and determinant det.
+template <class SlackOf>
+HWY_INLINE bool watertightInLanes(const VF (&a)[3], const VF (&b)[3], const VF (&c)[3], VF sx, VF sy, VF sz, MF cull,
+                                  VF tmin, SlackOf slackOf, MF& live, VF& t, VF& ev, VF& ew, VF& det) {
+    const DF df;
+    const VF zero = hn::Zero(df);
+    const VF ax = hn::Sub(a[0], hn::Mul(sx, a[2])), ay = hn::Sub(a[1], hn::Mul(sy, a[2]));
+    const VF bx = hn::Sub(b[0], hn::Mul(sx, b[2])), by = hn::Sub(b[1], hn::Mul(sy, b[2]));
+    const VF cx = hn::Sub(c[0], hn::Mul(sx, c[2])), cy = hn::Sub(c[1], hn::Mul(sy, c[2]));
+    const VF eu = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
+    ev = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
+    ew = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
+    const MF anyNegative = hn::Or(hn::Or(eu < zero, ev < zero), ew < zero);
+    const MF anyPositive = hn::Or(hn::Or(eu > zero, ev > zero), ew > zero);
+    MF m = hn::AndNot(hn::And(anyNegative, anyPositive), live);
+    det = hn::Add(hn::Add(eu, ev), ew);
+    m = hn::AndNot(det == zero, m);
+    m = hn::AndNot(hn::And(cull, det < zero), m);  // shared::backFaceIsCulled
+    // Most triangles fail the edge test: the rest of the conjunction only where one passes.
+    if (hn::AllFalse(df, m)) return false;
+    // Max and Min rather than maxLike and minLike here: the extremes of the projected vertices
+    // are only compared, where +0 equals -0.
+    const VF slack = slackOf();
+    const VF negSlack = hn::Neg(slack);
+    const MF outside = hn::Or(hn::Or(hn::Min(ax, hn::Min(bx, cx)) > slack, hn::Max(ax, hn::Max(bx, cx)) < negSlack),
+                              hn::Or(hn::Min(ay, hn::Min(by, cy)) > slack, hn::Max(ay, hn::Max(by, cy)) < negSlack));
+    m = hn::AndNot(outside, m);
+    if (hn::AllFalse(df, m)) return false;
+    const VF az = hn::Mul(sz, a[2]), bz = hn::Mul(sz, b[2]), cz = hn::Mul(sz, c[2]);
+    const VF tScaled = hn::Add(hn::Add(hn::Mul(eu, az), hn::Mul(ev, bz)), hn::Mul(ew, cz));
+    const MF front = det > zero;
+    const MF behind = hn::Or(hn::And(front, tScaled <= zero), hn::AndNot(front, tScaled >= zero));
+    m = hn::AndNot(behind, m);
+    t = hn::Div(tScaled, det);
+    live = hn::And(m, t > tmin);
+    return !hn::AllFalse(df, live);
+}
+
 // shared::intersectWatertight for one ray and hn::Lanes triangles at a time; the tie rule then
 // runs per hit lane in scalar code. The ray's axes are template arguments, so that a[kx] and
 // the like name registers: indexed by a run-time axis, the vertex vectors went through the
@@ -346,7 +389,6 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
     const DF df;
     const DU du;
     const std::size_t n = hn::Lanes(df);
-    const VF zero = hn::Zero(df);
     const VF projectionSlack = hn::Set(df, shared::kProjectionSlack);
     alignas(64) float tLane[64], uLane[64], vLane[64];
     static_assert(HWY_LANES(float) <= 16, "the hit lanes are read as 16 mask bits");
@@ -361,43 +403,20 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
             b[k] = hn::Sub(hn::Load(df, &batch.vertex[1][k][j]), origin[k]);
             c[k] = hn::Sub(hn::Load(df, &batch.vertex[2][k][j]), origin[k]);
         }
-        const VF ax = hn::Sub(a[kx], hn::Mul(sx, a[kz])), ay = hn::Sub(a[ky], hn::Mul(sy, a[kz]));
-        const VF bx = hn::Sub(b[kx], hn::Mul(sx, b[kz])), by = hn::Sub(b[ky], hn::Mul(sy, b[kz]));
-        const VF cx = hn::Sub(c[kx], hn::Mul(sx, c[kz])), cy = hn::Sub(c[ky], hn::Mul(sy, c[kz]));
-        const VF eu = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
-        const VF ev = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
-        const VF ew = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
-        const MF anyNegative = hn::Or(hn::Or(eu < zero, ev < zero), ew < zero);
-        const MF anyPositive = hn::Or(hn::Or(eu > zero, ev > zero), ew > zero);
-        MF m = hn::AndNot(hn::And(anyNegative, anyPositive), hn::FirstN(df, batch.count - j));
-        const VF det = hn::Add(hn::Add(eu, ev), ew);
-        m = hn::AndNot(det == zero, m);
-        // shared::backFaceIsCulled.
-        const MF cullBackFace = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
-        m = hn::AndNot(hn::And(cullBackFace, det < zero), m);
-        // Most triangles of a batch fail the edge test: the rest of the conjunction only
-        // where one passes.
-        if (hn::AllFalse(df, m)) continue;
-        // Max and Min rather than maxLike and minLike here: reach is a maximum of absolute
-        // values (no -0, no NaN: the same value whichever equal operand wins), and the
-        // extremes of the projected vertices are only compared, where +0 equals -0.
-        const VF reach = hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
-                                 hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
-                                         hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
-        const VF slack = hn::Mul(reach, projectionSlack);
-        const VF negSlack = hn::Neg(slack);
-        const MF outside = hn::Or(hn::Or(hn::Min(ax, hn::Min(bx, cx)) > slack, hn::Max(ax, hn::Max(bx, cx)) < negSlack),
-                                  hn::Or(hn::Min(ay, hn::Min(by, cy)) > slack, hn::Max(ay, hn::Max(by, cy)) < negSlack));
-        m = hn::AndNot(outside, m);
-        if (hn::AllFalse(df, m)) continue;
-        const VF az = hn::Mul(sz, a[kz]), bz = hn::Mul(sz, b[kz]), cz = hn::Mul(sz, c[kz]);
-        const VF tScaled = hn::Add(hn::Add(hn::Mul(eu, az), hn::Mul(ev, bz)), hn::Mul(ew, cz));
-        const MF front = det > zero;
-        const MF behind = hn::Or(hn::And(front, tScaled <= zero), hn::AndNot(front, tScaled >= zero));
-        m = hn::AndNot(behind, m);
-        const VF t = hn::Div(tScaled, det);
-        m = hn::And(m, t > tmin);
-        if (hn::AllFalse(df, m)) continue;
+        const VF pa[3] = {a[kx], a[ky], a[kz]}, pb[3] = {b[kx], b[ky], b[kz]}, pc[3] = {c[kx], c[ky], c[kz]};
+        // reach is a maximum of absolute values (no -0, no NaN): the same value whichever equal
+        // operand wins.
+        auto slackOf = [&] {
+            const VF reach =
+                hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
+                        hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
+                                hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
+            return hn::Mul(reach, projectionSlack);
+        };
+        const MF cull = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
+        MF m = hn::FirstN(df, batch.count - j);
+        VF t, ev, ew, det;
+        if (!watertightInLanes(pa, pb, pc, sx, sy, sz, cull, tmin, slackOf, m, t, ev, ew, det)) continue;
         hn::Store(t, df, tLane);
         hn::Store(hn::Div(ev, det), df, uLane);
         hn::Store(hn::Div(ew, det), df, vLane);
@@ -545,41 +564,19 @@ HWY_INLINE void testKeptTriangles(const LeafTriangles& batch, const BatchFromOri
     const DF df;
     const DU du;
     const DI di;
-    const VF zero = hn::Zero(df);
     const VF sx = shear[0], sy = shear[1], sz = shear[2];
     const VU flip = hn::Set(du, 0x80000000u);
+    const MF none = hn::FirstN(df, 0);
     for (std::uint32_t i = 0; i < keptCount; ++i) {
         const std::uint32_t j = kept[i];
-        const VF akx = pick(0, 0, j), aky = pick(0, 1, j), akz = pick(0, 2, j);
-        const VF bkx = pick(1, 0, j), bky = pick(1, 1, j), bkz = pick(1, 2, j);
-        const VF ckx = pick(2, 0, j), cky = pick(2, 1, j), ckz = pick(2, 2, j);
-        const VF ax = hn::Sub(akx, hn::Mul(sx, akz)), ay = hn::Sub(aky, hn::Mul(sy, akz));
-        const VF bx = hn::Sub(bkx, hn::Mul(sx, bkz)), by = hn::Sub(bky, hn::Mul(sy, bkz));
-        const VF cx = hn::Sub(ckx, hn::Mul(sx, ckz)), cy = hn::Sub(cky, hn::Mul(sy, ckz));
-        const VF eu = hn::Sub(hn::Mul(cx, by), hn::Mul(cy, bx));
-        const VF ev = hn::Sub(hn::Mul(ax, cy), hn::Mul(ay, cx));
-        const VF ew = hn::Sub(hn::Mul(bx, ay), hn::Mul(by, ax));
-        const MF anyNegative = hn::Or(hn::Or(eu < zero, ev < zero), ew < zero);
-        const MF anyPositive = hn::Or(hn::Or(eu > zero, ev > zero), ew > zero);
-        MF m = hn::AndNot(hn::And(anyNegative, anyPositive), valid);
-        const VF det = hn::Add(hn::Add(eu, ev), ew);
-        m = hn::AndNot(det == zero, m);
-        if (batch.cullBackFace[j] != 0u) m = hn::AndNot(det < zero, m);  // shared::backFaceIsCulled
-        if (hn::AllFalse(df, m)) continue;
-        const VF slack = hn::Set(df, from.slack[j]);
-        const VF negSlack = hn::Neg(slack);
-        const MF outside = hn::Or(hn::Or(hn::Min(ax, hn::Min(bx, cx)) > slack, hn::Max(ax, hn::Max(bx, cx)) < negSlack),
-                                  hn::Or(hn::Min(ay, hn::Min(by, cy)) > slack, hn::Max(ay, hn::Max(by, cy)) < negSlack));
-        m = hn::AndNot(outside, m);
-        if (hn::AllFalse(df, m)) continue;
-        const VF az = hn::Mul(sz, akz), bz = hn::Mul(sz, bkz), cz = hn::Mul(sz, ckz);
-        const VF tScaled = hn::Add(hn::Add(hn::Mul(eu, az), hn::Mul(ev, bz)), hn::Mul(ew, cz));
-        const MF front = det > zero;
-        const MF behind = hn::Or(hn::And(front, tScaled <= zero), hn::AndNot(front, tScaled >= zero));
-        m = hn::AndNot(behind, m);
-        const VF t = hn::Div(tScaled, det);
-        m = hn::And(m, t > tmin);
-        if (hn::AllFalse(df, m)) continue;
+        const VF a[3] = {pick(0, 0, j), pick(0, 1, j), pick(0, 2, j)};
+        const VF b[3] = {pick(1, 0, j), pick(1, 1, j), pick(1, 2, j)};
+        const VF c[3] = {pick(2, 0, j), pick(2, 1, j), pick(2, 2, j)};
+        MF m = valid;
+        VF t, ev, ew, det;
+        if (!watertightInLanes(a, b, c, sx, sy, sz, batch.cullBackFace[j] != 0u ? valid : none, tmin,
+                               [&] { return hn::Set(df, from.slack[j]); }, m, t, ev, ew, det))
+            continue;
         // The no-area rule, last of the conjunction, only where the rest says hit.
         if (triangleHasNoArea(batch, j)) continue;
         // shared::hitPrecedes, lane by lane, the ids compared as unsigned (kMissPrim the largest).
