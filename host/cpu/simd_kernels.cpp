@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
-#include <type_traits>
 
 #include "cpu/predicates.hpp"
 #include "cpu/ray_packet.hpp"
@@ -337,6 +336,17 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     }
 }
 
+// shared::intersectWatertight's projection slack for vertices a, b, c less the ray's origin:
+// their largest absolute coordinate (no -0, no NaN in a maximum of absolute values, so the
+// same value whichever equal operand wins) times kProjectionSlack.
+HWY_INLINE VF projectionSlackOf(const VF (&a)[3], const VF (&b)[3], const VF (&c)[3]) {
+    const DF df;
+    const VF reach = hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
+                             hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
+                                     hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
+    return hn::Mul(reach, hn::Set(df, shared::kProjectionSlack));
+}
+
 // shared::intersectWatertight's tests after the move to the ray's origin, lanes at a time, on
 // the vertices less the origin in the ray's axes order (p[0] = a[kx], p[1] = a[ky], p[2] =
 // a[kz]): the edge test first, the rest only where some lane passes it. live holds the lanes
@@ -389,7 +399,6 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
     const DF df;
     const DU du;
     const std::size_t n = hn::Lanes(df);
-    const VF projectionSlack = hn::Set(df, shared::kProjectionSlack);
     alignas(64) float tLane[64], uLane[64], vLane[64];
     static_assert(HWY_LANES(float) <= 16, "the hit lanes are read as 16 mask bits");
     std::uint8_t bits[8] = {};
@@ -404,15 +413,7 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
             c[k] = hn::Sub(hn::Load(df, &batch.vertex[2][k][j]), origin[k]);
         }
         const VF pa[3] = {a[kx], a[ky], a[kz]}, pb[3] = {b[kx], b[ky], b[kz]}, pc[3] = {c[kx], c[ky], c[kz]};
-        // reach is a maximum of absolute values (no -0, no NaN): the same value whichever equal
-        // operand wins.
-        auto slackOf = [&] {
-            const VF reach =
-                hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
-                        hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
-                                hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
-            return hn::Mul(reach, projectionSlack);
-        };
+        auto slackOf = [&] { return projectionSlackOf(a, b, c); };
         const MF cull = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
         MF m = hn::FirstN(df, batch.count - j);
         VF t, ev, ew, det;
@@ -526,7 +527,6 @@ HWY_INLINE void batchFromOrigin(const LeafTriangles& batch, const glm::vec3& ori
     const DF df;
     const std::size_t n = hn::Lanes(df);
     const VF o[3] = {hn::Set(df, origin.x), hn::Set(df, origin.y), hn::Set(df, origin.z)};
-    const VF projectionSlack = hn::Set(df, shared::kProjectionSlack);
     for (std::size_t j = 0; j < batch.count; j += n) {
         VF a[3], b[3], c[3];
         for (int k = 0; k < 3; ++k) {
@@ -537,10 +537,7 @@ HWY_INLINE void batchFromOrigin(const LeafTriangles& batch, const glm::vec3& ori
             hn::Store(b[k], df, &from.vertex[1][k][j]);
             hn::Store(c[k], df, &from.vertex[2][k][j]);
         }
-        const VF reach = hn::Max(hn::Max(hn::Max(hn::Abs(a[0]), hn::Abs(a[1])), hn::Max(hn::Abs(a[2]), hn::Abs(b[0]))),
-                                 hn::Max(hn::Max(hn::Abs(b[1]), hn::Abs(b[2])),
-                                         hn::Max(hn::Max(hn::Abs(c[0]), hn::Abs(c[1])), hn::Abs(c[2]))));
-        hn::Store(hn::Mul(reach, projectionSlack), df, &from.slack[j]);
+        hn::Store(projectionSlackOf(a, b, c), df, &from.slack[j]);
     }
 }
 
@@ -553,14 +550,14 @@ struct BestInLanes {
 // intersectRay with the rays in lanes and the kept triangles one at a time: a group's rays
 // share their origin, so a triangle's vertices less the origin and its slack are one value
 // for every lane, and only the ray's axes, shear and best hit differ from lane to lane. Each
-// lane computes what intersectRay computes for its ray, operation for operation.
-// pick(vertex, k, j) is coordinate k (0: kx, 1: ky, 2: kz) of triangle j's vertex, lane by
-// lane. Where a group keeps few of a batch's triangles (most leaves), a lane per ray does a
-// vector of work per triangle kept, where a lane per triangle did a vector per ray.
-template <class Pick>
+// lane computes what intersectRay computes for its ray, operation for operation, picking its
+// ray's kx, ky and kz coordinates by selection (is0[k] and is1[k]: coordinate k is 0, 1, else
+// 2), which moves bits without rounding. Where a group keeps few of a batch's triangles (most
+// leaves), a lane per ray does a vector of work per triangle kept, where a lane per triangle
+// did a vector per ray.
 HWY_INLINE void testKeptTriangles(const LeafTriangles& batch, const BatchFromOrigin& from, const std::uint32_t* kept,
-                                  std::uint32_t keptCount, const VF (&shear)[4], VF tmin, MF valid, Pick pick,
-                                  BestInLanes& best) {
+                                  std::uint32_t keptCount, const VF (&shear)[4], VF tmin, MF valid, const MF (&is0)[3],
+                                  const MF (&is1)[3], BestInLanes& best) {
     const DF df;
     const DU du;
     const DI di;
@@ -569,9 +566,15 @@ HWY_INLINE void testKeptTriangles(const LeafTriangles& batch, const BatchFromOri
     const MF none = hn::FirstN(df, 0);
     for (std::uint32_t i = 0; i < keptCount; ++i) {
         const std::uint32_t j = kept[i];
-        const VF a[3] = {pick(0, 0, j), pick(0, 1, j), pick(0, 2, j)};
-        const VF b[3] = {pick(1, 0, j), pick(1, 1, j), pick(1, 2, j)};
-        const VF c[3] = {pick(2, 0, j), pick(2, 1, j), pick(2, 2, j)};
+        auto pick = [&](int vertex, int k) {
+            const float* coordinate = &from.vertex[vertex][0][j];  // coordinate c at [c * kLeafBatch]
+            return hn::IfThenElse(is0[k], hn::Set(df, coordinate[0]),
+                                  hn::IfThenElse(is1[k], hn::Set(df, coordinate[kLeafBatch]),
+                                                 hn::Set(df, coordinate[2 * kLeafBatch])));
+        };
+        const VF a[3] = {pick(0, 0), pick(0, 1), pick(0, 2)};
+        const VF b[3] = {pick(1, 0), pick(1, 1), pick(1, 2)};
+        const VF c[3] = {pick(2, 0), pick(2, 1), pick(2, 2)};
         MF m = valid;
         VF t, ev, ew, det;
         if (!watertightInLanes(a, b, c, sx, sy, sz, batch.cullBackFace[j] != 0u ? valid : none, tmin,
@@ -591,9 +594,7 @@ HWY_INLINE void testKeptTriangles(const LeafTriangles& batch, const BatchFromOri
     }
 }
 
-// The kept triangles against the group's rays, a vector of rays at a time. Where every ray of
-// a vector has the same axes (a coherent group's usual case) the coordinates are picked once
-// for all lanes; otherwise lane by lane.
+// The kept triangles against the group's rays, a vector of rays at a time.
 HWY_INLINE void intersectGroupInLanes(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                                       const LeafTriangles& batch, const BatchFromOrigin& from,
                                       const std::uint32_t* kept, std::uint32_t keptCount, float rayTmin) {
@@ -606,7 +607,6 @@ HWY_INLINE void intersectGroupInLanes(const Ray* rays, Hit* hits, const std::uin
     const VU three = hn::Set(du, 3u);
     alignas(64) std::uint32_t ids[64];
     alignas(64) float bestLanes[4][64];
-    auto coordinate = [&](int vertex, int axis, std::uint32_t j) { return from.vertex[vertex][axis][j]; };
     for (std::uint32_t r = 0; r < rayCount; r += std::uint32_t(n)) {
         const std::uint32_t lanes = std::min(std::uint32_t(n), rayCount - r);
         for (std::size_t l = 0; l < n; ++l) ids[l] = rayIds[r + std::min(std::uint32_t(l), lanes - 1)];
@@ -618,43 +618,14 @@ HWY_INLINE void intersectGroupInLanes(const Ray* rays, Hit* hits, const std::uin
         BestInLanes best{hit[0], hit[2], hit[3], hn::BitCast(du, hit[1])};
         const MF valid = hn::FirstN(df, lanes);
         const VU axes = hn::BitCast(du, dirAndAxes[3]);
-        const std::uint32_t firstAxes = hn::GetLane(axes);
-        auto fixed = [&](auto kx, auto ky, auto kz) {
-            constexpr int axis[3] = {decltype(kx)::value, decltype(ky)::value, decltype(kz)::value};
-            testKeptTriangles(batch, from, kept, keptCount, shear, tmin, valid,
-                              [&](int vertex, int k, std::uint32_t j) { return hn::Set(df, coordinate(vertex, axis[k], j)); },
-                              best);
-        };
-        using I0 = std::integral_constant<int, 0>;
-        using I1 = std::integral_constant<int, 1>;
-        using I2 = std::integral_constant<int, 2>;
-        // ids past `lanes` repeat the last ray, so every lane is a ray of the group.
-        if (hn::AllTrue(du, axes == hn::Set(du, firstAxes))) {
-            switch (firstAxes) {
-                case packedAxes(1, 2, 0): fixed(I1{}, I2{}, I0{}); break;
-                case packedAxes(2, 1, 0): fixed(I2{}, I1{}, I0{}); break;
-                case packedAxes(2, 0, 1): fixed(I2{}, I0{}, I1{}); break;
-                case packedAxes(0, 2, 1): fixed(I0{}, I2{}, I1{}); break;
-                case packedAxes(0, 1, 2): fixed(I0{}, I1{}, I2{}); break;
-                case packedAxes(1, 0, 2): fixed(I1{}, I0{}, I2{}); break;
-                default: HWY_ABORT("ray axes %u: makeRay and segmentRay make only six", firstAxes);
-            }
-        } else {
-            // Lane masks choosing coordinate 0, 1 or else 2 for kx, ky and kz.
-            MF is0[3], is1[3];
-            for (int k = 0; k < 3; ++k) {
-                const VU axis = hn::And(hn::ShiftRightSame(axes, 2 * k), three);
-                is0[k] = hn::RebindMask(df, axis == hn::Zero(du));
-                is1[k] = hn::RebindMask(df, axis == hn::Set(du, 1u));
-            }
-            testKeptTriangles(batch, from, kept, keptCount, shear, tmin, valid,
-                              [&](int vertex, int k, std::uint32_t j) {
-                                  return hn::IfThenElse(is0[k], hn::Set(df, coordinate(vertex, 0, j)),
-                                                        hn::IfThenElse(is1[k], hn::Set(df, coordinate(vertex, 1, j)),
-                                                                       hn::Set(df, coordinate(vertex, 2, j))));
-                              },
-                              best);
+        // Lane masks choosing coordinate 0, 1 or else 2 for kx, ky and kz.
+        MF is0[3], is1[3];
+        for (int k = 0; k < 3; ++k) {
+            const VU axis = hn::And(hn::ShiftRightSame(axes, 2 * k), three);
+            is0[k] = hn::RebindMask(df, axis == hn::Zero(du));
+            is1[k] = hn::RebindMask(df, axis == hn::Set(du, 1u));
         }
+        testKeptTriangles(batch, from, kept, keptCount, shear, tmin, valid, is0, is1, best);
         hn::Store(best.t, df, bestLanes[0]);
         hn::Store(hn::BitCast(df, best.prim), df, bestLanes[1]);
         hn::Store(best.u, df, bestLanes[2]);
@@ -854,8 +825,9 @@ void ClassifyFacing(const Triangle* triangles, std::uint32_t count, const glm::v
 }
 
 // BandEdges::bandsOf (image_bands.hpp) lane by lane: the same float operations on each lane's
-// bounds in the same order. Max and Min where bandsOf takes glm::max and glm::min: they differ
-// at most in a zero's sign, which changes no sum's comparison with the slack.
+// bounds in the same order. Max and Min where bandsOf takes glm::max and glm::min: on finite
+// bounds (a frame's are: the scene is checked for NaN and Inf on load) they differ at most in a
+// zero's sign, which changes no sum's comparison with the slack.
 void BandsOfBounds(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count, const glm::vec3& apex,
                    const glm::vec3* up, std::uint32_t edges, std::uint32_t* first, std::uint32_t* last) {
     const DF df;
