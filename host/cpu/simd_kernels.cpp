@@ -177,16 +177,30 @@ HWY_INLINE void slabInterval(VF origin, VF invDir, float lo, float hi, VF& tNear
     tFar = hn::IfThenElse(parallel, hn::IfThenElse(inside, none, all), maxLike(t0, t1));
 }
 
-// shared::rayMayCrossCell lane by lane: the ray may meet the (widened) cell at some t in
-// [tmin, tmax].
-HWY_INLINE MF mayCrossCell(const VF origin[3], const VF invDir[3], VF tmin, VF tmax, const glm::vec3& lo,
-                           const glm::vec3& hi) {
+// ids[first, first + lanes) into a vector's worth of idLanes, the lanes past `lanes` repeating
+// the last id: every lane then loads a record the caller owns, and the caller masks them off.
+HWY_INLINE void laneIds(const std::uint32_t* ids, std::uint32_t first, std::uint32_t lanes, std::uint32_t* idLanes) {
+    const std::size_t n = hn::Lanes(DF());
+    for (std::size_t l = 0; l < n; ++l) idLanes[l] = ids[first + std::min(std::uint32_t(l), lanes - 1)];
+}
+
+// shared::rayBoxIntervalRounded lane by lane.
+HWY_INLINE void rayBoxIntervalRounded(const VF origin[3], const VF invDir[3], const glm::vec3& lo, const glm::vec3& hi,
+                                      VF& tNear, VF& tFar) {
     VF xn, xf, yn, yf, zn, zf;
     slabInterval(origin[0], invDir[0], lo.x, hi.x, xn, xf);
     slabInterval(origin[1], invDir[1], lo.y, hi.y, yn, yf);
     slabInterval(origin[2], invDir[2], lo.z, hi.z, zn, zf);
-    const VF tNear = maxLike(xn, maxLike(yn, zn));
-    const VF tFar = minLike(xf, minLike(yf, zf));
+    tNear = maxLike(xn, maxLike(yn, zn));
+    tFar = minLike(xf, minLike(yf, zf));
+}
+
+// shared::rayMayCrossCell lane by lane: the ray may meet the (widened) cell at some t in
+// [tmin, tmax].
+HWY_INLINE MF mayCrossCell(const VF origin[3], const VF invDir[3], VF tmin, VF tmax, const glm::vec3& lo,
+                           const glm::vec3& hi) {
+    VF tNear, tFar;
+    rayBoxIntervalRounded(origin, invDir, lo, hi, tNear, tFar);
     return hn::And(hn::And(tNear <= tFar, tFar >= tmin), tNear <= tmax);
 }
 
@@ -251,7 +265,7 @@ std::uint32_t EndRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* i
     std::uint32_t ended = 0;
     for (std::uint32_t k = 0; k < count; k += std::uint32_t(n)) {
         const std::uint32_t lanes = std::min(std::uint32_t(n), count - k);
-        for (std::size_t l = 0; l < n; ++l) idLanes[l] = ids[k + std::min(std::uint32_t(l), lanes - 1)];
+        laneIds(ids, k, lanes, idLanes);
         VF best[4];
         loadQuadPerLane<0, 4>(hit, idLanes, best);  // t, prim, u, v
         MF ends = hn::And(hn::RebindMask(df, hn::BitCast(du, best[1]) != miss), hn::FirstN(df, lanes));
@@ -260,11 +274,8 @@ std::uint32_t EndRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* i
             VF start[4], invDir[4];
             loadQuadPerLane<0>(ray, idLanes, start);
             loadQuadPerLane<8>(ray, idLanes, invDir);
-            VF xn, xf, yn, yf, zn, zf;
-            slabInterval(start[0], invDir[0], box.lo.x, box.hi.x, xn, xf);
-            slabInterval(start[1], invDir[1], box.lo.y, box.hi.y, yn, yf);
-            slabInterval(start[2], invDir[2], box.lo.z, box.hi.z, zn, zf);
-            const VF tFar = minLike(xf, minLike(yf, zf));
+            VF tNear, tFar;
+            rayBoxIntervalRounded(start, invDir, box.lo, box.hi, tNear, tFar);
             const VF farHigh = hn::Add(tFar, hn::Mul(hn::Abs(tFar), slabSlack));
             ends = hn::And(ends, best[0] <= farHigh);
         }
@@ -609,7 +620,7 @@ HWY_INLINE void intersectGroupInLanes(const Ray* rays, Hit* hits, const std::uin
     alignas(64) float bestLanes[4][64];
     for (std::uint32_t r = 0; r < rayCount; r += std::uint32_t(n)) {
         const std::uint32_t lanes = std::min(std::uint32_t(n), rayCount - r);
-        for (std::size_t l = 0; l < n; ++l) ids[l] = rayIds[r + std::min(std::uint32_t(l), lanes - 1)];
+        laneIds(rayIds, r, lanes, ids);
         // Floats 4-7 of a Ray: the direction and the packed axes; 12-14 the shear.
         VF dirAndAxes[4], shear[4], hit[4];
         loadQuadPerLane<4>(rayFloats, ids, dirAndAxes);
@@ -658,7 +669,7 @@ HWY_INLINE RayPacket boundsOfGroup(const Ray* rays, const std::uint32_t* rayIds,
     alignas(64) std::uint32_t ids[64];
     for (std::uint32_t i = 0; i < count; i += std::uint32_t(n)) {
         const std::uint32_t lanes = std::min(std::uint32_t(n), count - i);
-        for (std::size_t l = 0; l < n; ++l) ids[l] = rayIds[i + std::min(std::uint32_t(l), lanes - 1)];
+        laneIds(rayIds, i, lanes, ids);
         VF invDir[4];
         loadQuadPerLane<8>(base, ids, invDir);  // floats 8-10 of a Ray
         for (int a = 0; a < 3; ++a) {
