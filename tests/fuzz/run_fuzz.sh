@@ -50,8 +50,11 @@ fi
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 # Configure only once (the generator cannot change afterwards); later runs rebuild incrementally.
+# Line tables only: a finding's stack still has files and lines, and the build is shorter than
+# with -g (host/core/gltf_loader.cpp 15.3 s against 19.3 s; docs/fuzzing.md).
 if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+        -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
         -DDACRT_FUZZ=ON >"$build/configure.log" 2>&1 || { cat "$build/configure.log"; exit 1; }
 fi
 cmake --build "$build" --target "dacrt_${target}_fuzzer"
@@ -60,7 +63,13 @@ fuzzer="$build/dacrt_${target}_fuzzer"
 # UBSan reports abort (the code is built with -fno-sanitize-recover=all); these make the
 # report carry a stack. Leaks count as findings (libFuzzer's -detect_leaks=1 default).
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:allocator_may_return_null=0}"
+# intercept_tls_get_addr=0: clang 14's runtime can take a dynamic TLS block (OpenImageIO's, in
+# the module loaded for images) for one with a pre-2.25 glibc header when its address is 16 past
+# a page, and LeakSanitizer's tracer then dies on it ("Tracer caught signal 11", "LeakSanitizer
+# has encountered a fatal error"; google/sanitizers#1322): fuzz.image failed so in 3 of 5 runs
+# on 2026-12-06 with nothing found. Without the interceptor those blocks are reached as the heap
+# blocks they are (10-second runs of image, exr and gltf reported no leak).
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:allocator_may_return_null=0:intercept_tls_get_addr=0}"
 # Leaks inside libraries, not dacrt, are suppressed as in the sanitizer job (.ci/lsan.supp).
 export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$here/../../.ci/lsan.supp:print_suppressions=0}"
 
