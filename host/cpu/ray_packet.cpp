@@ -18,4 +18,29 @@ bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin,
     return tNear <= tFar && tFar >= tmin;
 }
 
+void sortRaysByTile(const std::uint32_t* rayIds, std::uint32_t count, std::uint32_t imageWidth, std::uint32_t tiles,
+                    std::uint32_t* tileEnds, std::uint32_t* sorted) {
+    const std::uint32_t tilesX = (imageWidth + kPacketTile - 1) / kPacketTile;
+    auto tileOf = [&](std::uint32_t id) { return (id / imageWidth / kPacketTile) * tilesX + (id % imageWidth) / kPacketTile; };
+    std::uint32_t* start = tileEnds;  // start[t]: where tile t's rays begin, until they are placed
+    std::fill(start, start + tiles + 1, 0u);
+    auto forEachRun = [&](auto&& onRun) {
+        for (std::uint32_t k = 0; k < count;) {
+            const std::uint32_t id = rayIds[k];
+            const std::uint32_t x = id % imageWidth;
+            const std::uint32_t idsLeftInTileRow = std::min(kPacketTile - x % kPacketTile, imageWidth - x);
+            std::uint32_t runEnd = k + 1;
+            while (runEnd < count && runEnd - k < idsLeftInTileRow && rayIds[runEnd] == id + (runEnd - k)) ++runEnd;
+            onRun(tileOf(id), k, runEnd);
+            k = runEnd;
+        }
+    };
+    forEachRun([&](std::uint32_t tile, std::uint32_t runBegin, std::uint32_t runEnd) { start[tile + 1] += runEnd - runBegin; });
+    for (std::uint32_t t = 0; t < tiles; ++t) start[t + 1] += start[t];
+    forEachRun([&](std::uint32_t tile, std::uint32_t runBegin, std::uint32_t runEnd) {
+        std::copy(rayIds + runBegin, rayIds + runEnd, sorted + start[tile]);
+        start[tile] += runEnd - runBegin;
+    });
+}
+
 }  // namespace dacrt

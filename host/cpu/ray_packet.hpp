@@ -40,6 +40,17 @@ void addToPacketBounds(Packet& p, const glm::vec3& invDir) {
     }
 }
 
+// rayIds[0, count), ids of a frame's pixel rays (id = y * imageWidth + x), copied into sorted
+// by their 8x8 tile (tiles row-major, tilesX = ceil(imageWidth / 8) a row), each tile's ids in
+// their order in rayIds: a stable counting sort over `tiles` tiles. tileEnds (tiles + 1
+// entries) comes out with tileEnds[t] where tile t's ids end in sorted (its begin: the end of
+// the tile before, or 0). It goes run by run of consecutive ids within a tile's row (up to
+// eight pixels, fewer in the last column of a width that is not a multiple of 8): one division
+// a run, and a count or slot kept in a register through it, where each id divided and waited
+// on the store of the one before it to the same counter.
+void sortRaysByTile(const std::uint32_t* rayIds, std::uint32_t count, std::uint32_t imageWidth, std::uint32_t tiles,
+                    std::uint32_t* tileEnds, std::uint32_t* sorted);
+
 // The packet filter: false only where shared::rayMayCrossCell(ray, cell, tmax) is false for
 // every ray of p (origin and tmin: the rays' shared start).
 bool packetMayCrossCell(const RayPacket& p, const glm::vec3& origin, float tmin, const Box& cell);

@@ -318,38 +318,15 @@ void DacrtTraversal::tracePackets(const Box& box, std::uint32_t& terminated, std
 
 // A counting sort of the rays by 8x8 tile into packetRays, then each packet's bounds.
 std::uint32_t DacrtTraversal::buildPackets(std::uint32_t begin, std::uint32_t end) {
-    const std::uint32_t tilesX = (imageWidth_ + kPacketTile - 1) / kPacketTile;
-    auto tileOf = [&](std::uint32_t id) { return (id / imageWidth_ / kPacketTile) * tilesX + (id % imageWidth_) / kPacketTile; };
-    std::uint32_t* start = packet_.tileCounts;  // start[t]: where tile t's rays begin
-    std::fill(start, start + tiles_ + 1, 0u);
-    // Both passes go run by run of consecutive ids within a tile's row (up to eight pixels):
-    // one division a run, and a count or slot kept in a register through it, where each ray
-    // divided and waited on the store of the one before it to the same counter.
-    auto forEachRun = [&](auto&& onRun) {
-        for (std::uint32_t k = begin; k < end;) {
-            const std::uint32_t id = rayIds_[k];
-            const std::uint32_t x = id % imageWidth_;
-            const std::uint32_t idsLeftInTileRow = std::min(kPacketTile - x % kPacketTile, imageWidth_ - x);
-            std::uint32_t runEnd = k + 1;
-            while (runEnd < end && runEnd - k < idsLeftInTileRow && rayIds_[runEnd] == id + (runEnd - k)) ++runEnd;
-            onRun(tileOf(id), k, runEnd);
-            k = runEnd;
-        }
-    };
-    forEachRun([&](std::uint32_t tile, std::uint32_t runBegin, std::uint32_t runEnd) { start[tile + 1] += runEnd - runBegin; });
-    for (std::uint32_t t = 0; t < tiles_; ++t) start[t + 1] += start[t];
-    forEachRun([&](std::uint32_t tile, std::uint32_t runBegin, std::uint32_t runEnd) {
-        std::copy(rayIds_ + runBegin, rayIds_ + runEnd, packet_.packetRays + start[tile]);
-        start[tile] += runEnd - runBegin;
-    });
-    // start[t] is now where tile t's rays end.
+    std::uint32_t* tileEnds = packet_.tileCounts;
+    sortRaysByTile(rayIds_ + begin, end - begin, imageWidth_, tiles_, tileEnds, packet_.packetRays);
     std::uint32_t packets = 0, tileBegin = 0;
-    for (std::uint32_t t = 0; t < tiles_; tileBegin = start[t], ++t) {
-        if (start[t] == tileBegin) continue;
+    for (std::uint32_t t = 0; t < tiles_; tileBegin = tileEnds[t], ++t) {
+        if (tileEnds[t] == tileBegin) continue;
         RayPacket& p = packet_.packets[packets];
-        p = simd::boundsOfRays(rays_, packet_.packetRays + tileBegin, start[t] - tileBegin);
+        p = simd::boundsOfRays(rays_, packet_.packetRays + tileBegin, tileEnds[t] - tileBegin);
         p.begin = tileBegin;
-        p.end = start[t];
+        p.end = tileEnds[t];
         packet_.packetIds[packets] = packets;
         ++packets;
     }

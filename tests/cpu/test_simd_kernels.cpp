@@ -16,6 +16,7 @@
 #include "cpu/cull_lanes.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/predicates.hpp"
+#include "cpu/ray_packet.hpp"
 #include "cpu/simd_kernels.hpp"
 #include "support/simd_targets.hpp"
 #include "cpu/traversal.hpp"
@@ -496,6 +497,110 @@ TEST_F(EveryTarget, LeafGroupsGiveTheBatchsHitsBitForBit) {
         EXPECT_GT(skipped, tests / 20) << "the groups must narrow the leaf, not only keep it";
         EXPECT_GT(missedWithoutWidening, 0u) << "the leaf must hold hits that only the widening keeps";
     });
+}
+
+// A triangle hit at exactly the t of the ray's best so far wins by the smaller id, the ids
+// compared unsigned (shared::hitPrecedes): it takes the place of a miss ending there
+// (kMissPrim) or of a hit whose id is 2^31 or more, and not of a hit with id 0. The groups
+// compare ids in signed lanes with their top bits flipped, and the per-ray kernel in scalar
+// code: both must give the scalar test's winners. Without the flip, the first two kinds of tie
+// go the other way.
+TEST_F(EveryTarget, LeafKernelsBreakTiesWithTheIdsAsUnsigned) {
+    forEachTarget([] {
+        Random rng(31);
+        constexpr std::uint32_t kTieIds[] = {kMissPrim, 0x80000000u, 0u};
+        std::size_t ties[3] = {}, tiesWon[3] = {};
+        for (int trial = 0; trial < 300; ++trial) {
+            SharedStartLeaf leaf = sharedStartLeaf(rng);
+            std::vector<Hit> truth(leaf.rays.size(), missHit());
+            for (std::uint32_t id : leaf.rayIds)
+                for (std::uint32_t prim : leaf.triIds) testTriangle(leaf.rays[id], leaf.tris[prim], prim, truth[id]);
+            // Each ray that hits starts with a best at its hit's t, under one of the tie ids.
+            std::vector<Hit> start(leaf.rays.size(), missHit());
+            std::vector<int> kind(leaf.rays.size(), -1);
+            for (std::size_t i = 0; i < leaf.rays.size(); ++i)
+                if (truth[i].prim != kMissPrim) {
+                    kind[i] = int(rng.index(3));
+                    start[i] = Hit{truth[i].t, kTieIds[kind[i]], 0.25f, 0.5f};
+                }
+            std::vector<Hit> expected = start, groups = start, perRay = start;
+            for (std::uint32_t id : leaf.rayIds)
+                for (std::uint32_t prim : leaf.triIds) testTriangle(leaf.rays[id], leaf.tris[prim], prim, expected[id]);
+            simd::LeafTriangles batch;
+            simd::gatherLeafTriangles(leaf.tris.data(), leaf.triIds.data(), std::uint32_t(leaf.triIds.size()), batch);
+            const std::uint32_t rayCount = std::uint32_t(leaf.rayIds.size());
+            simd::intersectBatchInGroups(leaf.rays.data(), groups.data(), leaf.rayIds.data(), rayCount, batch,
+                                         2.0f * leaf.margin);
+            simd::intersectBatch(leaf.rays.data(), perRay.data(), leaf.rayIds.data(), rayCount, batch);
+            for (std::size_t i = 0; i < leaf.rays.size(); ++i) {
+                ASSERT_TRUE(sameHit(groups[i], expected[i]))
+                    << "trial " << trial << " ray " << i << ": groups prim " << groups[i].prim << ", scalar prim "
+                    << expected[i].prim << " (tie with " << start[i].prim << " at t " << start[i].t << ")";
+                ASSERT_TRUE(sameHit(perRay[i], expected[i]))
+                    << "trial " << trial << " ray " << i << ": per-ray prim " << perRay[i].prim << ", scalar prim "
+                    << expected[i].prim << " (tie with " << start[i].prim << " at t " << start[i].t << ")";
+                if (kind[i] < 0) continue;
+                ++ties[kind[i]];
+                tiesWon[kind[i]] += expected[i].prim != start[i].prim;
+            }
+        }
+        // The hit takes the tie from the miss and the high id every time it is the best hit, and
+        // never from id 0 unless it is triangle 0.
+        EXPECT_EQ(tiesWon[0], ties[0]);
+        EXPECT_EQ(tiesWon[1], ties[1]);
+        EXPECT_LT(tiesWon[2], ties[2] / 4);
+        EXPECT_GT(ties[0], 1000u);
+        EXPECT_GT(ties[1], 1000u);
+    });
+}
+
+// The packets' tile sort gives what a stable sort of the ids by 8x8 tile gives, and each
+// tile's end, on widths that are not multiples of 8 (the last column of tiles narrower: a
+// run of ids stops at the row's end) as on those that are: ids in runs in pixel order (as a
+// frame starts), in runs whose order is shuffled (as the partitions leave them), and one by
+// one in any order, each with pixels left out.
+TEST(PacketTiles, SortedAsAStableSortByTileOnEveryWidth) {
+    Random rng(37);
+    std::size_t cases = 0;
+    for (const std::uint32_t width : {1u, 3u, 7u, 8u, 9u, 13u, 16u, 21u, 64u, 67u})
+        for (int trial = 0; trial < 40; ++trial) {
+            const std::uint32_t height = 1 + std::uint32_t(rng.index(20));
+            const std::uint32_t tilesX = (width + kPacketTile - 1) / kPacketTile;
+            const std::uint32_t tiles = tilesX * ((height + kPacketTile - 1) / kPacketTile);
+            const double keep = trial % 4 == 0 ? 1.0 : rng.uniformFloat(0.2f, 0.95f);
+            std::vector<std::uint32_t> ids;
+            for (std::uint32_t id = 0; id < width * height; ++id)
+                if (rng.uniform() < keep) ids.push_back(id);
+            if (trial % 3 == 1) {  // runs of up to 20 ids, their order shuffled
+                std::vector<std::vector<std::uint32_t>> runs;
+                for (std::size_t k = 0; k < ids.size();) {
+                    const std::size_t length = std::min(ids.size() - k, std::size_t(1 + rng.index(20)));
+                    runs.emplace_back(ids.begin() + std::ptrdiff_t(k), ids.begin() + std::ptrdiff_t(k + length));
+                    k += length;
+                }
+                for (std::size_t k = runs.size(); k > 1; --k) std::swap(runs[k - 1], runs[rng.index(k)]);
+                ids.clear();
+                for (const auto& run : runs) ids.insert(ids.end(), run.begin(), run.end());
+            } else if (trial % 3 == 2) {
+                for (std::size_t k = ids.size(); k > 1; --k) std::swap(ids[k - 1], ids[rng.index(k)]);
+            }
+            auto tileOf = [&](std::uint32_t id) {
+                return (id / width) / kPacketTile * tilesX + (id % width) / kPacketTile;
+            };
+            std::vector<std::uint32_t> expected = ids;
+            std::stable_sort(expected.begin(), expected.end(),
+                             [&](std::uint32_t a, std::uint32_t b) { return tileOf(a) < tileOf(b); });
+            std::vector<std::uint32_t> sorted(ids.size(), 0xFFFFFFFFu), ends(tiles + 1, 0xFFFFFFFFu);
+            sortRaysByTile(ids.data(), std::uint32_t(ids.size()), width, tiles, ends.data(), sorted.data());
+            ASSERT_EQ(sorted, expected) << "width " << width << " height " << height << " trial " << trial;
+            std::uint32_t end = 0;
+            for (std::uint32_t t = 0; t < tiles; ++t) {
+                while (end < expected.size() && tileOf(expected[end]) == t) ++end;
+                ASSERT_EQ(ends[t], end) << "width " << width << " height " << height << " trial " << trial << " tile " << t;
+            }
+            ++cases;
+        }
+    EXPECT_EQ(cases, 400u);
 }
 
 // A packet's answer covers every one of its rays' answers (with no best hit yet), and it
