@@ -82,6 +82,18 @@ bool outsideFrustum(const Triangle& t, const ViewFrustum& f) {
 
 namespace {
 
+// box.extend(t.v0), box.extend(t.v1), box.extend(t.v2) where `kept`, else nothing, as
+// box.extend(the triangle's own minimum), box.extend(its maximum): each glm::min and glm::max
+// keeps its first operand on a tie, so either way the first of equal values in the order
+// chunk, triangle, vertex wins (a zero's sign included), and the box has the same bits.
+// Where not kept, the triangle's bounds are replaced by an empty box's, which changes nothing.
+inline void extendByTriangle(Box& box, const Triangle& t, bool kept) {
+    const glm::vec3 lo = glm::min(glm::min(t.v0, t.v1), t.v2), hi = glm::max(glm::max(t.v0, t.v1), t.v2);
+    const Box empty;
+    box.lo = glm::min(box.lo, kept ? lo : empty.lo);
+    box.hi = glm::max(box.hi, kept ? hi : empty.hi);
+}
+
 // Whether the whole box lies inside the frustum with room to spare: then no triangle in it is
 // outside, and the per-triangle test is skipped.
 bool frustumHolds(const ViewFrustum& f, const Box& box) {
@@ -117,22 +129,24 @@ TriangleSkips skipTriangles(const FrameGeometry& g, const SkipSwitches& switches
         std::vector<std::uint8_t> facing(end - begin, backFaces ? simd::kUndecided : simd::kKeep);
         if (backFaces && end - begin <= simd::kMaxTriangles)
             simd::classifyFacing(tris.data() + begin, std::uint32_t(end - begin), g.rayOrigin, facing.data());
+        // The verdicts, counts and box by arithmetic on each triangle's outcome rather than
+        // branches on it (half the single-sided triangles of a closed mesh face away: a coin
+        // toss a triangle), and the box through the triangle's own bounds, so that its chain
+        // of dependent minima and maxima is one long a triangle, not three.
         for (std::size_t i = begin; i < end; ++i) {
             const Triangle& t = tris[i];
-            Verdict v = Verdict::Traced;
-            tally.singleSided += t.cullBackFace != 0u;
             const std::uint8_t f = facing[i - begin];
-            if (f == simd::kDrop || (f == simd::kUndecided && t.cullBackFace && facesAwayFrom(t, origin)))
-                v = Verdict::BackFacing, ++tally.backFacing;
-            else if (frustum && outsideFrustum(t, *g.frustum))
-                v = Verdict::OutsideFrustum, ++tally.outside;
-            else {
-                ++tally.kept;
-                tally.box.extend(t.v0);  // the triangle's bounds, without reading them
-                tally.box.extend(t.v1);
-                tally.box.extend(t.v2);
-            }
-            verdict[i] = std::uint8_t(v);
+            const bool singleSided = t.cullBackFace != 0u;
+            const bool back = (f == simd::kDrop) | (f == simd::kUndecided && singleSided && facesAwayFrom(t, origin));
+            const bool outside = !back && frustum && outsideFrustum(t, *g.frustum);
+            const bool kept = !back && !outside;
+            tally.singleSided += singleSided;
+            tally.backFacing += back;
+            tally.outside += outside;
+            tally.kept += kept;
+            extendByTriangle(tally.box, t, kept);  // the triangle's bounds, without reading them
+            static_assert(std::uint8_t(Verdict::BackFacing) == 1 && std::uint8_t(Verdict::OutsideFrustum) == 2);
+            verdict[i] = std::uint8_t(std::uint8_t(back) | std::uint8_t(outside) << 1);
         }
         tallies[c] = tally;
     });
@@ -167,9 +181,15 @@ std::uint64_t listTraced(const std::vector<SkipTally>& tallies, const std::uint8
     resizeMapped(s.traced, total);
     pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
         const auto [begin, end] = skipChunkRange(c, chunks, triangles);
+        // Every id written at the next place, which moves on where the id is kept (no branch
+        // on the verdict); the chunk's last kept id ends the loop, so that no write passes
+        // the chunk's own places.
         std::uint64_t k = offset[c];
-        for (std::size_t i = begin; i < end; ++i)
-            if (verdict[i] == kTracedVerdict) s.traced[k++] = std::uint32_t(i);
+        const std::uint64_t chunkEnd = c + 1 < chunks ? offset[c + 1] : total;
+        for (std::size_t i = begin; i < end && k < chunkEnd; ++i) {
+            s.traced[k] = std::uint32_t(i);
+            k += verdict[i] == kTracedVerdict;
+        }
     });
     return outside;
 }
