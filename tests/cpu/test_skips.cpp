@@ -1,6 +1,8 @@
 // The face rule (single-sided triangles are hit from the front only) in every CPU test, and
 // the triangle skips: each drops only triangles no ray of the frame can hit, so every backend
 // traces the same hits with them as brute force does without them.
+#include <cstring>
+
 #include <gtest/gtest.h>
 
 #include "core/procedural.hpp"
@@ -197,6 +199,64 @@ TEST(Skips, EveryCpuBackendWithSkipsEqualsBruteWithoutInsideAnOpenBox) {
         for (unsigned regions : {1u, 2u, 4u})
             EXPECT_TRUE(identicalHits(reference.hits, traceWithSkips(culled, b, SkipSwitches{}, regions).hits))
                 << toString(b) << ", " << regions << " regions";
+}
+
+// The skip pass's list and box are their scalar definitions, bit for bit: the ids of the
+// triangles neither test drops, ascending, and the box Box::extend makes of their vertices in
+// that order (the first of equal values wins, so a zero's sign is the first zero's). A sphere of
+// 20,480 single-sided triangles (five chunks of the pass) touches x = 0 and y = 0, where its
+// vertices take +0 or -0 at random; half its faces turn away from the eye, and a narrow view
+// leaves part of it outside the frustum.
+TEST(Skips, TheTracedListAndBoxAreTheirScalarDefinitionsBitForBit) {
+    Scene scene = sceneFromMeshes({icosphere({0.5f, -0.5f, -3.0f}, 0.5f, 5)});
+    applyCullMode(scene, CullMode::BackFaces);
+    Random rng(41);
+    std::size_t signedZeros = 0;
+    for (Triangle& t : scene.triangles)
+        for (glm::vec3* v : {&t.v0, &t.v1, &t.v2}) {
+            if (v->x <= 0.02f) v->x = rng.uniform() < 0.5 ? -0.0f : 0.0f, ++signedZeros;
+            if (v->y >= -0.02f) v->y = rng.uniform() < 0.5 ? -0.0f : 0.0f, ++signedZeros;
+        }
+    ASSERT_GT(signedZeros, 20u);
+    CameraOptions view;
+    view.eye = glm::dvec3(2.0, -0.7, 0.0);
+    view.target = glm::dvec3(0.5, -0.5, -3.0);
+    view.fovDegrees = 6.0;
+    Frame frame(std::move(scene), 64, 48, view);
+    frame.geometry.frustum = viewFrustum(defaultCamera(frame.scene, 64, 48, view), 64, 48);
+    ThreadPool pool(2);
+    for (const bool frustum : {false, true}) {
+        SkipSwitches switches;
+        switches.frustum = frustum;
+        const TriangleSkips skips = skipTriangles(frame.geometry, switches, pool);
+        ASSERT_TRUE(skips.applied);
+        ASSERT_EQ(skips.frustumTested, frustum);
+        std::vector<std::uint32_t> traced;
+        Box box;
+        std::uint64_t back = 0, outside = 0;
+        const glm::dvec3 origin(frame.geometry.rayOrigin);
+        for (std::uint32_t i = 0; i < frame.scene.triangles.size(); ++i) {
+            const Triangle& t = frame.scene.triangles[i];
+            if (t.cullBackFace && facesAwayFrom(t, origin)) {
+                ++back;
+            } else if (frustum && outsideFrustum(t, *frame.geometry.frustum)) {
+                ++outside;
+            } else {
+                traced.push_back(i);
+                box.extend(t.v0), box.extend(t.v1), box.extend(t.v2);
+            }
+        }
+        EXPECT_GT(back, 8000u);
+        if (frustum) EXPECT_GT(outside, 1000u);
+        EXPECT_EQ(skips.backFacing, back);
+        EXPECT_EQ(skips.outsideFrustum, outside);
+        ASSERT_EQ(std::vector<std::uint32_t>(skips.traced.begin(), skips.traced.end()), traced) << "frustum " << frustum;
+        EXPECT_EQ(std::memcmp(&skips.tracedBox, &box, sizeof(Box)), 0)
+            << "frustum " << frustum << ": lo " << skips.tracedBox.lo.x << " " << skips.tracedBox.lo.y << ", expected "
+            << box.lo.x << " " << box.lo.y << "; hi " << skips.tracedBox.hi.x << " " << skips.tracedBox.hi.y
+            << ", expected " << box.hi.x << " " << box.hi.y;
+        if (!frustum) EXPECT_TRUE(box.lo.x == 0.0f && box.hi.y == 0.0f) << "the zeros must bound the traced box";
+    }
 }
 
 TEST(Skips, AFrameWhoseTrianglesAreAllSkippedNeedsNoTrace) {
