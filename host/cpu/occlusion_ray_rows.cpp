@@ -6,6 +6,7 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
+#include <cstring>
 
 #include "core/ray_fields-inl.h"
 #include "cpu/occlusion_ray_rows.hpp"
@@ -83,6 +84,75 @@ void MakeOcclusionRays(const OcclusionBatch& batch, std::uint32_t seed, float se
     }
 }
 
+// shared::dot3 lane by lane: (a.x b.x + a.y b.y) + a.z b.z.
+template <class VF>
+HWY_INLINE VF Dot3(const VF (&a)[3], const VF (&b)[3]) {
+    return hn::Add(hn::Add(hn::Mul(a[0], b[0]), hn::Mul(a[1], b[1])), hn::Mul(a[2], b[2]));
+}
+
+int MakeShadowRays(const ShadowBatch& batch, const shared::ShadowLight& light, Ray* out, std::uint32_t* surface) {
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int lanes = int(hn::Lanes(df));
+    const bool directional = light.type == shared::kLightDirectional;
+    const bool spot = light.type == shared::kLightSpot;
+    const bool ranged = light.range > 0.0f;
+    const VF zero = hn::Zero(df);
+    const VF position[3] = {hn::Set(df, light.position.x), hn::Set(df, light.position.y), hn::Set(df, light.position.z)};
+    const VF shining[3] = {hn::Set(df, light.direction.x), hn::Set(df, light.direction.y), hn::Set(df, light.direction.z)};
+    const VF towardLight[3] = {hn::Neg(shining[0]), hn::Neg(shining[1]), hn::Neg(shining[2])};
+    const VF rangeSquared = hn::Set(df, light.range * light.range);
+    const VF cosOuterSquared = hn::Set(df, light.cosOuterSquared);
+    const VF smallest = hn::Set(df, shared::kSmallestDirection);
+    const VF tmin = hn::Set(df, shared::kSegmentStart), tmax = hn::Set(df, shared::shadowSegmentEnd(light));
+    constexpr std::size_t kMost = hn::MaxLanes(df);
+    HWY_ALIGN float storage[4][4 * kMost];
+    float* const quarters[4] = {storage[0], storage[1], storage[2], storage[3]};
+    int made = 0;
+    for (int i = 0; i < batch.count; i += lanes) {
+        const int valid = std::min(lanes, batch.count - i);
+        VF point[3], normal[3], origin[3];
+        for (int c = 0; c < 3; ++c) {
+            point[c] = hn::LoadU(df, batch.point[c] + i);
+            normal[c] = hn::LoadU(df, batch.normal[c] + i);
+            origin[c] = hn::LoadU(df, batch.origin[c] + i);
+        }
+        // shadowRay's tests in its order: the surface faces the light, then (point and spot
+        // lights) the range and the cone, then a direction long enough to make a ray of.
+        VF toLight[3], d[3];
+        for (int c = 0; c < 3; ++c) {
+            toLight[c] = directional ? towardLight[c] : hn::Sub(position[c], point[c]);
+            d[c] = directional ? towardLight[c] : hn::Sub(position[c], origin[c]);
+        }
+        auto reaches = hn::And(hn::FirstN(df, std::size_t(valid)), hn::Gt(Dot3(normal, toLight), zero));
+        if (!directional) {
+            const VF distanceSquared = Dot3(toLight, toLight);
+            if (ranged) reaches = hn::AndNot(hn::Gt(distanceSquared, rangeSquared), reaches);
+            if (spot) {
+                const VF along = hn::Neg(Dot3(shining, toLight));
+                const auto outside = hn::Or(hn::Not(hn::Gt(along, zero)),
+                                            hn::Lt(hn::Mul(along, along), hn::Mul(cosOuterSquared, distanceSquared)));
+                reaches = hn::AndNot(outside, reaches);
+            }
+        }
+        const VF largest = hn::Max(hn::Abs(d[0]), hn::Max(hn::Abs(d[1]), hn::Abs(d[2])));
+        reaches = hn::AndNot(hn::Lt(largest, smallest), reaches);
+        if (hn::AllFalse(df, reaches)) continue;
+        for (int c = 0; c < 3; ++c) d[c] = ray_fields::HWY_NAMESPACE::FlushSmall(df, d[c]);
+        ray_fields::HWY_NAMESPACE::StoreRayQuarters(df, origin, tmin, d, tmax, quarters);
+        alignas(8) std::uint8_t bits[8] = {};
+        hn::StoreMaskBits(df, reaches, bits);
+        std::uint32_t mask = std::uint32_t(bits[0]) | std::uint32_t(bits[1]) << 8;
+        for (; mask; mask &= mask - 1) {
+            const int l = __builtin_ctz(mask);
+            auto* ray = reinterpret_cast<unsigned char*>(&out[made]);
+            for (int q = 0; q < 4; ++q) std::memcpy(ray + 16 * q, quarters[q] + 4 * l, 16);
+            surface[made++] = std::uint32_t(i + l);
+        }
+    }
+    return made;
+}
+
 }  // namespace HWY_NAMESPACE
 }  // namespace dacrt::occlusion
 HWY_AFTER_NAMESPACE();
@@ -91,10 +161,15 @@ HWY_AFTER_NAMESPACE();
 namespace dacrt {
 namespace occlusion {
 HWY_EXPORT(MakeOcclusionRays);
+HWY_EXPORT(MakeShadowRays);
 }  // namespace occlusion
 
 void makeOcclusionRays(const OcclusionBatch& batch, std::uint32_t seed, float segmentLength, Ray* out) {
     HWY_DYNAMIC_DISPATCH(occlusion::MakeOcclusionRays)(batch, seed, segmentLength, out);
+}
+
+int makeShadowRays(const ShadowBatch& batch, const shared::ShadowLight& light, Ray* out, std::uint32_t* surface) {
+    return HWY_DYNAMIC_DISPATCH(occlusion::MakeShadowRays)(batch, light, out, surface);
 }
 
 }  // namespace dacrt

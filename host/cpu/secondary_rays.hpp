@@ -87,8 +87,8 @@ void secondaryRaysOf(const SecondaryPass& pass, std::uint32_t i, const Hit& hit,
 }
 
 // The rays primary rays first .. end - 1 send in the pass, in slot order, as secondaryRaysOf
-// makes them one primary ray at a time (the same rays, emitted in the same order): an occlusion
-// pass's are made in batches, several at a time (occlusion_ray_rows.hpp). primaryRayOf(i)
+// makes them one primary ray at a time (the same rays, emitted in the same order), made in
+// batches several at a time (occlusion_ray_rows.hpp). primaryRayOf(i)
 // returns ray i, asked for only where it hit.
 template <typename PrimaryRayOf, typename Emit>
 void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::size_t end, const Hit* hits,
@@ -99,12 +99,33 @@ void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::siz
         if (i + kHitsAhead < end && hitSendsRays(hits[i + kHitsAhead]))
             simd::prefetchTriangle(triangles[hits[i + kHitsAhead].prim]);
     };
-    if (pass.kind != shared::kPassOcclusion) {
+    if (pass.kind == shared::kPassShadow) {
+        // A shadow ray per surface, made in batches several at a time (makeShadowRays), each
+        // emitted raysPerHit times as secondaryRaysOf emits it.
+        ShadowBatch batch;
+        std::uint32_t firstSlot[ShadowBatch::kRays], surface[ShadowBatch::kRays];
+        Ray rays[ShadowBatch::kRays];
+        const auto flush = [&] {
+            const int made = makeShadowRays(batch, pass.light, rays, surface);
+            for (int r = 0; r < made; ++r)
+                for (std::uint32_t k = 0; k < pass.raysPerHit; ++k) emit(firstSlot[surface[r]] + k, rays[r]);
+            batch.count = 0;
+        };
         for (std::size_t i = first; i < end; ++i) {
             prefetchAhead(i);
-            secondaryRaysOf(pass, std::uint32_t(i), hits[i], [&]() -> decltype(auto) { return primaryRayOf(i); },
-                            triangles, emit);
+            if (!hitSendsRays(hits[i])) continue;
+            const shared::SurfaceSample s = shared::surfaceOfHit(primaryRayOf(i), hits[i], triangles[hits[i].prim]);
+            if (!s.valid) continue;  // shadowRay makes none
+            if (batch.count == ShadowBatch::kRays) flush();
+            const int j = batch.count++;
+            for (int c = 0; c < 3; ++c) {
+                batch.point[c][j] = s.point[c];
+                batch.normal[c][j] = s.normal[c];
+                batch.origin[c][j] = s.origin[c];
+            }
+            firstSlot[j] = std::uint32_t(i) * pass.raysPerHit;
         }
+        if (batch.count > 0) flush();
         return;
     }
     OcclusionBatch batch;

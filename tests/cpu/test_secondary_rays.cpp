@@ -224,6 +224,71 @@ void expectPassAgrees(const PassFrame& pass, bool closest) {
 
 }  // namespace
 
+// makeShadowRays is shadowRay lane by lane, on every SIMD target: random surfaces around
+// point, spot and directional lights, some with a range, the light on or near their planes,
+// at the range's and the cone's edges, and some surfaces nearly at the light (directions
+// below 2^-64, or with components to flush); batches of every length up to the 256 a batch holds.
+TEST(SecondaryRays, ShadowRaysInLanesAreShadowRayBitForBit) {
+    for (const std::string& target : simd::availableTargets()) {
+        SCOPED_TRACE("target " + target);
+        simd::forceTarget(target);
+        Random rng(43);
+        std::size_t made = 0, refused = 0;
+        for (int trial = 0; trial < 300; ++trial) {
+            ShadowLight light{};
+            const int type = trial % 3;
+            light.type = type == 0 ? shared::kLightPoint : type == 1 ? shared::kLightSpot : shared::kLightDirectional;
+            light.position = rng.vec3(-2.0f, 2.0f);
+            light.direction = glm::vec3(glm::normalize(rng.onSphere()));
+            light.range = rng.uniform() < 0.5 ? 0.0f : rng.uniformFloat(0.5f, 3.0f);
+            light.cosOuterSquared = rng.uniformFloat(0.0f, 0.95f);
+            ShadowBatch batch;
+            batch.count = 1 + int(rng.index(ShadowBatch::kRays));
+            std::vector<shared::SurfaceSample> surfaces(std::size_t(batch.count));
+            for (int j = 0; j < batch.count; ++j) {
+                shared::SurfaceSample& s = surfaces[std::size_t(j)];
+                s.normal = glm::vec3(glm::normalize(rng.onSphere()));
+                const double pick = rng.uniform();
+                if (pick < 0.1) {  // at the light, or a hair from it
+                    s.point = light.position;
+                    s.origin = light.position + glm::vec3(rng.onSphere()) * (rng.uniform() < 0.5 ? 0x1p-70f : 0x1p-40f);
+                } else {
+                    s.point = light.position + glm::vec3(rng.onSphere()) * rng.uniformFloat(0.1f, 4.0f);
+                    if (pick < 0.3) s.point[rng.index(3)] = light.position[rng.index(3)];  // components to flush
+                    s.origin = s.point + s.normal * 1e-4f;
+                }
+                if (rng.uniform() < 0.1) s.normal = glm::normalize(light.position - s.point + glm::vec3(0.0f, 0.0f, 1e-3f));
+                s.valid = true;
+                for (int c = 0; c < 3; ++c) {
+                    batch.point[c][j] = s.point[c];
+                    batch.normal[c][j] = s.normal[c];
+                    batch.origin[c][j] = s.origin[c];
+                }
+            }
+            std::vector<Ray> rays(std::size_t(batch.count));
+            std::vector<std::uint32_t> which(std::size_t(batch.count));
+            const int count = makeShadowRays(batch, light, rays.data(), which.data());
+            int k = 0;
+            for (int j = 0; j < batch.count; ++j) {
+                const shared::GeneratedRay g = shared::shadowRay(surfaces[std::size_t(j)], light);
+                if (!g.traced) {
+                    ++refused;
+                    continue;
+                }
+                ASSERT_LT(k, count) << "trial " << trial << " surface " << j;
+                ASSERT_EQ(which[std::size_t(k)], std::uint32_t(j)) << "trial " << trial;
+                ASSERT_EQ(std::memcmp(&rays[std::size_t(k)], &g.ray, sizeof(Ray)), 0) << "trial " << trial << " surface " << j;
+                ++k;
+                ++made;
+            }
+            ASSERT_EQ(k, count) << "trial " << trial;
+        }
+        EXPECT_GT(made, 10000u);
+        EXPECT_GT(refused, 5000u);
+    }
+    simd::forceTarget("");
+}
+
 TEST(BackendsAgree, OcclusionRaysClosestAndAnyHit) {
     // Rays from every visible surface in every direction of its hemisphere: no common near
     // side, so every split classifies them (ChildOrder::PerRay).
@@ -323,11 +388,18 @@ TEST(SecondaryRays, MadeInChunksAreEveryRayOfTheDefinitionInSlotOrder) {
     ASSERT_GT(missing, frame.rays.size() / 10);
     ASSERT_LT(missing, frame.rays.size() - frame.rays.size() / 10);
     ThreadPool pool(2);
-    // Occlusion rays are made in batches of 256 several at a time (occlusion_ray_rows.hpp), on
-    // every SIMD target: 300 samples a hit span batches.
+    // Occlusion and shadow rays are made in batches of 256 several at a time
+    // (occlusion_ray_rows.hpp), on every SIMD target: 300 samples a hit span batches; the
+    // lights are a point light, a directional one and a spot light with a range.
+    SecondaryPass spot = pointShadowPass({0.3f, 1.6f, 0.4f});
+    spot.light.type = shared::kLightSpot;
+    spot.light.direction = glm::vec3(glm::normalize(glm::dvec3(-0.1, -1.0, -0.2)));
+    spot.light.cosOuterSquared = 0.3f;
+    spot.light.range = 2.4f;
     for (const std::string& target : simd::availableTargets())
     for (const SecondaryPass& pass : {occlusionPass(3, 0.8f), occlusionPass(300, kNoHitT, 12345),
-                                      pointShadowPass({0.3f, 1.6f, 0.4f})}) {
+                                      pointShadowPass({0.3f, 1.6f, 0.4f}), directionalShadowPass({0.2, -1.0, -0.4}),
+                                      spot}) {
         SCOPED_TRACE("target " + target);
         simd::forceTarget(target);
         std::vector<Ray> rays;
