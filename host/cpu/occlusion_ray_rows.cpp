@@ -6,7 +6,6 @@
 #include <hwy/highway.h>
 
 #include <algorithm>
-#include <cstring>
 
 #include "core/ray_fields-inl.h"
 #include "cpu/occlusion_ray_rows.hpp"
@@ -145,8 +144,8 @@ int MakeShadowRays(const ShadowBatch& batch, const shared::ShadowLight& light, R
         std::uint32_t mask = std::uint32_t(bits[0]) | std::uint32_t(bits[1]) << 8;
         for (; mask; mask &= mask - 1) {
             const int l = __builtin_ctz(mask);
-            auto* ray = reinterpret_cast<unsigned char*>(&out[made]);
-            for (int q = 0; q < 4; ++q) std::memcpy(ray + 16 * q, quarters[q] + 4 * l, 16);
+            const float* const lane[4] = {quarters[0] + 4 * l, quarters[1] + 4 * l, quarters[2] + 4 * l, quarters[3] + 4 * l};
+            ray_fields::HWY_NAMESPACE::CopyRayQuarters(lane, 1, 4, out + made);
             surface[made++] = std::uint32_t(i + l);
         }
     }

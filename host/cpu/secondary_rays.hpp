@@ -88,20 +88,25 @@ void secondaryRaysOf(const SecondaryPass& pass, std::uint32_t i, const Hit& hit,
 
 // The rays primary rays first .. end - 1 send in the pass, in slot order, as secondaryRaysOf
 // makes them one primary ray at a time (the same rays, emitted in the same order), made in
-// batches several at a time (occlusion_ray_rows.hpp). primaryRayOf(i)
-// returns ray i, asked for only where it hit.
+// batches several at a time (occlusion_ray_rows.hpp). primaryRayOf(i) returns ray i, asked for
+// only where it hit.
 template <typename PrimaryRayOf, typename Emit>
 void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::size_t end, const Hit* hits,
                           PrimaryRayOf&& primaryRayOf, const std::vector<Triangle>& triangles, Emit&& emit) {
-    // The hit triangles lie anywhere in the scene's array: each asked for a few hits ahead.
+    // onSurface(i, surface) for each primary ray whose hit has a surface that sends rays, in
+    // order; the hit triangles lie anywhere in the scene's array: each asked for a few hits ahead.
     constexpr std::size_t kHitsAhead = 8;
-    const auto prefetchAhead = [&](std::size_t i) {
-        if (i + kHitsAhead < end && hitSendsRays(hits[i + kHitsAhead]))
-            simd::prefetchTriangle(triangles[hits[i + kHitsAhead].prim]);
+    const auto forEachSurface = [&](auto&& onSurface) {
+        for (std::size_t i = first; i < end; ++i) {
+            if (i + kHitsAhead < end && hitSendsRays(hits[i + kHitsAhead]))
+                simd::prefetchTriangle(triangles[hits[i + kHitsAhead].prim]);
+            if (!hitSendsRays(hits[i])) continue;
+            const shared::SurfaceSample s = shared::surfaceOfHit(primaryRayOf(i), hits[i], triangles[hits[i].prim]);
+            if (s.valid) onSurface(std::uint32_t(i), s);  // else shadowRay and occlusionRay make none
+        }
     };
     if (pass.kind == shared::kPassShadow) {
-        // A shadow ray per surface, made in batches several at a time (makeShadowRays), each
-        // emitted raysPerHit times as secondaryRaysOf emits it.
+        // A shadow ray per surface, each emitted raysPerHit times as secondaryRaysOf emits it.
         ShadowBatch batch;
         std::uint32_t firstSlot[ShadowBatch::kRays], surface[ShadowBatch::kRays];
         Ray rays[ShadowBatch::kRays];
@@ -111,11 +116,7 @@ void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::siz
                 for (std::uint32_t k = 0; k < pass.raysPerHit; ++k) emit(firstSlot[surface[r]] + k, rays[r]);
             batch.count = 0;
         };
-        for (std::size_t i = first; i < end; ++i) {
-            prefetchAhead(i);
-            if (!hitSendsRays(hits[i])) continue;
-            const shared::SurfaceSample s = shared::surfaceOfHit(primaryRayOf(i), hits[i], triangles[hits[i].prim]);
-            if (!s.valid) continue;  // shadowRay makes none
+        forEachSurface([&](std::uint32_t i, const shared::SurfaceSample& s) {
             if (batch.count == ShadowBatch::kRays) flush();
             const int j = batch.count++;
             for (int c = 0; c < 3; ++c) {
@@ -123,8 +124,8 @@ void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::siz
                 batch.normal[c][j] = s.normal[c];
                 batch.origin[c][j] = s.origin[c];
             }
-            firstSlot[j] = std::uint32_t(i) * pass.raysPerHit;
-        }
+            firstSlot[j] = i * pass.raysPerHit;
+        });
         if (batch.count > 0) flush();
         return;
     }
@@ -136,22 +137,18 @@ void secondaryRaysOfRange(const SecondaryPass& pass, std::size_t first, std::siz
         for (int j = 0; j < batch.count; ++j) emit(slots[j], rays[j]);
         batch.count = 0;
     };
-    for (std::size_t i = first; i < end; ++i) {
-        prefetchAhead(i);
-        if (!hitSendsRays(hits[i])) continue;
-        const shared::SurfaceSample surface = shared::surfaceOfHit(primaryRayOf(i), hits[i], triangles[hits[i].prim]);
-        if (!surface.valid) continue;  // occlusionRay makes none
+    forEachSurface([&](std::uint32_t i, const shared::SurfaceSample& s) {
         for (std::uint32_t k = 0; k < pass.raysPerHit; ++k) {
             if (batch.count == OcclusionBatch::kRays) flush();
             const int j = batch.count++;
-            batch.stream[j] = occlusionStream(pass, std::uint32_t(i), k);
+            batch.stream[j] = occlusionStream(pass, i, k);
             for (int c = 0; c < 3; ++c) {
-                batch.normal[c][j] = surface.normal[c];
-                batch.origin[c][j] = surface.origin[c];
+                batch.normal[c][j] = s.normal[c];
+                batch.origin[c][j] = s.origin[c];
             }
-            slots[j] = std::uint32_t(i) * pass.raysPerHit + k;
+            slots[j] = i * pass.raysPerHit + k;
         }
-    }
+    });
     if (batch.count > 0) flush();
 }
 
