@@ -404,9 +404,12 @@ HWY_INLINE bool watertightInLanes(const VF (&a)[3], const VF (&b)[3], const VF (
 // shared::intersectWatertight for one ray and hn::Lanes triangles at a time; the tie rule then
 // runs per hit lane in scalar code. The ray's axes are template arguments, so that a[kx] and
 // the like name registers: indexed by a run-time axis, the vertex vectors went through the
-// stack on every batch of triangles.
-template <int kx, int ky, int kz>
+// stack on every batch of triangles. An any-hit ray (kAnyHit) that has a hit is done: it
+// tests nothing more, and it takes the first hit lane of the first vector that has one.
+template <int kx, int ky, int kz, bool kAnyHit>
 HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch) {
+    if constexpr (kAnyHit)
+        if (best.prim != kMissPrim) return best;
     const DF df;
     const DU du;
     const std::size_t n = hn::Lanes(df);
@@ -438,7 +441,9 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
             // The no-area rule, last of the conjunction, only where the rest says hit.
             if (triangleHasNoArea(batch, j + l)) continue;
             const std::uint32_t prim = batch.prim[j + l];
-            if (shared::hitPrecedes(tLane[l], prim, best.t, best.prim)) best = Hit{tLane[l], prim, uLane[l], vLane[l]};
+            if (!shared::hitPrecedes(tLane[l], prim, best.t, best.prim)) continue;
+            best = Hit{tLane[l], prim, uLane[l], vLane[l]};
+            if constexpr (kAnyHit) return best;
         }
     }
     return best;
@@ -448,6 +453,7 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
 // ky the next two in cyclic order, swapped where the direction along kz is negative.
 constexpr std::uint32_t packedAxes(int kx, int ky, int kz) { return std::uint32_t(kx | ky << 2 | kz << 4); }
 
+template <bool kAnyHit>
 HWY_INLINE void intersectRays(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                               const LeafTriangles& batch) {
     // A few rays ahead asked for: a leaf's rays are scattered over the pass's arrays.
@@ -461,20 +467,23 @@ HWY_INLINE void intersectRays(const Ray* rays, Hit* hits, const std::uint32_t* r
         const Ray& ray = rays[rayId];
         const Hit best = hits[rayId];
         switch (ray.axes) {
-            case packedAxes(1, 2, 0): hits[rayId] = intersectRay<1, 2, 0>(ray, best, batch); break;
-            case packedAxes(2, 1, 0): hits[rayId] = intersectRay<2, 1, 0>(ray, best, batch); break;
-            case packedAxes(2, 0, 1): hits[rayId] = intersectRay<2, 0, 1>(ray, best, batch); break;
-            case packedAxes(0, 2, 1): hits[rayId] = intersectRay<0, 2, 1>(ray, best, batch); break;
-            case packedAxes(0, 1, 2): hits[rayId] = intersectRay<0, 1, 2>(ray, best, batch); break;
-            case packedAxes(1, 0, 2): hits[rayId] = intersectRay<1, 0, 2>(ray, best, batch); break;
+            case packedAxes(1, 2, 0): hits[rayId] = intersectRay<1, 2, 0, kAnyHit>(ray, best, batch); break;
+            case packedAxes(2, 1, 0): hits[rayId] = intersectRay<2, 1, 0, kAnyHit>(ray, best, batch); break;
+            case packedAxes(2, 0, 1): hits[rayId] = intersectRay<2, 0, 1, kAnyHit>(ray, best, batch); break;
+            case packedAxes(0, 2, 1): hits[rayId] = intersectRay<0, 2, 1, kAnyHit>(ray, best, batch); break;
+            case packedAxes(0, 1, 2): hits[rayId] = intersectRay<0, 1, 2, kAnyHit>(ray, best, batch); break;
+            case packedAxes(1, 0, 2): hits[rayId] = intersectRay<1, 0, 2, kAnyHit>(ray, best, batch); break;
             default: HWY_ABORT("ray axes %u: makeRay and segmentRay make only six", ray.axes);
         }
     }
 }
 
 void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                    const LeafTriangles& batch) {
-    intersectRays(rays, hits, rayIds, rayCount, batch);
+                    const LeafTriangles& batch, bool anyHit) {
+    if (anyHit)
+        intersectRays<true>(rays, hits, rayIds, rayCount, batch);
+    else
+        intersectRays<false>(rays, hits, rayIds, rayCount, batch);
 }
 
 // The batch's triangle bounds, widened, lanes at a time: min and max of exact vertices, then
@@ -718,6 +727,141 @@ std::uint64_t IntersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint
     return skipped;
 }
 
+// How many groups of a leaf's rays try the narrowing before it is kept or dropped.
+constexpr std::uint32_t kTrialGroups = 2;
+
+// The box of the group's segments from their origins (the watertight test reports no hit at
+// t < 0, whatever tmin is) to their best t so far (a later hit must precede it, so it lies
+// before that t): the smallest and largest of o and o + t d over the group, lanes at a time. False where some lane's box is not a number (an infinite
+// coordinate times a zero).
+HWY_INLINE bool boxOfSegments(const Ray* rays, const Hit* hits, const std::uint32_t* rayIds, std::uint32_t count,
+                              glm::vec3& lo, glm::vec3& hi) {
+    const DF df;
+    const std::size_t n = hn::Lanes(df);
+    const float* rayFloats = reinterpret_cast<const float*>(rays);
+    const float* hitFloats = reinterpret_cast<const float*>(hits);
+    alignas(64) std::uint32_t ids[64];
+    VF boxLo[3], boxHi[3];
+    for (int a = 0; a < 3; ++a) {
+        boxLo[a] = hn::Set(df, kNoHitT);
+        boxHi[a] = hn::Set(df, -kNoHitT);
+    }
+    MF notANumber = hn::FirstN(df, 0);
+    for (std::uint32_t i = 0; i < count; i += std::uint32_t(n)) {
+        laneIds(rayIds, i, std::min(std::uint32_t(n), count - i), ids);
+        VF origin[4], dir[4];
+        loadQuadPerLane<0>(rayFloats, ids, origin);
+        loadQuadPerLane<4>(rayFloats, ids, dir);
+        const VF t = loadPerLane<4>(hitFloats, ids, 0);
+        for (int a = 0; a < 3; ++a) {
+            const VF end = hn::Add(origin[a], hn::Mul(t, dir[a]));
+            notANumber = hn::Or(notANumber, hn::IsNaN(end));
+            boxLo[a] = hn::Min(boxLo[a], hn::Min(origin[a], end));
+            boxHi[a] = hn::Max(boxHi[a], hn::Max(origin[a], end));
+        }
+    }
+    if (!hn::AllFalse(df, notANumber)) return false;
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = hn::GetLane(hn::MinOfLanes(df, boxLo[a]));
+        hi[a] = hn::GetLane(hn::MaxOfLanes(df, boxHi[a]));
+    }
+    return true;
+}
+
+// The triangles of batch whose widened bounds overlap the box, in order, into narrowed (each
+// field's vector compressed and stored whole at the count so far, which is at most its own
+// first lane j, so no store passes lane j + n <= kLeafBatch), where that leaves fewer vectors
+// of them to test than the batch has. Returns the batch, or narrowed.
+HWY_INLINE const LeafTriangles& narrowToBox(const LeafTriangles& batch, const WidenedBounds& b, const glm::vec3& lo,
+                                            const glm::vec3& hi, LeafTriangles& narrowed) {
+    const DF df;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    MF overlaps[kLeafBatch];
+    std::uint32_t kept = 0;
+    for (std::size_t j = 0; j < batch.count; j += n) {
+        MF overlap = hn::FirstN(df, batch.count - j);
+        for (int a = 0; a < 3; ++a)
+            overlap = hn::And(overlap, hn::And(hn::Load(df, &b.lo[a][j]) <= hn::Set(df, hi[a]),
+                                               hn::Load(df, &b.hi[a][j]) >= hn::Set(df, lo[a])));
+        overlaps[j / n] = overlap;
+        kept += std::uint32_t(hn::CountTrue(df, overlap));
+    }
+    if ((kept + n - 1) / n == (batch.count + n - 1) / n) return batch;
+    std::uint32_t count = 0;
+    for (std::size_t j = 0; j < batch.count; j += n) {
+        const MF overlap = overlaps[j / n];
+        if (hn::AllFalse(df, overlap)) continue;
+        const auto keep = hn::RebindMask(du, overlap);
+        // Every field as 32-bit lanes: the floats' bits move unchanged.
+        auto compress = [&](const void* from, void* to) {
+            const VU v = hn::Load(du, static_cast<const std::uint32_t*>(from) + j);
+            hn::StoreU(compressIds(v, keep), du, static_cast<std::uint32_t*>(to) + count);
+        };
+        for (int k = 0; k < 3; ++k)
+            for (int c = 0; c < 3; ++c) compress(batch.vertex[k][c], narrowed.vertex[k][c]);
+        compress(batch.prim, narrowed.prim);
+        compress(batch.cullBackFace, narrowed.cullBackFace);
+        count += std::uint32_t(hn::CountTrue(df, overlap));
+    }
+    narrowed.count = count;
+    return narrowed;
+}
+
+// intersectBatch in groups of kLeafGroupRays consecutive ids, each testing only the triangles
+// whose bounds, widened by `widening`, overlap the box of its segments (boxOfSegments). A group
+// whose box holds the leaf's cell (every triangle of the leaf meets the cell) tests them all
+// without narrowing. A leaf whose first groups save less than half a vector of triangles per
+// ray (small triangles, segments as long as the leaf: the Bunny's and the Dragon's occlusion
+// rays) gains less than the boxes cost: its other rays test every triangle.
+template <bool kAnyHit>
+HWY_INLINE std::uint64_t intersectSegmentGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds,
+                                                std::uint32_t rayCount, const LeafTriangles& batch, const Box& cell,
+                                                float widening) {
+    const std::size_t n = hn::Lanes(DF());
+    auto vectors = [&](std::uint32_t triangles) { return (triangles + n - 1) / n; };
+    WidenedBounds bounds;
+    bool haveBounds = false;
+    LeafTriangles narrowed;
+    std::uint64_t skipped = 0, vectorsSaved = 0;
+    std::uint32_t g = 0;
+    for (; g < rayCount; g += kLeafGroupRays) {
+        if (g == kTrialGroups * kLeafGroupRays && vectorsSaved * 2 < g) break;
+        const std::uint32_t groupRays = std::min(kLeafGroupRays, rayCount - g);
+        glm::vec3 lo, hi;
+        if (!boxOfSegments(rays, hits, rayIds + g, groupRays, lo, hi) ||
+            (lo.x <= cell.lo.x && lo.y <= cell.lo.y && lo.z <= cell.lo.z && hi.x >= cell.hi.x &&
+             hi.y >= cell.hi.y && hi.z >= cell.hi.z)) {
+            intersectRays<kAnyHit>(rays, hits, rayIds + g, groupRays, batch);
+            continue;
+        }
+        if (!haveBounds) {
+            widenedBoundsOf(batch, widening, bounds);
+            haveBounds = true;
+        }
+        const LeafTriangles& kept = narrowToBox(batch, bounds, lo, hi, narrowed);
+        skipped += std::uint64_t(groupRays) * (batch.count - kept.count);
+        vectorsSaved += std::uint64_t(groupRays) * (vectors(batch.count) - vectors(kept.count));
+        if (kept.count == 0) continue;
+        intersectRays<kAnyHit>(rays, hits, rayIds + g, groupRays, kept);
+    }
+    if (g < rayCount) intersectRays<kAnyHit>(rays, hits, rayIds + g, rayCount - g, batch);
+    return skipped;
+}
+
+// A batch of one vector of triangles has none to save, and a leaf with fewer rays than twice
+// the trial's would spend most of them on it: both test every triangle.
+std::uint64_t IntersectBatchInSegmentGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds,
+                                            std::uint32_t rayCount, const LeafTriangles& batch, const Box& cell,
+                                            float widening, bool anyHit) {
+    if (batch.count <= hn::Lanes(DF()) || rayCount < 2 * kTrialGroups * kLeafGroupRays) {
+        IntersectBatch(rays, hits, rayIds, rayCount, batch, anyHit);
+        return 0;
+    }
+    return anyHit ? intersectSegmentGroups<true>(rays, hits, rayIds, rayCount, batch, cell, widening)
+                  : intersectSegmentGroups<false>(rays, hits, rayIds, rayCount, batch, cell, widening);
+}
+
 // firstRegionOfRay lanes at a time: each lane's walk start, then every region's test in
 // ascending order, a lane moving up keeping the first region at or after its start that its
 // ray crosses, a lane moving down the last one at or before it. The walk's clamp of its start
@@ -911,6 +1055,7 @@ HWY_EXPORT(EndRaysHitInBox);
 HWY_EXPORT(PartitionTrianglesOnFace);
 HWY_EXPORT(IntersectBatch);
 HWY_EXPORT(IntersectBatchInGroups);
+HWY_EXPORT(IntersectBatchInSegmentGroups);
 HWY_EXPORT(BoundsOfRays);
 HWY_EXPORT(GatherLeafTriangles);
 HWY_EXPORT(CompiledTarget);
@@ -985,8 +1130,8 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 }
 
 void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                    const LeafTriangles& batch) {
-    HWY_DYNAMIC_DISPATCH(IntersectBatch)(rays, hits, rayIds, rayCount, batch);
+                    const LeafTriangles& batch, bool anyHit) {
+    HWY_DYNAMIC_DISPATCH(IntersectBatch)(rays, hits, rayIds, rayCount, batch, anyHit);
 }
 
 RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32_t count) {
@@ -996,6 +1141,13 @@ RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32
 std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                                      const LeafTriangles& batch, float widening) {
     return HWY_DYNAMIC_DISPATCH(IntersectBatchInGroups)(rays, hits, rayIds, rayCount, batch, widening);
+}
+
+std::uint64_t intersectBatchInSegmentGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds,
+                                            std::uint32_t rayCount, const LeafTriangles& batch, const Box& cell,
+                                            float widening, bool anyHit) {
+    return HWY_DYNAMIC_DISPATCH(IntersectBatchInSegmentGroups)(rays, hits, rayIds, rayCount, batch, cell, widening,
+                                                               anyHit);
 }
 
 std::string activeTarget() { return hwy::TargetName(HWY_DYNAMIC_DISPATCH(CompiledTarget)()); }

@@ -76,9 +76,12 @@ void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
 // The watertight test of each ray rays[rayIds[r]], r < rayCount, against every triangle of
 // batch; its hit becomes the first under the tie rule (smaller t, then smaller id) of the
 // hit it had and the batch's hits with t > tmin: what testTriangle over the batch gives, in
-// any order, since the rule is a total order on distinct ids.
+// any order, since the rule is a total order on distinct ids. With anyHit (HitQuery::Any) a ray
+// that has a hit (prim not kMissPrim) keeps it, and one that has none takes the first hit
+// found that the tie rule puts before its segment's end, if any: a hit wherever the
+// closest-hit kernel finds one, not necessarily the same (docs/correctness.md, "Any hit").
 void intersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                    const LeafTriangles& batch);
+                    const LeafTriangles& batch, bool anyHit = false);
 
 // The bounds of rays[rayIds[0, count)] (count > 0) as startPacketBounds and addToPacketBounds
 // (ray_packet.hpp) make them, lanes at a time (begin and end left 0).
@@ -94,6 +97,19 @@ RayPacket boundsOfRays(const Ray* rays, const std::uint32_t* rayIds, std::uint32
 constexpr std::uint32_t kLeafGroupRays = 16;
 std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                                      const LeafTriangles& batch, float widening);
+
+// intersectBatch for rays with their own starts and segments, in groups of up to
+// kLeafGroupRays consecutive ids: each group tests only the triangles whose bounds, widened by
+// `widening` (twice the filter margin), overlap the box of the group's segments from their
+// origins to their best t so far, except where that box holds `cell` (the leaf's cell widened
+// by the margin, which every triangle of the batch meets), or where narrowing cannot pay (one
+// vector of triangles, fewer than 64 rays, or a leaf whose first two groups saved little). The
+// same hits as intersectBatch: a hit the test reports lies within the margin of its triangle's
+// bounds at a point of the ray's exact segment (docs/correctness.md, "Leaf groups"). Returns
+// the ray/triangle tests skipped.
+std::uint64_t intersectBatchInSegmentGroups(const Ray* rays, Hit* hits, const std::uint32_t* rayIds,
+                                            std::uint32_t rayCount, const LeafTriangles& batch, const Box& cell,
+                                            float widening, bool anyHit);
 
 // For the bounds of ids[0, count) (bounds[0, count) where ids is null), the first and the
 // last of the bands between `edges` band edges that BandEdges::bandsOf finds (image_bands.hpp:

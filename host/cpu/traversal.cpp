@@ -417,13 +417,15 @@ template <typename PrepareRay, typename TestTriangle>
 void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
                               std::uint32_t triBegin, std::uint32_t triEnd) {
     const bool groups = sharedRayFields_ == simd::SharedRayFields::Start;
+    const Box cell = widen(box, margin_);
     for (std::uint32_t j = triBegin; j < triEnd; j += simd::kLeafBatch) {
         simd::gatherLeafTriangles(triangles_, triIds_ + j, std::min(triEnd - j, simd::kLeafBatch), batch_);
         if (groups)
             counters_.rayTriangleTestsSkipped += simd::intersectBatchInGroups(
                 rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_, 2.0f * margin_);
         else
-            simd::intersectBatch(rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_);
+            counters_.rayTriangleTestsSkipped += simd::intersectBatchInSegmentGroups(
+                rays_, hits_, rayIds_ + terminated, rayEnd - terminated, batch_, cell, 2.0f * margin_, anyHit_);
     }
     endRaysHitInBox(box, terminated, rayEnd);
 }

@@ -499,6 +499,156 @@ TEST_F(EveryTarget, LeafGroupsGiveTheBatchsHitsBitForBit) {
     });
 }
 
+// A leaf's triangles and rays as a secondary pass's leaf holds them: a sheet of triangles on
+// a grid, neighbours sharing vertices and edges (some flat, with no extent along z; some
+// duplicated, some with no area, half single-sided), and rays with their own starts and
+// short segments, in runs of eight at one triangle (neighbouring surface points, as a pass's
+// ids are ordered by pixel): each aimed at a vertex, an edge's midpoint or a face point (or
+// just beside it) from a start a random distance back along its direction (some with a
+// negative tmin), its segment ending exactly there, short of it or past it.
+// Hits lie on the triangles' bounds and segments end on them, where only the widening keeps a
+// triangle. In some leaves the rays are long enough that their groups' boxes hold the cell,
+// and in some their order is shuffled, so that no group is narrow.
+struct OwnSegmentLeaf {
+    std::vector<Triangle> tris;
+    std::vector<Ray> rays;
+    std::vector<Hit> start;  // each ray's best before the leaf: a miss at its segment's end
+    std::vector<std::uint32_t> triIds, rayIds;
+    Box cell;  // the triangles' bounds widened by the margin, as the traversal's leaf cell
+    float margin = 0.0f;
+};
+
+OwnSegmentLeaf ownSegmentLeaf(Random& rng) {
+    OwnSegmentLeaf leaf;
+    const float scale = rng.uniform() < 0.3 ? 1e5f : 1.0f;
+    const glm::vec3 offset = rng.uniform() < 0.3 ? rng.vec3(-1e6f, 1e6f) : glm::vec3(0.0f);
+    const std::uint32_t side = 4 + std::uint32_t(rng.index(3));  // 32 to 72 triangles
+    auto grid = [&](std::uint32_t x, std::uint32_t y, float z) {
+        return offset + glm::vec3(float(x) / float(side), float(y) / float(side), z) * scale;
+    };
+    const bool flat = rng.uniform() < 0.3;
+    std::vector<float> height((side + 1) * (side + 1));
+    for (float& h : height) h = flat ? 0.0f : rng.uniformFloat(-0.1f, 0.1f);
+    for (std::uint32_t y = 0; y < side; ++y)
+        for (std::uint32_t x = 0; x < side; ++x) {
+            auto corner = [&](std::uint32_t cx, std::uint32_t cy) { return grid(cx, cy, height[cy * (side + 1) + cx]); };
+            for (int half = 0; half < 2; ++half) {
+                Triangle t;
+                if (!leaf.tris.empty() && rng.uniform() < 0.1) {
+                    t = leaf.tris[rng.index(leaf.tris.size())];  // a duplicate under another id
+                } else {
+                    t.v0 = corner(x, y);
+                    t.v1 = half == 0 ? corner(x + 1, y) : corner(x + 1, y + 1);
+                    t.v2 = half == 0 ? corner(x + 1, y + 1) : corner(x, y + 1);
+                    if (rng.uniform() < 0.05) t.v2 = t.v1;  // no area
+                    t.cullBackFace = rng.uniform() < 0.5 ? 1u : 0u;
+                }
+                leaf.tris.push_back(t);
+            }
+        }
+    glm::vec3 lo(kNoHitT), hi(-kNoHitT), farthest(0.0f);
+    for (const Triangle& t : leaf.tris)
+        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) lo = glm::min(lo, v), hi = glm::max(hi, v);
+    const float extent = glm::length(hi - lo);
+    const bool longRays = rng.uniform() < 0.15;
+    leaf.rays.resize(40 + rng.index(200));
+    leaf.start.resize(leaf.rays.size());
+    // In some leaves each run of a group's size is one ray repeated: its group's box is that
+    // ray's segment's alone, which a hit at the segment's end can leave a rounding outside its
+    // triangle's bounds (what the widening is for).
+    const bool repeated = rng.uniform() < 0.3;
+    std::size_t aimed = 0;
+    for (std::size_t i = 0; i < leaf.rays.size(); ++i) {
+        if (repeated && i % simd::kLeafGroupRays != 0) {
+            leaf.rays[i] = leaf.rays[i - 1];
+            leaf.start[i] = leaf.start[i - 1];
+            continue;
+        }
+        if (i % 8 == 0) aimed = rng.index(leaf.tris.size());
+        const Triangle& aim = leaf.tris[aimed];
+        const double pick = rng.uniform();
+        glm::dvec3 target = pick < 0.2 ? glm::dvec3(aim.v0)
+                            : pick < 0.4 ? glm::dvec3(aim.v1)
+                            : pick < 0.55 ? glm::dvec3(aim.v2)
+                            : pick < 0.75 ? 0.5 * (glm::dvec3(aim.v0) + glm::dvec3(aim.v2))
+                                          : glm::dvec3(aim.v0) + 0.3 * glm::dvec3(aim.v1 - aim.v0) +
+                                                0.3 * glm::dvec3(aim.v2 - aim.v0);
+        if (rng.uniform() < 0.2) target += glm::dvec3(rng.onSphere()) * double(extent) * 1e-6;  // beside it
+        const glm::dvec3 dir = rng.onSphere();
+        const double back = double(extent) * (longRays ? 4.0 : rng.uniformFloat(0.001f, 0.05f));
+        const glm::vec3 origin = glm::vec3(target - dir * back);
+        Ray& r = leaf.rays[i];
+        r = makeRay(origin, dir, rng.uniform() < 0.1 ? -float(back) : 0.0f);  // no hit behind the origin even so
+        const double end = rng.uniform();
+        r.tmax = float(back * (end < 0.5 ? 1.0 : end < 0.75 ? 0.5 : 2.0));
+        leaf.start[i] = missHit(r);
+        farthest = glm::max(farthest, glm::abs(origin));
+    }
+    leaf.margin = filterMargin(Box{lo, hi}, farthest);
+    leaf.cell = Box{lo - glm::vec3(leaf.margin), hi + glm::vec3(leaf.margin)};
+    leaf.triIds = shuffledIds(rng, std::uint32_t(leaf.tris.size()), std::uint32_t(leaf.tris.size()));
+    leaf.triIds.resize(std::min<std::size_t>(leaf.triIds.size(), simd::kLeafBatch));
+    leaf.rayIds.resize(leaf.rays.size());
+    for (std::uint32_t i = 0; i < leaf.rayIds.size(); ++i) leaf.rayIds[i] = i;
+    if (rng.uniform() < 0.15) rng.shuffle(leaf.rayIds);
+    return leaf;
+}
+
+// The segment groups narrow a leaf's triangles per group of rays with their own segments and
+// still find every hit the batch finds: bit for bit for closest hits; for any hit, a hit
+// exactly where the batch finds one, and a hit the triangle itself gives the ray. With no
+// widening they would miss hits at the segments' ends and on the bounds' faces, which this
+// leaf makes on purpose.
+TEST_F(EveryTarget, SegmentGroupsGiveTheBatchsHitsBitForBit) {
+    forEachTarget([] {
+        Random rng(37);
+        std::uint64_t tests = 0, skipped = 0, missedWithoutWidening = 0;
+        std::size_t hitsFound = 0, anyHitsFound = 0;
+        for (int trial = 0; trial < 400; ++trial) {
+            const OwnSegmentLeaf leaf = ownSegmentLeaf(rng);
+            const std::vector<Hit>& start = leaf.start;
+            std::vector<Hit> expected = start;
+            for (std::uint32_t id : leaf.rayIds)
+                for (std::uint32_t prim : leaf.triIds) testTriangle(leaf.rays[id], leaf.tris[prim], prim, expected[id]);
+            simd::LeafTriangles batch;
+            simd::gatherLeafTriangles(leaf.tris.data(), leaf.triIds.data(), std::uint32_t(leaf.triIds.size()), batch);
+            const Box& cell = leaf.cell;
+            const std::uint32_t rayCount = std::uint32_t(leaf.rayIds.size());
+            for (bool anyHit : {false, true}) {
+                std::vector<Hit> got = start, unwidened = start;
+                skipped += simd::intersectBatchInSegmentGroups(leaf.rays.data(), got.data(), leaf.rayIds.data(),
+                                                               rayCount, batch, cell, 2.0f * leaf.margin, anyHit);
+                simd::intersectBatchInSegmentGroups(leaf.rays.data(), unwidened.data(), leaf.rayIds.data(), rayCount,
+                                                    batch, cell, 0.0f, anyHit);
+                tests += std::uint64_t(rayCount) * leaf.triIds.size();
+                for (std::size_t i = 0; i < leaf.rays.size(); ++i) {
+                    missedWithoutWidening += (unwidened[i].prim == kMissPrim) != (expected[i].prim == kMissPrim);
+                    if (!anyHit) {
+                        ASSERT_TRUE(sameHit(got[i], expected[i]))
+                            << "trial " << trial << " ray " << i << ": groups prim " << got[i].prim << " t "
+                            << got[i].t << ", scalar prim " << expected[i].prim << " t " << expected[i].t;
+                        hitsFound += expected[i].prim != kMissPrim;
+                        continue;
+                    }
+                    ASSERT_EQ(got[i].prim == kMissPrim, expected[i].prim == kMissPrim)
+                        << "trial " << trial << " ray " << i << ": any hit " << got[i].prim << ", closest "
+                        << expected[i].prim;
+                    if (got[i].prim == kMissPrim) continue;
+                    ++anyHitsFound;
+                    Hit own = start[i];
+                    testTriangle(leaf.rays[i], leaf.tris[got[i].prim], got[i].prim, own);
+                    ASSERT_TRUE(sameHit(got[i], own)) << "trial " << trial << " ray " << i << ": any hit "
+                                                      << got[i].prim << " is not that triangle's hit";
+                }
+            }
+        }
+        EXPECT_GT(hitsFound, 3000u);
+        EXPECT_GT(anyHitsFound, 3000u);
+        EXPECT_GT(skipped, tests / 5) << "the groups must narrow the leaf, not only keep it";
+        EXPECT_GT(missedWithoutWidening, 0u) << "the leaf must hold hits that only the widening keeps";
+    });
+}
+
 // A triangle hit at exactly the t of the ray's best so far wins by the smaller id, the ids
 // compared unsigned (shared::hitPrecedes): it takes the place of a miss ending there
 // (kMissPrim) or of a hit whose id is 2^31 or more, and not of a hit with id 0. The groups
