@@ -804,6 +804,14 @@ HWY_INLINE const LeafTriangles& narrowToBox(const LeafTriangles& batch, const Wi
         compress(batch.cullBackFace, narrowed.cullBackFace);
         count += std::uint32_t(hn::CountTrue(df, overlap));
     }
+    // The last vector's lanes past the count repeat the first kept triangle, as
+    // gatherLeafTriangles pads a batch: never read as hits, and no stale values in them.
+    for (std::size_t l = count; count > 0 && l < (count + n - 1) / n * n; ++l) {
+        for (int k = 0; k < 3; ++k)
+            for (int c = 0; c < 3; ++c) narrowed.vertex[k][c][l] = narrowed.vertex[k][c][0];
+        narrowed.prim[l] = narrowed.prim[0];
+        narrowed.cullBackFace[l] = narrowed.cullBackFace[0];
+    }
     narrowed.count = count;
     return narrowed;
 }
