@@ -818,7 +818,8 @@ HWY_INLINE const LeafTriangles& narrowToBox(const LeafTriangles& batch, const Wi
 
 // intersectBatch in groups of kLeafGroupRays consecutive ids, each testing only the triangles
 // whose bounds, widened by `widening`, overlap the box of its segments (boxOfSegments). A group
-// whose box holds the leaf's cell (every triangle of the leaf meets the cell) tests them all
+// whose box holds the leaf's cell (every triangle of the leaf has bounds overlapping the cell,
+// so they overlap the box too, and the narrowing would keep them all) tests them all
 // without narrowing. A leaf whose first groups save less than half a vector of triangles per
 // ray (small triangles, segments as long as the leaf: the Bunny's and the Dragon's occlusion
 // rays) gains less than the boxes cost: its other rays test every triangle.

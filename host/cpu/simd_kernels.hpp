@@ -102,7 +102,7 @@ std::uint64_t intersectBatchInGroups(const Ray* rays, Hit* hits, const std::uint
 // kLeafGroupRays consecutive ids: each group tests only the triangles whose bounds, widened by
 // `widening` (twice the filter margin), overlap the box of the group's segments from their
 // origins to their best t so far, except where that box holds `cell` (the leaf's cell widened
-// by the margin, which every triangle of the batch meets), or where narrowing cannot pay (one
+// by the margin, which every triangle's bounds overlap), or where narrowing cannot pay (one
 // vector of triangles, fewer than 64 rays, or a leaf whose first two groups saved little). The
 // same hits as intersectBatch: a hit the test reports lies within the margin of its triangle's
 // bounds at a point of the ray's exact segment (docs/correctness.md, "Leaf groups"). Returns

@@ -574,13 +574,17 @@ OwnSegmentLeaf ownSegmentLeaf(Random& rng) {
                                           : glm::dvec3(aim.v0) + 0.3 * glm::dvec3(aim.v1 - aim.v0) +
                                                 0.3 * glm::dvec3(aim.v2 - aim.v0);
         if (rng.uniform() < 0.2) target += glm::dvec3(rng.onSphere()) * double(extent) * 1e-6;  // beside it
-        const glm::dvec3 dir = rng.onSphere();
+        glm::dvec3 dir = rng.onSphere();
+        if (rng.uniform() < 0.05) {  // along an axis: zero direction components
+            dir = glm::dvec3(0.0);
+            dir[rng.index(3)] = rng.uniform() < 0.5 ? 1.0 : -1.0;
+        }
         const double back = double(extent) * (longRays ? 4.0 : rng.uniformFloat(0.001f, 0.05f));
         const glm::vec3 origin = glm::vec3(target - dir * back);
         Ray& r = leaf.rays[i];
         r = makeRay(origin, dir, rng.uniform() < 0.1 ? -float(back) : 0.0f);  // no hit behind the origin even so
         const double end = rng.uniform();
-        r.tmax = float(back * (end < 0.5 ? 1.0 : end < 0.75 ? 0.5 : 2.0));
+        r.tmax = end < 0.03 ? kNoHitT : float(back * (end < 0.5 ? 1.0 : end < 0.75 ? 0.5 : 2.0));  // some whole rays
         leaf.start[i] = missHit(r);
         farthest = glm::max(farthest, glm::abs(origin));
     }
@@ -595,15 +599,16 @@ OwnSegmentLeaf ownSegmentLeaf(Random& rng) {
 }
 
 // The segment groups narrow a leaf's triangles per group of rays with their own segments and
-// still find every hit the batch finds: bit for bit for closest hits; for any hit, a hit
-// exactly where the batch finds one, and a hit the triangle itself gives the ray. With no
-// widening they would miss hits at the segments' ends and on the bounds' faces, which this
-// leaf makes on purpose.
+// still find every hit the batch finds: bit for bit for closest hits, ties at a segment's very
+// end included; for any hit, a hit exactly where the batch finds one, and a hit the triangle
+// itself gives the ray, or the hit the ray already had. With no widening they would miss hits
+// at the segments' ends and on the bounds' faces, which this leaf makes on purpose.
 TEST_F(EveryTarget, SegmentGroupsGiveTheBatchsHitsBitForBit) {
     forEachTarget([] {
         Random rng(37);
+        constexpr std::uint32_t kTieIds[] = {kMissPrim, 0x80000000u, 0u};
         std::uint64_t tests = 0, skipped = 0, missedWithoutWidening = 0;
-        std::size_t hitsFound = 0, anyHitsFound = 0;
+        std::size_t hitsFound = 0, anyHitsFound = 0, tiesTaken = 0;
         for (int trial = 0; trial < 400; ++trial) {
             const OwnSegmentLeaf leaf = ownSegmentLeaf(rng);
             const std::vector<Hit>& start = leaf.start;
@@ -614,14 +619,43 @@ TEST_F(EveryTarget, SegmentGroupsGiveTheBatchsHitsBitForBit) {
             simd::gatherLeafTriangles(leaf.tris.data(), leaf.triIds.data(), std::uint32_t(leaf.triIds.size()), batch);
             const Box& cell = leaf.cell;
             const std::uint32_t rayCount = std::uint32_t(leaf.rayIds.size());
+            // Closest hits with a best so far at exactly their hit's t (the box's end) under a
+            // miss, a high id or id 0: the tie rule must pick the scalar test's winner.
+            std::vector<Hit> tieStart = start;
+            for (std::size_t i = 0; i < leaf.rays.size(); ++i)
+                if (expected[i].prim != kMissPrim)
+                    tieStart[i] = Hit{expected[i].t, kTieIds[rng.index(std::size(kTieIds))], 0.25f, 0.5f};
+            std::vector<Hit> tieExpected = tieStart, tieGot = tieStart;
+            for (std::uint32_t id : leaf.rayIds)
+                for (std::uint32_t prim : leaf.triIds)
+                    testTriangle(leaf.rays[id], leaf.tris[prim], prim, tieExpected[id]);
+            simd::intersectBatchInSegmentGroups(leaf.rays.data(), tieGot.data(), leaf.rayIds.data(),
+                                                std::uint32_t(leaf.rayIds.size()), batch, cell, 2.0f * leaf.margin,
+                                                false);
+            for (std::size_t i = 0; i < leaf.rays.size(); ++i) {
+                ASSERT_TRUE(sameHit(tieGot[i], tieExpected[i]))
+                    << "trial " << trial << " ray " << i << ": groups prim " << tieGot[i].prim << ", scalar prim "
+                    << tieExpected[i].prim << " (tie with " << tieStart[i].prim << ")";
+                tiesTaken += tieStart[i].prim != kMissPrim && tieStart[i].prim != 0u &&
+                             tieExpected[i].prim != tieStart[i].prim;
+            }
             for (bool anyHit : {false, true}) {
-                std::vector<Hit> got = start, unwidened = start;
+                // An any-hit ray that already has a hit keeps it: every fifth one here.
+                std::vector<Hit> anyStart = start;
+                if (anyHit)
+                    for (std::size_t i = 0; i < anyStart.size(); i += 5) anyStart[i] = Hit{start[i].t, 7, 0.25f, 0.5f};
+                std::vector<Hit> got = anyStart, unwidened = anyStart;
                 skipped += simd::intersectBatchInSegmentGroups(leaf.rays.data(), got.data(), leaf.rayIds.data(),
                                                                rayCount, batch, cell, 2.0f * leaf.margin, anyHit);
                 simd::intersectBatchInSegmentGroups(leaf.rays.data(), unwidened.data(), leaf.rayIds.data(), rayCount,
                                                     batch, cell, 0.0f, anyHit);
                 tests += std::uint64_t(rayCount) * leaf.triIds.size();
                 for (std::size_t i = 0; i < leaf.rays.size(); ++i) {
+                    if (anyHit && i % 5 == 0) {
+                        ASSERT_TRUE(sameHit(got[i], anyStart[i]))
+                            << "trial " << trial << " ray " << i << ": a ray's any hit changed to " << got[i].prim;
+                        continue;
+                    }
                     missedWithoutWidening += (unwidened[i].prim == kMissPrim) != (expected[i].prim == kMissPrim);
                     if (!anyHit) {
                         ASSERT_TRUE(sameHit(got[i], expected[i]))
@@ -644,6 +678,7 @@ TEST_F(EveryTarget, SegmentGroupsGiveTheBatchsHitsBitForBit) {
         }
         EXPECT_GT(hitsFound, 3000u);
         EXPECT_GT(anyHitsFound, 3000u);
+        EXPECT_GT(tiesTaken, 1000u) << "hits at a segment's very end must take ties from misses and high ids";
         EXPECT_GT(skipped, tests / 5) << "the groups must narrow the leaf, not only keep it";
         EXPECT_GT(missedWithoutWidening, 0u) << "the leaf must hold hits that only the widening keeps";
     });
