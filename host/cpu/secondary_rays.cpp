@@ -94,27 +94,15 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
     return out;
 }
 
-std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced) {
+std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced, ThreadPool* pool) {
     if (traced.size() != rays.rays.size())
         throw InternalError("a secondary pass traced " + std::to_string(traced.size()) + " rays of " +
                             std::to_string(rays.rays.size()));
-    const Hit none{0.0f, kNotTracedPrim, 0.0f, 0.0f};
-    // Rays in slot order (as makeSecondaryRays makes them) fill the array in one sweep, each
-    // slot written once: an occlusion pass's slots are raysPerHit a pixel (the Bunny's 4-ray
-    // pass: 20 MB), mostly without a ray, and filling them before scattering the hits wrote
-    // them twice. Rays grouped out of slot order (groupByOctant) are scattered.
-    std::vector<Hit> slots;
-    reserveMapped(slots, rays.slotCount);
-    for (std::size_t i = 0; i < traced.size(); ++i) {
-        if (rays.slots[i] < slots.size()) {
-            slots.resize(rays.slotCount, none);
-            for (std::size_t j = 0; j < traced.size(); ++j) slots[rays.slots[j]] = traced[j];
-            return slots;
-        }
-        slots.resize(rays.slots[i], none);
-        slots.push_back(traced[i]);
-    }
-    slots.resize(rays.slotCount, none);
+    std::vector<Hit> slots = filledArray(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f}, pool);
+    // Each ray has its own slot, so chunks of rays scatter side by side.
+    forEachChunk(traced.size(), kFrameScanChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) slots[rays.slots[i]] = traced[i];
+    });
     return slots;
 }
 

@@ -173,8 +173,9 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
                                 ThreadPool& pool);
 
 // The pass's result per slot: the traced hit (any hit: the visibility is exact), or
-// Hit{0, kNotTracedPrim} where no ray was made.
-std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced);
+// Hit{0, kNotTracedPrim} where no ray was made. pool: the fill and scatter in chunks side by
+// side (none: on the calling thread).
+std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced, ThreadPool* pool = nullptr);
 
 // The frame a pass's rays are traced as: any hit (frameGeometry finds their child order:
 // shadow rays to a directional light share a direction, the others go every way). pool: its

@@ -262,7 +262,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     const double makeMs = msSince(start);
     out.rays = rays.rays.size();
     if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
-        out.result.hits = hitsPerSlot(rays, {});
+        out.result.hits = hitsPerSlot(rays, {}, &threadPool);
     } else {
         std::vector<std::size_t> groups = {0, rays.rays.size()};  // one trace of every ray
         std::optional<double> groupMs;
@@ -282,7 +282,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
         out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, passRequest, onPlan)
                                        : tracePassRays(primary, rays.rays, passRequest, onPlan);
         if (out.result.hits.empty()) return out;  // stopped at the plan
-        out.result.hits = hitsPerSlot(rays, out.result.hits);
+        out.result.hits = hitsPerSlot(rays, out.result.hits, &threadPool);
         out.result.phases.groupRays = groupMs;
     }
     out.result.phases.makeRays = makeMs;
@@ -377,8 +377,11 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
         throw InternalError("passes traced together: " + std::to_string(traced.hits.size()) + " hits for " +
                             std::to_string(rays.size()) + " rays");
     const Hit none{0.0f, kNotTracedPrim, 0.0f, 0.0f};
-    for (std::size_t p = 0; p < passes.size(); ++p) out[p].result.hits = mappedArray(slotCount[p], none);
-    for (std::size_t i = 0; i < traced.hits.size(); ++i) out[passOf[i]].result.hits[slotOf[i]] = traced.hits[i];
+    for (std::size_t p = 0; p < passes.size(); ++p) out[p].result.hits = filledArray(slotCount[p], none, &threadPool);
+    // Each ray has its own slot of its pass, so chunks of rays scatter side by side.
+    forEachChunk(traced.hits.size(), kFrameScanChunk, &threadPool, [&](std::size_t, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) out[passOf[i]].result.hits[slotOf[i]] = traced.hits[i];
+    });
     std::vector<Hit> lastHits = std::move(out.back().result.hits);
     out.back().result = std::move(traced);
     out.back().result.hits = std::move(lastHits);

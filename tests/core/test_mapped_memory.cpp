@@ -45,13 +45,29 @@ TEST(MappedMemory, ReserveAndResizeKeepTheElementsAndZeroTheNewOnes) {
     EXPECT_EQ(v, std::vector<std::uint64_t>(10, 9u));
 }
 
+// Every element, on a pool of 2 and on the calling thread, over sizes that end inside a chunk
+// of the fill, on one, and with none; mappedArray's elements are value-initialized.
 TEST(MappedMemory, ArraysAreFilledWithTheirValueFreshOrReused) {
-    for (int round = 0; round < 3; ++round) {  // later rounds may reuse the memory freed before
-        const std::vector<float> a = mappedArray<float>(5 * kMiB, 1.5f);
-        ASSERT_EQ(a.size(), 5 * kMiB);
-        for (std::size_t i = 0; i < a.size(); i += 997) ASSERT_EQ(a[i], 1.5f) << i;
-        EXPECT_EQ(a.back(), 1.5f);
-    }
+    ThreadPool pool(2);
+    struct Slot {
+        float t;
+        std::uint32_t id;
+        float u, v;
+    };
+    const Slot value{0.5f, 0xFFFFFFFEu, 0.25f, 0.125f};
+    for (ThreadPool* on : {static_cast<ThreadPool*>(nullptr), &pool})
+        for (int round = 0; round < 3; ++round) {  // later rounds may reuse the memory freed before
+            for (const std::size_t n : {std::size_t(0), std::size_t(1), kFillChunk, 3 * kFillChunk + 17, 5 * kMiB}) {
+                const std::vector<Slot> a = filledArray(n, value, on);
+                ASSERT_EQ(a.size(), n);
+                for (std::size_t i = 0; i < n; ++i)
+                    ASSERT_TRUE(a[i].t == value.t && a[i].id == value.id && a[i].u == value.u && a[i].v == value.v)
+                        << i << " of " << n;
+            }
+            const std::vector<float> zeros = mappedArray<float>(5 * kMiB);
+            ASSERT_EQ(zeros.size(), 5 * kMiB);
+            for (std::size_t i = 0; i < zeros.size(); ++i) ASSERT_EQ(zeros[i], 0.0f) << i;
+        }
     EXPECT_TRUE(mappedArray<int>(0).empty());
     mapForWriting(nullptr, 8 * kMiB);  // nothing to map
 }

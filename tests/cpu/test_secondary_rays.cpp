@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/mapped_memory.hpp"
 #include "core/procedural.hpp"
 #include "core/random.hpp"
 #include "cpu/ray_grouping.hpp"
@@ -471,9 +472,10 @@ TEST(SecondaryRays, GroupingByOctantIsAStablePermutationThatHitsPerSlotUndoes) {
     }
 }
 
-// hitsPerSlot fills slots in one sweep where the rays are in slot order and scatters them
-// otherwise: both give each ray's hit in its slot and kNotTracedPrim in every other slot, from
-// the first slot to the last, with no ray, and with rays that leave slot order part way.
+// hitsPerSlot gives each ray's hit in its slot and kNotTracedPrim in every other slot, from the
+// first slot to the last, with no ray, with rays in slot order and out of it; on the calling
+// thread and on a pool of 2, with slot counts of several fill chunks and rays of several scan
+// chunks.
 TEST(SecondaryRays, HitsPerSlotPutsEveryHitInItsSlotInOrderOrNot) {
     auto slotsWith = [](std::vector<std::uint32_t> slots, std::uint64_t slotCount) {
         SecondaryRays r;
@@ -487,19 +489,36 @@ TEST(SecondaryRays, HitsPerSlotPutsEveryHitInItsSlotInOrderOrNot) {
         for (std::uint32_t slot : r.slots) hits.push_back(Hit{0.5f * float(slot), slot + 1000u, 0.25f, 0.125f});
         return hits;
     };
-    const std::vector<std::vector<std::uint32_t>> cases = {
-        {}, {0}, {6}, {0, 1, 2, 3, 4, 5, 6}, {1, 3, 4, 6}, {2, 5, 1, 6}, {0, 4, 3}, {6, 5, 4, 3, 2, 1, 0}};
-    for (const std::vector<std::uint32_t>& slots : cases) {
-        const SecondaryRays rays = slotsWith(slots, 7);
-        const std::vector<Hit> perSlot = hitsPerSlot(rays, hitsOf(rays));
-        ASSERT_EQ(perSlot.size(), 7u);
-        for (std::uint32_t s = 0; s < 7; ++s) {
-            const bool traced = std::find(slots.begin(), slots.end(), s) != slots.end();
-            EXPECT_EQ(perSlot[s].prim, traced ? s + 1000u : kNotTracedPrim) << "slot " << s << " of case " << slots.size();
-            EXPECT_EQ(perSlot[s].t, traced ? 0.5f * float(s) : 0.0f) << "slot " << s;
-            EXPECT_EQ(perSlot[s].u, traced ? 0.25f : 0.0f) << "slot " << s;
+    struct Case {
+        std::vector<std::uint32_t> slots;
+        std::uint32_t slotCount;
+    };
+    std::vector<Case> cases;
+    for (std::vector<std::uint32_t> slots : std::vector<std::vector<std::uint32_t>>{
+             {}, {0}, {6}, {0, 1, 2, 3, 4, 5, 6}, {1, 3, 4, 6}, {2, 5, 1, 6}, {0, 4, 3}, {6, 5, 4, 3, 2, 1, 0}})
+        cases.push_back({std::move(slots), 7});
+    const std::uint32_t many = 3 * std::uint32_t(kFillChunk) + 5;  // a ray in every third slot
+    std::vector<std::uint32_t> everyThird;
+    for (std::uint32_t s = 1; s < many; s += 3) everyThird.push_back(s);
+    cases.push_back({everyThird, many});
+    std::reverse(everyThird.begin(), everyThird.end());
+    cases.push_back({everyThird, many});
+    ThreadPool pool(2);
+    for (ThreadPool* on : {static_cast<ThreadPool*>(nullptr), &pool})
+        for (const Case& c : cases) {
+            const SecondaryRays rays = slotsWith(c.slots, c.slotCount);
+            const std::vector<Hit> perSlot = hitsPerSlot(rays, hitsOf(rays), on);
+            ASSERT_EQ(perSlot.size(), c.slotCount);
+            std::vector<std::uint8_t> traced(c.slotCount, 0);
+            for (std::uint32_t s : c.slots) traced[s] = 1;
+            for (std::uint32_t s = 0; s < c.slotCount; ++s) {
+                ASSERT_EQ(perSlot[s].prim, traced[s] ? s + 1000u : kNotTracedPrim)
+                    << "slot " << s << " of case " << c.slots.size() << (on ? " on a pool" : "");
+                ASSERT_EQ(perSlot[s].t, traced[s] ? 0.5f * float(s) : 0.0f) << "slot " << s;
+                ASSERT_EQ(perSlot[s].u, traced[s] ? 0.25f : 0.0f) << "slot " << s;
+                ASSERT_EQ(perSlot[s].v, traced[s] ? 0.125f : 0.0f) << "slot " << s;
+            }
         }
-    }
 }
 
 TEST(SecondaryRays, BatchesAreEqualRunsOfAtMostTheLimit) {
