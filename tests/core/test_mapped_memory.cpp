@@ -1,6 +1,7 @@
 // Mapping an array's pages ahead is advice to the system: whatever it grants or refuses, and
 // whether the pages were mapped already (memory freed and allocated again) or not, the
 // array's contents and size are what the same calls without it give.
+#include <algorithm>
 #include <cstdint>
 #include <numeric>
 #include <vector>
@@ -60,13 +61,14 @@ TEST(MappedMemory, ArraysAreFilledWithTheirValueFreshOrReused) {
             for (const std::size_t n : {std::size_t(0), std::size_t(1), kFillChunk, 3 * kFillChunk + 17, 5 * kMiB}) {
                 const std::vector<Slot> a = filledArray(n, value, on);
                 ASSERT_EQ(a.size(), n);
-                for (std::size_t i = 0; i < n; ++i)
-                    ASSERT_TRUE(a[i].t == value.t && a[i].id == value.id && a[i].u == value.u && a[i].v == value.v)
-                        << i << " of " << n;
+                const auto differs = std::count_if(a.begin(), a.end(), [&](const Slot& e) {
+                    return !(e.t == value.t && e.id == value.id && e.u == value.u && e.v == value.v);
+                });
+                EXPECT_EQ(differs, 0) << "of " << n << (on ? " on a pool" : "");
             }
             const std::vector<float> zeros = mappedArray<float>(5 * kMiB);
             ASSERT_EQ(zeros.size(), 5 * kMiB);
-            for (std::size_t i = 0; i < zeros.size(); ++i) ASSERT_EQ(zeros[i], 0.0f) << i;
+            EXPECT_EQ(std::count(zeros.begin(), zeros.end(), 0.0f), std::ptrdiff_t(zeros.size()));
         }
     EXPECT_TRUE(mappedArray<int>(0).empty());
     mapForWriting(nullptr, 8 * kMiB);  // nothing to map
