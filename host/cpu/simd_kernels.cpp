@@ -732,9 +732,10 @@ constexpr std::uint32_t kTrialGroups = 2;
 
 // The box of the group's segments from their origins (the watertight test reports no hit at
 // t < 0, whatever tmin is) to their best t so far (a later hit must precede it, so it lies
-// before that t): the smallest and largest of o and o + t d over the group, lanes at a time. False where some lane's box is not a number (an infinite
-// coordinate times a zero).
-HWY_INLINE bool boxOfSegments(const Ray* rays, const Hit* hits, const std::uint32_t* rayIds, std::uint32_t count,
+// before that t): the smallest and largest of o and o + t d over the group, lanes at a time.
+// Never not a number: the rays' fields are finite and t at most kNoHitT (an infinite tmax is
+// stored as kNoHitT), so o + t d overflows at worst to an infinity, which narrows nothing.
+HWY_INLINE void boxOfSegments(const Ray* rays, const Hit* hits, const std::uint32_t* rayIds, std::uint32_t count,
                               glm::vec3& lo, glm::vec3& hi) {
     const DF df;
     const std::size_t n = hn::Lanes(df);
@@ -746,7 +747,6 @@ HWY_INLINE bool boxOfSegments(const Ray* rays, const Hit* hits, const std::uint3
         boxLo[a] = hn::Set(df, kNoHitT);
         boxHi[a] = hn::Set(df, -kNoHitT);
     }
-    MF notANumber = hn::FirstN(df, 0);
     for (std::uint32_t i = 0; i < count; i += std::uint32_t(n)) {
         laneIds(rayIds, i, std::min(std::uint32_t(n), count - i), ids);
         VF origin[4], dir[4];
@@ -755,17 +755,14 @@ HWY_INLINE bool boxOfSegments(const Ray* rays, const Hit* hits, const std::uint3
         const VF t = loadPerLane<4>(hitFloats, ids, 0);
         for (int a = 0; a < 3; ++a) {
             const VF end = hn::Add(origin[a], hn::Mul(t, dir[a]));
-            notANumber = hn::Or(notANumber, hn::IsNaN(end));
             boxLo[a] = hn::Min(boxLo[a], hn::Min(origin[a], end));
             boxHi[a] = hn::Max(boxHi[a], hn::Max(origin[a], end));
         }
     }
-    if (!hn::AllFalse(df, notANumber)) return false;
     for (int a = 0; a < 3; ++a) {
         lo[a] = hn::GetLane(hn::MinOfLanes(df, boxLo[a]));
         hi[a] = hn::GetLane(hn::MaxOfLanes(df, boxHi[a]));
     }
-    return true;
 }
 
 // The triangles of batch whose widened bounds overlap the box, in order, into narrowed (each
@@ -838,9 +835,9 @@ HWY_INLINE std::uint64_t intersectSegmentGroups(const Ray* rays, Hit* hits, cons
         if (g == kTrialGroups * kLeafGroupRays && vectorsSaved * 2 < g) break;
         const std::uint32_t groupRays = std::min(kLeafGroupRays, rayCount - g);
         glm::vec3 lo, hi;
-        if (!boxOfSegments(rays, hits, rayIds + g, groupRays, lo, hi) ||
-            (lo.x <= cell.lo.x && lo.y <= cell.lo.y && lo.z <= cell.lo.z && hi.x >= cell.hi.x &&
-             hi.y >= cell.hi.y && hi.z >= cell.hi.z)) {
+        boxOfSegments(rays, hits, rayIds + g, groupRays, lo, hi);
+        if (lo.x <= cell.lo.x && lo.y <= cell.lo.y && lo.z <= cell.lo.z && hi.x >= cell.hi.x &&
+            hi.y >= cell.hi.y && hi.z >= cell.hi.z) {
             intersectRays<kAnyHit>(rays, hits, rayIds + g, groupRays, batch);
             continue;
         }
