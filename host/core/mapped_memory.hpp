@@ -7,6 +7,7 @@
 // maps fresh.
 #include <algorithm>
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 #include "core/thread_pool.hpp"
@@ -54,9 +55,11 @@ constexpr std::size_t kFillChunk = 65536;
 // resize(n, value) as a loop that rebuilds the value on the stack with narrow stores and
 // reloads it with one 16-byte load in every iteration, a load the narrow stores cannot forward
 // to. That loop took 7.4 ms for the Bunny's 1.2 million occlusion slots, the zeroing and the
-// fill 1.3 ms together (docs/benchmarks.md, "Slot arrays filled without a stall").
+// fill 1.3 ms together (docs/benchmarks.md, "Slot arrays filled without a stall"). Not from a
+// task of the same pool (ThreadPool::parallelFor does not nest).
 template <typename T>
 std::vector<T> filledArray(std::size_t n, const T& value, ThreadPool* pool = nullptr) {
+    static_assert(std::is_nothrow_copy_assignable_v<T>, "a pool's task must not throw");
     std::vector<T> v = mappedArray<T>(n);
     forEachChunk(n, kFillChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
         std::fill(v.begin() + std::ptrdiff_t(begin), v.begin() + std::ptrdiff_t(end), value);

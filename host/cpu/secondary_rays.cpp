@@ -1,6 +1,7 @@
 #include "cpu/secondary_rays.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "core/errors.hpp"
@@ -94,15 +95,29 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
     return out;
 }
 
-std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced, ThreadPool* pool) {
-    if (traced.size() != rays.rays.size())
-        throw InternalError("a secondary pass traced " + std::to_string(traced.size()) + " rays of " +
-                            std::to_string(rays.rays.size()));
-    std::vector<Hit> slots = filledArray(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f}, pool);
-    // Each ray has its own slot, so chunks of rays scatter side by side.
-    forEachChunk(traced.size(), kFrameScanChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) slots[rays.slots[i]] = traced[i];
+void scatterToSlots(std::span<std::vector<Hit>> slotArrays, const std::uint32_t* slotOf, const std::uint16_t* passOf,
+                    const Hit* hits, std::size_t count, ThreadPool* pool) {
+    std::atomic<bool> pastTheEnd{false};
+    forEachChunk(count, kFrameScanChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
+        bool past = false;
+        for (std::size_t i = begin; i < end; ++i) {
+            std::vector<Hit>& slots = slotArrays[passOf ? passOf[i] : 0];
+            if (slotOf[i] < slots.size())
+                slots[slotOf[i]] = hits[i];
+            else
+                past = true;
+        }
+        if (past) pastTheEnd.store(true, std::memory_order_relaxed);
     });
+    if (pastTheEnd.load()) throw InternalError("a secondary ray names a slot past its pass's slots");
+}
+
+std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced, ThreadPool* pool) {
+    if (traced.size() != rays.rays.size() || rays.slots.size() != rays.rays.size())
+        throw InternalError("a secondary pass traced " + std::to_string(traced.size()) + " rays of " +
+                            std::to_string(rays.rays.size()) + " (" + std::to_string(rays.slots.size()) + " slots named)");
+    std::vector<Hit> slots = filledArray(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f}, pool);
+    scatterToSlots({&slots, 1}, rays.slots.data(), nullptr, traced.data(), traced.size(), pool);
     return slots;
 }
 

@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -172,9 +173,16 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
                                 const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
                                 ThreadPool& pool);
 
+// hits[i] into slot slotOf[i] of slotArrays[passOf[i]] (of slotArrays[0] where passOf is null),
+// in chunks side by side on the pool (on the calling thread without one): each ray has its own
+// slot. Throws InternalError where a slot lies past its array (nothing is written there).
+// Not from a task of the same pool (ThreadPool::parallelFor does not nest).
+void scatterToSlots(std::span<std::vector<Hit>> slotArrays, const std::uint32_t* slotOf, const std::uint16_t* passOf,
+                    const Hit* hits, std::size_t count, ThreadPool* pool);
+
 // The pass's result per slot: the traced hit (any hit: the visibility is exact), or
 // Hit{0, kNotTracedPrim} where no ray was made. pool: the fill and scatter in chunks side by
-// side (none: on the calling thread).
+// side (none: on the calling thread; not from a task of the same pool).
 std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced, ThreadPool* pool = nullptr);
 
 // The frame a pass's rays are traced as: any hit (frameGeometry finds their child order:

@@ -377,11 +377,10 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
         throw InternalError("passes traced together: " + std::to_string(traced.hits.size()) + " hits for " +
                             std::to_string(rays.size()) + " rays");
     const Hit none{0.0f, kNotTracedPrim, 0.0f, 0.0f};
-    for (std::size_t p = 0; p < passes.size(); ++p) out[p].result.hits = filledArray(slotCount[p], none, &threadPool);
-    // Each ray has its own slot of its pass, so chunks of rays scatter side by side.
-    forEachChunk(traced.hits.size(), kFrameScanChunk, &threadPool, [&](std::size_t, std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) out[passOf[i]].result.hits[slotOf[i]] = traced.hits[i];
-    });
+    std::vector<std::vector<Hit>> hitsOfPass(passes.size());
+    for (std::size_t p = 0; p < passes.size(); ++p) hitsOfPass[p] = filledArray(slotCount[p], none, &threadPool);
+    scatterToSlots(hitsOfPass, slotOf.data(), passOf.data(), traced.hits.data(), traced.hits.size(), &threadPool);
+    for (std::size_t p = 0; p < passes.size(); ++p) out[p].result.hits = std::move(hitsOfPass[p]);
     std::vector<Hit> lastHits = std::move(out.back().result.hits);
     out.back().result = std::move(traced);
     out.back().result.hits = std::move(lastHits);

@@ -66,9 +66,14 @@ TEST(MappedMemory, ArraysAreFilledWithTheirValueFreshOrReused) {
                 });
                 EXPECT_EQ(differs, 0) << "of " << n << (on ? " on a pool" : "");
             }
-            const std::vector<float> zeros = mappedArray<float>(5 * kMiB);
-            ASSERT_EQ(zeros.size(), 5 * kMiB);
-            EXPECT_EQ(std::count(zeros.begin(), zeros.end(), 0.0f), std::ptrdiff_t(zeros.size()));
+            // Value-initialized, in memory that held other values (a small array reuses the heap's
+            // freed block; a large one is mapped fresh).
+            for (const std::size_t n : {std::size_t(1000), 5 * kMiB}) {
+                { const std::vector<float> before(n, 2.5f); }
+                const std::vector<float> zeros = mappedArray<float>(n);
+                ASSERT_EQ(zeros.size(), n);
+                EXPECT_EQ(std::count(zeros.begin(), zeros.end(), 0.0f), std::ptrdiff_t(n));
+            }
         }
     EXPECT_TRUE(mappedArray<int>(0).empty());
     mapForWriting(nullptr, 8 * kMiB);  // nothing to map

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/errors.hpp"
 #include "core/mapped_memory.hpp"
 #include "core/procedural.hpp"
 #include "core/random.hpp"
@@ -519,6 +520,15 @@ TEST(SecondaryRays, HitsPerSlotPutsEveryHitInItsSlotInOrderOrNot) {
                 ASSERT_EQ(perSlot[s].v, traced[s] ? 0.125f : 0.0f) << "slot " << s;
             }
         }
+    // A slot past the pass's slots is refused, on the calling thread and on the pool, and a
+    // slot list that does not match the rays.
+    for (ThreadPool* on : {static_cast<ThreadPool*>(nullptr), &pool}) {
+        const SecondaryRays past = slotsWith({1, 7}, 7);
+        EXPECT_THROW(hitsPerSlot(past, hitsOf(past), on), InternalError);
+    }
+    SecondaryRays unnamed = slotsWith({1, 2}, 7);
+    unnamed.slots.pop_back();
+    EXPECT_THROW(hitsPerSlot(unnamed, std::vector<Hit>(2), nullptr), InternalError);
 }
 
 TEST(SecondaryRays, BatchesAreEqualRunsOfAtMostTheLimit) {

@@ -106,8 +106,8 @@ struct SecondaryPassSet {
     std::vector<std::pair<std::string, SecondaryPass>> passes;
 
     SecondaryPassSet(std::string setName, Scene scene, const CameraOptions& camera,
-                     std::vector<std::pair<std::string, SecondaryPass>> setPasses)
-        : name(std::move(setName)), frame(std::move(scene), 48, 36, camera), primary(frame.trace(Backend::Brute, 0, 2)),
+                     std::vector<std::pair<std::string, SecondaryPass>> setPasses, int width = 48, int height = 36)
+        : name(std::move(setName)), frame(std::move(scene), width, height, camera), primary(frame.trace(Backend::Brute, 0, 2)),
           passes(std::move(setPasses)) {}
     SecondaryPassSet(const SecondaryPassSet&) = delete;
 };
