@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <type_traits>
 
 #include "core/errors.hpp"
 #include "core/mapped_memory.hpp"
@@ -196,7 +197,9 @@ bool AccessorReader::tryReserve(std::uint64_t bytes) const {
 std::vector<glm::dvec4> AccessorReader::readVectors(int index, std::initializer_list<int> types, const std::string& where) const {
     const Elements e = elements(index, types, where);
     reserveDecoded(e.count, sizeof(glm::dvec4), where + ": accessor " + std::to_string(index));
-    std::vector<glm::dvec4> out = filledArray(std::size_t(e.count), glm::dvec4(0.0));
+    // Zeros where an element has fewer than four components: glm's vectors value-initialize to 0.
+    static_assert(std::is_trivially_default_constructible_v<glm::dvec4>);
+    std::vector<glm::dvec4> out = mappedArray<glm::dvec4>(std::size_t(e.count));
     if (e.data) {
         const std::uint64_t componentSize = std::uint64_t(tinygltf::GetComponentSizeInBytes(std::uint32_t(e.componentType)));
         for (std::uint64_t i = 0; i < e.count; ++i) {

@@ -28,15 +28,12 @@ void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
 // pass over the rays, in chunks side by side on the pool (none: on the calling thread).
 bool startHits(const FrameGeometry& g, std::vector<Hit>& hits, ThreadPool* pool) {
     const std::vector<Ray>& rays = *g.rays;
-    reserveMapped(hits, rays.size());
-    hits.resize(rays.size());
     if (g.uniformByConstruction) {  // one segment: every start the first ray's, the rays unread
-        const Hit start = missHit(rays[0]);
-        forEachChunk(rays.size(), kFrameScanChunk, pool, [&](std::size_t, std::size_t begin, std::size_t end) {
-            std::fill(hits.begin() + std::ptrdiff_t(begin), hits.begin() + std::ptrdiff_t(end), start);
-        });
+        hits = filledArray(rays.size(), missHit(rays[0]), pool);
         return true;
     }
+    reserveMapped(hits, rays.size());
+    hits.resize(rays.size());
     std::vector<std::uint8_t> shareSegment((rays.size() + kFrameScanChunk - 1) / kFrameScanChunk, 1);
     forEachChunk(rays.size(), kFrameScanChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
         bool share = true;

@@ -112,11 +112,15 @@ void scatterToSlots(std::span<std::vector<Hit>> slotArrays, const std::uint32_t*
     if (pastTheEnd.load()) throw InternalError("a secondary ray names a slot past its pass's slots");
 }
 
+std::vector<Hit> notTracedSlots(std::uint64_t slotCount, ThreadPool* pool) {
+    return filledArray(std::size_t(slotCount), Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f}, pool);
+}
+
 std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& traced, ThreadPool* pool) {
     if (traced.size() != rays.rays.size() || rays.slots.size() != rays.rays.size())
         throw InternalError("a secondary pass traced " + std::to_string(traced.size()) + " rays of " +
                             std::to_string(rays.rays.size()) + " (" + std::to_string(rays.slots.size()) + " slots named)");
-    std::vector<Hit> slots = filledArray(rays.slotCount, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f}, pool);
+    std::vector<Hit> slots = notTracedSlots(rays.slotCount, pool);
     scatterToSlots({&slots, 1}, rays.slots.data(), nullptr, traced.data(), traced.size(), pool);
     return slots;
 }

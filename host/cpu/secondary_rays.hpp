@@ -173,6 +173,10 @@ SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray
                                 const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
                                 ThreadPool& pool);
 
+// A pass's slotCount slots before any hit: Hit{0, kNotTracedPrim} in each, filled in chunks
+// on the pool (filledArray).
+std::vector<Hit> notTracedSlots(std::uint64_t slotCount, ThreadPool* pool = nullptr);
+
 // hits[i] into slot slotOf[i] of slotArrays[passOf[i]] (of slotArrays[0] where passOf is null),
 // in chunks side by side on the pool (on the calling thread without one): each ray has its own
 // slot. Throws InternalError where a slot lies past its array (nothing is written there).

@@ -376,14 +376,11 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
     if (traced.hits.size() != rays.size())
         throw InternalError("passes traced together: " + std::to_string(traced.hits.size()) + " hits for " +
                             std::to_string(rays.size()) + " rays");
-    const Hit none{0.0f, kNotTracedPrim, 0.0f, 0.0f};
     std::vector<std::vector<Hit>> hitsOfPass(passes.size());
-    for (std::size_t p = 0; p < passes.size(); ++p) hitsOfPass[p] = filledArray(slotCount[p], none, &threadPool);
+    for (std::size_t p = 0; p < passes.size(); ++p) hitsOfPass[p] = notTracedSlots(slotCount[p], &threadPool);
     scatterToSlots(hitsOfPass, slotOf.data(), passOf.data(), traced.hits.data(), traced.hits.size(), &threadPool);
+    out.back().result = std::move(traced);  // the shared trace's plan, phases and counters
     for (std::size_t p = 0; p < passes.size(); ++p) out[p].result.hits = std::move(hitsOfPass[p]);
-    std::vector<Hit> lastHits = std::move(out.back().result.hits);
-    out.back().result = std::move(traced);
-    out.back().result.hits = std::move(lastHits);
     out.back().result.phases.makeRays = makeMs;
     std::vector<WorkLine>& work = out.back().result.memory.work;
     work.insert(work.begin(), merging.work.begin(), merging.work.end());

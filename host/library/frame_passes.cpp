@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "core/errors.hpp"
-#include "core/mapped_memory.hpp"
 #include "core/lights.hpp"
 #include "core/timing.hpp"
 #include "library/api_results.hpp"
@@ -50,7 +49,7 @@ std::uint32_t samplesPerBatch(const SecondaryPass& pass, std::uint64_t primaryRa
 void addBatch(TracedPass& whole, const SecondaryPass& batch, TracedPass&& part, std::uint64_t primaryRays) {
     const std::uint32_t total = whole.pass.raysPerHit;
     if (whole.result.hits.empty()) {
-        whole.result.hits = filledArray(primaryRays * total, Hit{0.0f, kNotTracedPrim, 0.0f, 0.0f});
+        whole.result.hits = notTracedSlots(primaryRays * total);
         whole.result.memory = part.result.memory;
         whole.result.gpu = part.result.gpu;
         whole.result.regions = part.result.regions;
