@@ -6,45 +6,17 @@
 #include <optional>
 
 #include "cpu/backend_options.hpp"
+#include "cpu/frame_start.hpp"
 #include "cpu/image_bands.hpp"
 #include "cpu/traversal.hpp"
 #include "core/errors.hpp"
 #include "core/mapped_memory.hpp"
 #include "cpu/scene_division.hpp"
+#include "cpu/subtrees.hpp"
 #include "core/timing.hpp"
 
 namespace dacrt {
 namespace {
-
-void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
-    plan.add("rays", std::uint64_t(g.rays->size()) * sizeof(Ray));
-    plan.add("hits", std::uint64_t(g.rays->size()) * sizeof(Hit));
-    plan.add("triangles", std::uint64_t(g.triangles->size()) * sizeof(Triangle));
-    plan.add("triangle bounds", std::uint64_t(g.triangles->size()) * sizeof(Bounds));
-}
-
-// Every ray's best hit starts at its segment's end (missHit). Returns whether every ray has
-// the first one's segment, bit for bit (TraversalBuffers::raysShareSegment), found in the same
-// pass over the rays, in chunks side by side on the pool (none: on the calling thread).
-bool startHits(const FrameGeometry& g, std::vector<Hit>& hits, ThreadPool* pool) {
-    const std::vector<Ray>& rays = *g.rays;
-    if (g.uniformByConstruction) {  // one segment: every start the first ray's, the rays unread
-        hits = filledArray(rays.size(), missHit(rays[0]), pool);
-        return true;
-    }
-    reserveMapped(hits, rays.size());
-    hits.resize(rays.size());
-    std::vector<std::uint8_t> shareSegment((rays.size() + kFrameScanChunk - 1) / kFrameScanChunk, 1);
-    forEachChunk(rays.size(), kFrameScanChunk, pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
-        bool share = true;
-        for (std::size_t i = begin; i < end; ++i) {
-            hits[i] = missHit(rays[i]);
-            share &= sameSegment(rays[i], rays[0]);
-        }
-        shareSegment[c] = share;
-    });
-    return !rays.empty() && std::all_of(shareSegment.begin(), shareSegment.end(), [](std::uint8_t s) { return s != 0; });
-}
 
 Box regionBox(const Region& r) {
     Box b;
@@ -339,8 +311,10 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
                 r.memory.work.insert(r.memory.work.end(), line.begin(), line.end());
                 return r;
             }
-            // Bands skip the sub-scenes too: --no-skip subscenes asks for the parallel scheme.
+            // Subtrees and bands skip the sub-scenes too: --no-skip subscenes asks for the
+            // parallel scheme.
             if (options.regions == 0 && options.skips.subScenes) {
+                if (tracesAsSubtrees(g, options.dacrt, pool.size())) return traceSubtrees(g, options.dacrt, pool, onPlan);
                 const std::vector<std::uint32_t> bands = imageBands(g, pool.size());
                 if (!bands.empty()) return traceImageBands(g, options.dacrt, pool, bands, onPlan);
             }

@@ -9,18 +9,6 @@
 namespace dacrt {
 namespace {
 
-Box widen(const Box& b, float margin) {
-    Box w;
-    w.lo = b.lo - glm::vec3(margin);
-    w.hi = b.hi + glm::vec3(margin);
-    return w;
-}
-
-int longestAxis(const Box& b) {
-    const glm::vec3 e = b.extent();
-    return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
-}
-
 // What the ray filter may broadcast from the first ray (simd::SharedRayFields).
 simd::SharedRayFields sharedRayFieldsOf(const FrameGeometry& g, const TraversalBuffers& buffers) {
     if (g.raysShareStart) return simd::SharedRayFields::Start;
@@ -122,13 +110,13 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
 
 std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
                                     std::uint32_t triBegin, std::uint32_t triEnd, const RetireRule& retire) {
-    const std::uint32_t crossing = filterRays(widen(box, margin_), terminated, rayEnd);
+    const std::uint32_t crossing = filterRays(widenedBox(box, margin_), terminated, rayEnd);
     if (packets_)
         tracePackets(box, terminated, crossing, triBegin, triEnd);
     else
         node(box, terminated, crossing, triBegin, triEnd, 0, 0);
     if (retire.axis < 0) return crossing;
-    const Box cell = widen(box, margin_);
+    const Box cell = widenedBox(box, margin_);
     for (std::uint32_t k = terminated; k < rayEnd; ++k) {
         const std::uint32_t id = rayIds_[k];
         const float d = rays_[id].dir[retire.axis];
@@ -204,7 +192,7 @@ std::uint32_t DacrtTraversal::partitionTrianglesByBounds(const Box& cell, std::u
 }
 
 float DacrtTraversal::splitPosition(const Box& box, int axis, std::uint32_t triBegin, std::uint32_t triEnd) const {
-    const float mid = 0.5f * (box.lo[axis] + box.hi[axis]);
+    const float mid = spatialMedian(box, axis);
     if (options_.split == SplitMethod::SpatialMedian) return mid;
     // Mora's sampled mean: every 50th triangle centre once the set is large, all of them below.
     const std::uint32_t count = triEnd - triBegin;
@@ -238,9 +226,7 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
                                Descend descend) {
     int axis = longestAxis(box);
     float split = splitPosition(box, axis, triBegin, triEnd);
-    if (fewItems || triEnd - triBegin < options_.triLimit || depth >= options_.maxDepth ||
-        stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis]))
-        return false;
+    if (endsAsLeaf(box, axis, split, fewItems, triEnd - triBegin, depth, stalls, options_)) return false;
     if (sampleRays && !sampledSplit(box, axis, itemBegin, itemEnd, triBegin, triEnd, split)) return false;
     Box low = box, high = box;
     low.hi[axis] = split;
@@ -249,7 +235,7 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
         const Box* child;
         int moving;  // the rays that visit it: +1 moving up (or not at all along axis), -1 down, 0 all
     };
-    const bool lowFirst = order_ == ChildOrder::PerRay || orderPoint_[axis] <= split;
+    const bool lowFirst = lowChildFirst(order_, orderPoint_, axis, split);
     Visit visits[3] = {{lowFirst ? &low : &high, 0}, {lowFirst ? &high : &low, 0}, {nullptr, 0}};
     if (order_ == ChildOrder::PerRay) {
         visits[0] = {&low, anyHit_ ? 0 : 1};
@@ -263,7 +249,7 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     const bool secondFromFirst = visits[2].child == nullptr && triangleOrderFree_;
     for (const Visit& visit : visits) {
         if (!visit.child) break;
-        const Box cell = widen(*visit.child, margin_);
+        const Box cell = widenedBox(*visit.child, margin_);
         const std::uint32_t childItems = filterItems(cell, itemBegin, itemEnd, axis, visit.moving);
         if (childItems == itemBegin) continue;
         const bool lowChild = visit.child == &low;
@@ -375,7 +361,7 @@ void DacrtTraversal::flushPackets(const Box& box, std::uint32_t packetBegin, std
     std::uint32_t* const regionRays = rayIds_;
     rayIds_ = packet_.flushRays;
     std::uint32_t terminated = 0;
-    const std::uint32_t crossing = filterRays(widen(box, margin_), 0, count);
+    const std::uint32_t crossing = filterRays(widenedBox(box, margin_), 0, count);
     node(box, terminated, crossing, triBegin, triEnd, depth, stalls);
     for (std::uint32_t k = 0; k < terminated; ++k) packet_.rayDone[rayIds_[k]] = 1;
     rayIds_ = regionRays;
@@ -417,7 +403,7 @@ template <typename PrepareRay, typename TestTriangle>
 void DacrtTraversal::leafSimd(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd,
                               std::uint32_t triBegin, std::uint32_t triEnd) {
     const bool groups = sharedRayFields_ == simd::SharedRayFields::Start;
-    const Box cell = widen(box, margin_);
+    const Box cell = widenedBox(box, margin_);
     for (std::uint32_t j = triBegin; j < triEnd; j += simd::kLeafBatch) {
         simd::gatherLeafTriangles(triangles_, triIds_ + j, std::min(triEnd - j, simd::kLeafBatch), batch_);
         if (groups)

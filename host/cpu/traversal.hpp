@@ -78,6 +78,40 @@ struct TraversalBuffers {
     bool raysShareSegment = false;
 };
 
+// A box widened by the filter margin on every side: the cell its filters test.
+inline Box widenedBox(const Box& b, float margin) {
+    Box w;
+    w.lo = b.lo - glm::vec3(margin);
+    w.hi = b.hi + glm::vec3(margin);
+    return w;
+}
+
+// The axis a node splits along, where the sampled cost does not choose: its box's longest.
+inline int longestAxis(const Box& b) {
+    const glm::vec3 e = b.extent();
+    return e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+}
+
+// The spatial median split of a box along axis.
+inline float spatialMedian(const Box& b, int axis) { return 0.5f * (b.lo[axis] + b.hi[axis]); }
+
+// Whether a split's low child is visited first: always where each ray's own order is kept
+// (ChildOrder::PerRay: the rays moving up, or every ray for any hit), else where the rays come
+// from that side (nearSide: FrameGeometry::nearSide).
+inline bool lowChildFirst(ChildOrder order, const glm::vec3& nearSide, int axis, float split) {
+    return order == ChildOrder::PerRay || nearSide[axis] <= split;
+}
+
+// Whether a node ends as a leaf before any sampled cost is asked, under resolved options:
+// too few items (fewItems: live rays under rayLimit, or packets under packetFlush), too few
+// triangles, too deep, stalled (splits in a row that kept every item and triangle), or a
+// split position on axis that is not inside its box.
+inline bool endsAsLeaf(const Box& box, int axis, float split, bool fewItems, std::uint32_t triangles,
+                       std::uint32_t depth, std::uint32_t stalls, const DacrtOptions& options) {
+    return fewItems || triangles < options.triLimit || depth >= options.maxDepth ||
+           stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis]);
+}
+
 class DacrtTraversal {
 public:
     DacrtTraversal(const FrameGeometry& geometry, const DacrtOptions& options, const TraversalBuffers& buffers,
@@ -90,6 +124,16 @@ public:
     // Rays that `retire` selects are finished too (moved before `terminated`).
     std::uint32_t trace(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
                         std::uint32_t triEnd, const RetireRule& retire = {});
+
+    // The recursion below a node whose live rays rayIds[terminated, rayEnd) already cross its
+    // widened box and whose triangles triIds[triBegin, triEnd) already overlap it: a subtree of
+    // a DACRT whose upper levels were divided elsewhere (subtrees.hpp), at their depth and
+    // stall count. Rays and triangles move as trace() moves them.
+    void traceBelow(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                    std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
+        node(box, terminated, rayEnd, triBegin, triEnd, depth, stalls);
+    }
+
 
 private:
     template <typename FilterItems, typename Descend>

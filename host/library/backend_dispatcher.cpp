@@ -14,6 +14,7 @@
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/image_bands.hpp"
 #include "cpu/pass_cull.hpp"
+#include "cpu/subtrees.hpp"
 #include "cpu/triangle_skips.hpp"
 #include "gpu/device_defaults.hpp"
 #include "library/triangle_batches.hpp"
@@ -510,9 +511,15 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
     std::vector<std::size_t> live;  // the groups with rays
     for (std::size_t k = 0; k + 1 < groups.size(); ++k)
         if (groups[k] < groups[k + 1]) live.push_back(k);
-    if (sideBySideWorkers(request, pool(threadsOf(request.trace)).size()) > 1 && live.size() > 1 &&
-        !(passCull_.skips.applied && passCull_.skips.traced.empty()))
+    if (sideBySideWorkers(request, threadPool.size()) > 1 && live.size() > 1 &&
+        !(passCull_.skips.applied && passCull_.skips.traced.empty())) {
+        // Every ray at once where the cpu backend traces them as subtrees (traceCpu), which
+        // filter each triangle once for every worker; else a group a worker.
+        const FrameGeometry whole = passGeometry(primary, rays, &threadPool);
+        if (tracesAsSubtrees(withSkips(whole, passCull_.skips), request.trace.dacrt, threadPool.size()))
+            return traceAfterSkips(whole, passCull_.skips, cullPlan, cullMs, request, onPlan, {});
         return traceGroupsSideBySide(primary, rays, groups, live, request, onPlan, cullPlan, cullMs);
+    }
     TraceResult whole;
     for (std::size_t k = 0; k + 1 < groups.size(); ++k) {
         if (groups[k] == groups[k + 1]) continue;
