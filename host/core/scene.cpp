@@ -63,12 +63,22 @@ std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles) {
 }
 
 void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool& pool, std::vector<Bounds>& bounds,
-                              Box& box) {
-    reserveMapped(bounds, triangles.size());
-    bounds.resize(triangles.size());
-    std::vector<Box> chunkBox((triangles.size() + kFrameScanChunk - 1) / kFrameScanChunk);
-    forEachChunk(triangles.size(), kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
+                              Box& box, std::vector<float>* columns) {
+    const std::size_t n = triangles.size();
+    reserveMapped(bounds, n);
+    bounds.resize(n);
+    if (columns) resizeMapped(*columns, 6 * n);
+    std::vector<Box> chunkBox((n + kFrameScanChunk - 1) / kFrameScanChunk);
+    forEachChunk(n, kFrameScanChunk, &pool, [&](std::size_t c, std::size_t begin, std::size_t end) {
         triangleBoundsLanes(triangles.data() + begin, end - begin, bounds.data() + begin, chunkBox[c]);
+        if (!columns) return;
+        // From the chunk's bounds while they are in the caches.
+        float* column = columns->data();
+        for (int axis = 0; axis < 3; ++axis)
+            for (std::size_t i = begin; i < end; ++i) {
+                column[std::size_t(axis) * n + i] = bounds[i].lo[axis];
+                column[std::size_t(3 + axis) * n + i] = bounds[i].hi[axis];
+            }
     });
     box = Box{};
     for (const Box& b : chunkBox) {

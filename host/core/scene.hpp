@@ -185,8 +185,11 @@ std::vector<Bounds> allTriangleBounds(const std::vector<Triangle>& triangles);
 // Both at once on every thread of pool, into bounds (resized; reusing its memory from frame to
 // frame) and box: the same values as allTriangleBounds and sceneBounds, bit for bit (chunks
 // are merged in order, so even the sign of a zero bound is the sequential one).
+// columns (where given): the same bounds' coordinates in six columns of triangles.size()
+// floats each, the low faces' x, y and z, then the high faces' (column (side * 3 + axis) holds
+// triangle i's at i), resized the same way: what the cpu triangle filters read (simd::TriangleFaces).
 void triangleBoundsInParallel(const std::vector<Triangle>& triangles, ThreadPool& pool, std::vector<Bounds>& bounds,
-                              Box& box);
+                              Box& box, std::vector<float>* columns = nullptr);
 
 // Checks that the scene can be traced: triangles exist and every coordinate is finite.
 // Throws InputError naming the first offending triangle and its provenance. On pool's threads

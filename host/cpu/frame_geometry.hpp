@@ -10,6 +10,7 @@
 #include "core/camera.hpp"
 #include "core/scene.hpp"
 #include "core/thread_pool.hpp"
+#include "cpu/triangle_faces.hpp"
 
 namespace dacrt {
 
@@ -34,6 +35,9 @@ enum class HitQuery { Closest, Any };
 struct FrameGeometry {
     const std::vector<Triangle>* triangles = nullptr;
     const std::vector<Bounds>* triangleBounds = nullptr;
+    // triangleBounds' coordinates in six columns (triangleBoundsInParallel's columns), which the
+    // triangle filters then read instead of the records (simd::TriangleFaces); null: none.
+    const std::vector<float>* boundsColumns = nullptr;
     const std::vector<Ray>* rays = nullptr;
     Box sceneBox;          // exact bounds of the triangles
     glm::vec3 rayOrigin{};  // the first ray's origin: every ray's when raysShareStart
@@ -64,6 +68,10 @@ struct FrameGeometry {
     // from frame to frame (library/peer_scenes.hpp). 0: a structure for this frame alone.
     std::uint64_t sceneId = 0;
 
+    // What the triangle filters read.
+    simd::TriangleFaces triangleFaces() const {
+        return {triangleBounds->data(), boundsColumns ? boundsColumns->data() : nullptr, triangleBounds->size()};
+    }
     std::size_t tracedTriangleCount() const { return tracedTriangles ? tracedTriangles->size() : triangles->size(); }
     std::uint32_t tracedTriangle(std::size_t i) const { return tracedTriangles ? (*tracedTriangles)[i] : std::uint32_t(i); }
 };

@@ -11,6 +11,7 @@ void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
     plan.add("hits", std::uint64_t(g.rays->size()) * sizeof(Hit));
     plan.add("triangles", std::uint64_t(g.triangles->size()) * sizeof(Triangle));
     plan.add("triangle bounds", std::uint64_t(g.triangles->size()) * sizeof(Bounds));
+    if (g.boundsColumns) plan.add("triangle bounds in columns", std::uint64_t(g.boundsColumns->size()) * sizeof(float));
 }
 
 bool startHits(const FrameGeometry& g, std::vector<Hit>& hits, ThreadPool* pool) {

@@ -290,29 +290,41 @@ std::uint32_t EndRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* i
     return ended;
 }
 
-template <bool kLowSide, bool kReaching>
-HWY_INLINE std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count,
-                                                  int axis, float bound, std::uint32_t* scratch) {
-    const float* b = reinterpret_cast<const float*>(bounds) + (kLowSide ? 0 : 4) + axis;
+// The coordinates b[id * kStride] of lanes' triangles: a face of the records (stride 8) or
+// of a column (stride 1).
+template <bool kLowSide, bool kReaching, std::size_t kStride>
+HWY_INLINE std::uint32_t partitionTrianglesOnFace(const float* b, std::uint32_t* ids, std::uint32_t count, float bound,
+                                                  std::uint32_t* scratch) {
     const DF df;
     const DU du;
     const VF face = hn::Set(df, bound);
     return stablePartition(ids, count, scratch, [&](VU, const std::uint32_t* idLanes) {
-        const VF coordinate = loadPerLane<8>(b, idLanes, 0);
+        const VF coordinate = loadPerLane<kStride>(b, idLanes, 0);
         const MF reaches = kLowSide ? coordinate <= face : coordinate >= face;
         // Bounds are never NaN (the loader refuses such vertices): beyond is the comparison negated.
         return hn::RebindMask(du, kReaching ? reaches : hn::Not(reaches));
     });
 }
 
-std::uint32_t PartitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
-                                       bool lowSide, float bound, std::uint32_t* scratch, FaceSide keep) {
+template <std::size_t kStride>
+HWY_INLINE std::uint32_t partitionOnFace(const float* b, std::uint32_t* ids, std::uint32_t count, bool lowSide, float bound,
+                                         std::uint32_t* scratch, FaceSide keep) {
     const bool reaching = keep == FaceSide::Reaching;
     if (lowSide)
-        return reaching ? partitionTrianglesOnFace<true, true>(bounds, ids, count, axis, bound, scratch)
-                        : partitionTrianglesOnFace<true, false>(bounds, ids, count, axis, bound, scratch);
-    return reaching ? partitionTrianglesOnFace<false, true>(bounds, ids, count, axis, bound, scratch)
-                    : partitionTrianglesOnFace<false, false>(bounds, ids, count, axis, bound, scratch);
+        return reaching ? partitionTrianglesOnFace<true, true, kStride>(b, ids, count, bound, scratch)
+                        : partitionTrianglesOnFace<true, false, kStride>(b, ids, count, bound, scratch);
+    return reaching ? partitionTrianglesOnFace<false, true, kStride>(b, ids, count, bound, scratch)
+                    : partitionTrianglesOnFace<false, false, kStride>(b, ids, count, bound, scratch);
+}
+
+std::uint32_t PartitionTrianglesOnFace(const TriangleFaces& faces, std::uint32_t* ids, std::uint32_t count, int axis,
+                                       bool lowSide, float bound, std::uint32_t* scratch, FaceSide keep) {
+    // lo[axis] for a new high face (lowSide), hi[axis] for a new low one.
+    if (faces.columns)
+        return partitionOnFace<1>(faces.columns + std::size_t(lowSide ? axis : 3 + axis) * faces.count, ids, count,
+                                  lowSide, bound, scratch, keep);
+    return partitionOnFace<8>(reinterpret_cast<const float*>(faces.bounds) + (lowSide ? 0 : 4) + axis, ids, count, lowSide,
+                              bound, scratch, keep);
 }
 
 HWY_INLINE bool triangleHasNoArea(const LeafTriangles& batch, std::size_t j) {
@@ -1125,9 +1137,9 @@ std::uint32_t partitionRaysMayCrossCell(const Ray* rays, const Hit* hits, std::u
     return HWY_DYNAMIC_DISPATCH(PartitionRays)(rays, hits, ids, count, cell, shared, scratch);
 }
 
-std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
+std::uint32_t partitionTrianglesOnFace(const TriangleFaces& faces, std::uint32_t* ids, std::uint32_t count, int axis,
                                        bool lowSide, float bound, std::uint32_t* scratch, FaceSide keep) {
-    return HWY_DYNAMIC_DISPATCH(PartitionTrianglesOnFace)(bounds, ids, count, axis, lowSide, bound, scratch, keep);
+    return HWY_DYNAMIC_DISPATCH(PartitionTrianglesOnFace)(faces, ids, count, axis, lowSide, bound, scratch, keep);
 }
 
 void gatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds, std::uint32_t count,

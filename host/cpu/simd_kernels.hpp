@@ -14,6 +14,7 @@
 
 #include "core/scene.hpp"
 #include "cpu/ray_packet.hpp"
+#include "cpu/triangle_faces.hpp"
 
 namespace dacrt::simd {
 
@@ -55,9 +56,14 @@ std::uint32_t endRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* i
 // (lowSide) or hi[axis] >= bound for a new low face. One gather per id instead of six.
 // FaceSide::Beyond keeps the others first instead: the triangles wholly beyond the face.
 enum class FaceSide { Reaching, Beyond };
-std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
+std::uint32_t partitionTrianglesOnFace(const TriangleFaces& faces, std::uint32_t* ids, std::uint32_t count, int axis,
                                        bool lowSide, float bound, std::uint32_t* scratch,
                                        FaceSide keep = FaceSide::Reaching);
+inline std::uint32_t partitionTrianglesOnFace(const Bounds* bounds, std::uint32_t* ids, std::uint32_t count, int axis,
+                                              bool lowSide, float bound, std::uint32_t* scratch,
+                                              FaceSide keep = FaceSide::Reaching) {
+    return partitionTrianglesOnFace(TriangleFaces{bounds, nullptr, 0}, ids, count, axis, lowSide, bound, scratch, keep);
+}
 
 // Up to kLeafBatch triangles of a leaf in structure-of-arrays form: coordinate c of vertex k
 // of triangle j is vertex[k][c][j]. Lanes past `count` are padding and never hit.

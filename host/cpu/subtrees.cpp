@@ -93,7 +93,7 @@ struct UpperLevels {
     // The triangles reaching into a child's cell, as DacrtTraversal::filterTriangles keeps them.
     IdPartition trianglesReaching(const Box& cell, int axis, bool lowChild) const {
         return [this, cell, axis, lowChild](std::uint32_t* ids, std::uint32_t count, std::uint32_t* scratch) {
-            return simd::partitionTrianglesOnFace(g.triangleBounds->data(), ids, count, axis, lowChild,
+            return simd::partitionTrianglesOnFace(g.triangleFaces(), ids, count, axis, lowChild,
                                                   lowChild ? cell.hi[axis] : cell.lo[axis], scratch);
         };
     }

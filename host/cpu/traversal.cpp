@@ -89,6 +89,7 @@ DacrtTraversal::DacrtTraversal(const FrameGeometry& g, const DacrtOptions& optio
     : rays_(g.rays->data()),
       triangles_(g.triangles->data()),
       triangleBounds_(g.triangleBounds->data()),
+      triangleFaces_(g.triangleFaces()),
       order_(g.order),
       orderPoint_(g.nearSide),
       anyHit_(g.query == HitQuery::Any),
@@ -181,7 +182,7 @@ std::uint32_t DacrtTraversal::filterTrianglesAfterSibling(const Box& cell, std::
 std::uint32_t DacrtTraversal::partitionTrianglesByBounds(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
                                                          bool lowChild, simd::FaceSide keep) {
     if (simd_)
-        return begin + simd::partitionTrianglesOnFace(triangleBounds_, triIds_ + begin, end - begin, axis, lowChild,
+        return begin + simd::partitionTrianglesOnFace(triangleFaces_, triIds_ + begin, end - begin, axis, lowChild,
                                                       lowChild ? cell.hi[axis] : cell.lo[axis], scratch_, keep);
     const bool reaching = keep == simd::FaceSide::Reaching;
     std::uint32_t* first = std::partition(triIds_ + begin, triIds_ + end, [&](std::uint32_t id) {

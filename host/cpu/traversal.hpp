@@ -187,6 +187,7 @@ private:
     const Ray* rays_;
     const Triangle* triangles_;
     const Bounds* triangleBounds_;
+    simd::TriangleFaces triangleFaces_;  // what the SIMD triangle filter reads
     ChildOrder order_;
     glm::vec3 orderPoint_;  // FrameGeometry::nearSide
     bool anyHit_;           // HitQuery::Any: a ray ends at its first hit

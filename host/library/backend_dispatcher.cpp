@@ -394,6 +394,7 @@ namespace {
 // the rays side by side (none for a group traced on one worker of the pool, inside its loop).
 FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>& rays, ThreadPool* pool = nullptr) {
     FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays, primary.sceneBox, pool);
+    g.boundsColumns = primary.boundsColumns;
     g.trianglesVersion = primary.trianglesVersion;
     g.sceneId = primary.sceneId;
     return g;

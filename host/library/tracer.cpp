@@ -23,6 +23,8 @@ struct Tracer::Impl {
     // The triangles' bounds of the frame being traced (dacrt's backends), their memory reused
     // from trace to trace.
     std::vector<Bounds> bounds;
+    // The same in columns, for the cpu backends' triangle filters (FrameGeometry::boundsColumns).
+    std::vector<float> boundsColumns;
 
     explicit Impl(const TracerOptions& o)
         : options(o),
@@ -56,13 +58,16 @@ FrameGeometry frameOf(Tracer::Impl& t, const TraceScene::Impl& s, const RayBatch
     const auto start = Clock::now();
     Box box = s.box;
     ThreadPool& pool = tracePool(t);
-    if (isPeer(t.request.trace.backend)) t.bounds.clear();
-    else triangleBoundsInParallel(s.scene.triangles, pool, t.bounds, box);
+    const Backend backend = t.request.trace.backend;
+    const bool columns = backend == Backend::Cpu || backend == Backend::CpuSeq;
+    if (isPeer(backend)) t.bounds.clear();
+    else triangleBoundsInParallel(s.scene.triangles, pool, t.bounds, box, columns ? &t.boundsColumns : nullptr);
     boundsMs = isPeer(t.request.trace.backend) ? 0.0 : msSince(start);
     FrameGeometry g = query == HitQuery::Any ? secondaryFrame(s.scene.triangles, t.bounds, r.rays, box, &pool)
                                              : frameGeometry(s.scene.triangles, t.bounds, r.rays, box, r.imageWidth, &pool,
                                                              r.pinholeRays);
     if (query == HitQuery::Closest) g.frustum = r.frustum;
+    if (columns) g.boundsColumns = &t.boundsColumns;
     g.trianglesVersion = s.scene.trianglesVersion;
     g.sceneId = s.id;
     return g;

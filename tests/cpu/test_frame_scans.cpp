@@ -88,20 +88,33 @@ TEST_F(FrameScansOnEveryTarget, TriangleBoundsInLanesExtendTheGivenBox) {
 }
 
 // Three chunks and a part (the parallel bounds take 16,384 triangles a chunk), on one thread
-// and on two.
+// and on two; with the columns, every coordinate of every record in its column, bit for bit,
+// also where the columns' memory held a larger frame's.
 TEST(FrameScans, BoundsComputedSideBySideAreTheSequentialOnes) {
     const std::vector<Triangle> triangles = tyingTriangles(3 * 16384 + 1000, 77);
     const std::vector<Bounds> expected = allTriangleBounds(triangles);
     const Box expectedBox = sceneBounds(triangles);
     ThreadPool one(1), two(2);
-    for (ThreadPool* pool : {&one, &two}) {
-        std::vector<Bounds> bounds;
-        Box box;
-        triangleBoundsInParallel(triangles, *pool, bounds, box);
-        ASSERT_EQ(bounds.size(), expected.size());
-        EXPECT_EQ(std::memcmp(bounds.data(), expected.data(), bounds.size() * sizeof(Bounds)), 0);
-        EXPECT_TRUE(sameBox(box, expectedBox));
-    }
+    for (ThreadPool* pool : {&one, &two})
+        for (const bool withColumns : {false, true}) {
+            std::vector<Bounds> bounds;
+            std::vector<float> columns(7 * triangles.size(), 5.0f);
+            Box box;
+            triangleBoundsInParallel(triangles, *pool, bounds, box, withColumns ? &columns : nullptr);
+            ASSERT_EQ(bounds.size(), expected.size());
+            EXPECT_EQ(std::memcmp(bounds.data(), expected.data(), bounds.size() * sizeof(Bounds)), 0);
+            EXPECT_TRUE(sameBox(box, expectedBox));
+            if (!withColumns) continue;
+            const std::size_t n = triangles.size();
+            ASSERT_EQ(columns.size(), 6 * n);
+            std::size_t differing = 0;
+            for (std::size_t i = 0; i < n; ++i)
+                for (int a = 0; a < 3; ++a) {
+                    differing += std::memcmp(&columns[std::size_t(a) * n + i], &expected[i].lo[a], sizeof(float)) != 0;
+                    differing += std::memcmp(&columns[std::size_t(3 + a) * n + i], &expected[i].hi[a], sizeof(float)) != 0;
+                }
+            EXPECT_EQ(differing, 0u);
+        }
 }
 
 // Rays from one point, then the same rays with one origin moved in the last chunk or one tmin

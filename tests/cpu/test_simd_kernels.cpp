@@ -201,7 +201,8 @@ TEST_F(EveryTarget, LeafEndMovesTheRaysTheScalarLoopMoves) {
     });
 }
 
-// Children of a cell the triangles overlap: the one-face test answers boundsOverlap.
+// Children of a cell the triangles overlap: the one-face test answers boundsOverlap, from the
+// records and from the same bounds in columns alike.
 TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCellAndItsComplement) {
     forEachTarget([] {
         Random rng(14);
@@ -231,9 +232,22 @@ TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCellAndItsCom
                        (side == simd::FaceSide::Reaching);
             });
             std::vector<std::uint32_t> scratch(count + simd::kScratchSlack);
+            // The same bounds in columns (FrameGeometry::boundsColumns) answer the same.
+            std::vector<float> columns(6 * bounds.size());
+            for (std::size_t i = 0; i < bounds.size(); ++i)
+                for (int a = 0; a < 3; ++a) {
+                    columns[std::size_t(a) * bounds.size() + i] = bounds[i].lo[a];
+                    columns[std::size_t(3 + a) * bounds.size() + i] = bounds[i].hi[a];
+                }
+            std::vector<std::uint32_t> columnIds = ids;
             const std::uint32_t kept =
                 simd::partitionTrianglesOnFace(bounds.data(), ids.data(), count, axis, lowSide, face, scratch.data(), side);
             ASSERT_TRUE(tally.check(kept, expectedKept, ids, expected)) << "trial " << trial;
+            const simd::TriangleFaces faces{bounds.data(), columns.data(), bounds.size()};
+            const std::uint32_t keptFromColumns =
+                simd::partitionTrianglesOnFace(faces, columnIds.data(), count, axis, lowSide, face, scratch.data(), side);
+            ASSERT_EQ(keptFromColumns, kept) << "trial " << trial;
+            ASSERT_EQ(columnIds, ids) << "trial " << trial;
         }
         EXPECT_GT(tally.kept, 1000u);
         EXPECT_GT(tally.rejected, 1000u);

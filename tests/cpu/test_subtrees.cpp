@@ -53,11 +53,17 @@ bool hasWorkLine(const TraceResult& r, const std::string& name) {
 
 // Short and unbounded occlusion rays and shadow rays towards a light above the shapes and one
 // among them, on two and three workers (a subtree may go to any of them): brute force's
-// visibility, each hit its triangle's own, and the same hits on every run. (The cpu backend
+// visibility, each hit its triangle's own, and the same hits on every run and with the bounds
+// read from columns. (The cpu backend
 // traces frames this small as one sequential DACRT: kSequentialBelowRays.)
 TEST(Subtrees, GiveBruteForcesVisibilityAndTheirTrianglesHits) {
     const Frame frame = denseFrame();
     const TraceResult primary = frame.trace(Backend::Brute, 0, 2);
+    std::vector<Bounds> bounds;
+    std::vector<float> columns;
+    Box box;
+    ThreadPool columnPool(2);
+    triangleBoundsInParallel(frame.scene.triangles, columnPool, bounds, box, &columns);
     const std::vector<std::pair<std::string, SecondaryPass>> passes{
         {"occlusion 0.8", occlusionPass(2, 0.8f)},
         {"occlusion unbounded", occlusionPass(2, kNoHitT)},
@@ -82,6 +88,9 @@ TEST(Subtrees, GiveBruteForcesVisibilityAndTheirTrianglesHits) {
             EXPECT_TRUE(hasWorkLine(first, "subtrees side by side"));
             const TraceResult again = traceSubtrees(pass.geometry, {}, pool);
             EXPECT_TRUE(identicalHits(first.hits, again.hits)) << "the first subtree in the recursion's order gives the hit";
+            FrameGeometry withColumns = pass.geometry;
+            withColumns.boundsColumns = &columns;
+            EXPECT_TRUE(identicalHits(first.hits, traceSubtrees(withColumns, {}, pool).hits)) << "bounds read from columns";
         }
     }
 }

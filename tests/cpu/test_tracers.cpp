@@ -354,3 +354,32 @@ TEST(ImageBands, AreTheCpuBackendsWayForAPrimaryFrameUnlessRegionsAreAsked) {
     EXPECT_TRUE(std::none_of(divided.memory.work.begin(), divided.memory.work.end(),
                              [](const WorkLine& w) { return w.name == "image bands side by side"; }));
 }
+
+// The triangle filters read the bounds from columns where the frame has them
+// (FrameGeometry::boundsColumns): the same hits, bit for bit, on cpu-seq, the bands and the
+// parallel scheme (closest hits, against brute force), and for an occlusion pass's any hits,
+// the same hits as from the records on every path.
+TEST(Tracers, BoundsColumnsGiveTheRecordsHitsBitForBit) {
+    CameraOptions o;
+    o.eye = glm::dvec3(0.5, 1.5, 4.0);
+    Frame frame(shapesScene(), 64, 48, o);
+    ThreadPool pool(2);
+    std::vector<Bounds> bounds;
+    std::vector<float> columns;
+    Box box;
+    triangleBoundsInParallel(frame.scene.triangles, pool, bounds, box, &columns);
+    FrameGeometry withColumns = frame.geometry;
+    withColumns.boundsColumns = &columns;
+    const TraceResult reference = frame.trace(Backend::Brute, 0, 2);
+    for (const auto& [backend, regions] : {std::pair{Backend::CpuSeq, 0u}, {Backend::Cpu, 0u}, {Backend::Cpu, 3u}}) {
+        SCOPED_TRACE(toString(backend) + ", " + std::to_string(regions) + " regions");
+        EXPECT_TRUE(identicalHits(reference.hits, traceFrame(withColumns, backend, regions, 2).hits));
+    }
+    const PassFrame pass(frame, reference.hits, occlusionPass(4, 0.8f));
+    FrameGeometry passColumns = pass.geometry;
+    passColumns.boundsColumns = &columns;
+    for (const auto& [backend, regions] : {std::pair{Backend::CpuSeq, 0u}, {Backend::Cpu, 0u}, {Backend::Cpu, 3u}}) {
+        SCOPED_TRACE("occlusion, " + toString(backend) + ", " + std::to_string(regions) + " regions");
+        EXPECT_TRUE(identicalHits(pass.trace(backend, regions, 2).hits, traceFrame(passColumns, backend, regions, 2).hits));
+    }
+}
