@@ -291,6 +291,23 @@ TraceResult traceParallel(const FrameGeometry& g, const TraceOptions& options, T
     return frame.finish();
 }
 
+namespace {
+
+// Whether the cpu backend traces a frame as one sequential DACRT, too small to pay for more.
+bool sequentialForItsSize(std::uint64_t rays, std::uint64_t tracedTriangles, const TraceOptions& options) {
+    const bool small = rays < kSequentialBelowRays && rays * tracedTriangles < kSequentialBelowPairs;
+    return options.regions == 0 && options.skips.subScenes && small;
+}
+
+}  // namespace
+
+bool cpuTracesAsSubtrees(std::uint64_t rays, std::uint64_t tracedTriangles, HitQuery query, const TraceOptions& options,
+                         unsigned workers) {
+    return options.backend == Backend::Cpu && options.regions == 0 && options.skips.subScenes &&
+           !sequentialForItsSize(rays, tracedTriangles, options) &&
+           tracesAsSubtrees(rays, tracedTriangles, query, options.dacrt, workers);
+}
+
 TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, ThreadPool& pool, const PlanHook& onPlan,
                      const ProgressHook& onProgress) {
     checkTraceOptions(options);
@@ -298,9 +315,8 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
         case Backend::Brute: return traceBrute(g, pool, onPlan, onProgress);
         case Backend::CpuSeq: return traceSequential(g, options.dacrt, onPlan);
         case Backend::Cpu: {
-            const std::uint64_t pairs = std::uint64_t(g.rays->size()) * g.tracedTriangleCount();
-            const bool small = g.rays->size() < kSequentialBelowRays && pairs < kSequentialBelowPairs;
-            if (options.regions == 0 && options.skips.subScenes && small) {
+            if (sequentialForItsSize(g.rays->size(), g.tracedTriangleCount(), options)) {
+                const std::uint64_t pairs = std::uint64_t(g.rays->size()) * g.tracedTriangleCount();
                 const std::vector<WorkLine> line{{"sub-scenes", 0,
                                                   "none: " + std::to_string(g.rays->size()) + " rays and " +
                                                       std::to_string(pairs) +
@@ -314,7 +330,9 @@ TraceResult traceCpu(const FrameGeometry& g, const TraceOptions& options, Thread
             // Subtrees and bands skip the sub-scenes too: --no-skip subscenes asks for the
             // parallel scheme.
             if (options.regions == 0 && options.skips.subScenes) {
-                if (tracesAsSubtrees(g, options.dacrt, pool.size())) return traceSubtrees(g, options.dacrt, pool, onPlan);
+                if (cpuTracesAsSubtrees(g.rays->size(), g.tracedTriangleCount(), g.query, options, pool.size()) &&
+                    tracesAsSubtrees(g, options.dacrt, pool.size()))
+                    return traceSubtrees(g, options.dacrt, pool, onPlan);
                 const std::vector<std::uint32_t> bands = imageBands(g, pool.size());
                 if (!bands.empty()) return traceImageBands(g, options.dacrt, pool, bands, onPlan);
             }

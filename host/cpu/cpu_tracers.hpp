@@ -17,6 +17,12 @@ using ProgressHook = std::function<void(double)>;
 TraceResult traceBrute(const FrameGeometry& geometry, ThreadPool& pool, const PlanHook& onPlan = {},
                        const ProgressHook& onProgress = {});
 
+// Whether traceCpu traces a frame of these counts as subtrees (subtrees.hpp): the cpu backend
+// without regions asked for, a frame large enough for more than one thread (kSequentialBelowRays),
+// and tracesAsSubtrees.
+bool cpuTracesAsSubtrees(std::uint64_t rays, std::uint64_t tracedTriangles, HitQuery query, const TraceOptions& options,
+                         unsigned workers);
+
 // One DACRT over the whole scene on the calling thread.
 TraceResult traceSequential(const FrameGeometry& geometry, const DacrtOptions& options, const PlanHook& onPlan = {});
 

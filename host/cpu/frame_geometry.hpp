@@ -3,11 +3,13 @@
 #include <cstdint>
 #include <cstring>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "core/camera.hpp"
+#include "core/errors.hpp"
 #include "core/scene.hpp"
 #include "core/thread_pool.hpp"
 #include "cpu/triangle_faces.hpp"
@@ -68,8 +70,12 @@ struct FrameGeometry {
     // from frame to frame (library/peer_scenes.hpp). 0: a structure for this frame alone.
     std::uint64_t sceneId = 0;
 
-    // What the triangle filters read.
+    // What the triangle filters read: the columns only where they are triangleBounds' (six
+    // columns of its length; a frame of a subset of the triangles keeps none).
     simd::TriangleFaces triangleFaces() const {
+        if (boundsColumns && boundsColumns->size() != 6 * triangleBounds->size())
+            throw InternalError("a frame's bound columns hold " + std::to_string(boundsColumns->size()) +
+                                " coordinates for " + std::to_string(triangleBounds->size()) + " triangles");
         return {triangleBounds->data(), boundsColumns ? boundsColumns->data() : nullptr, triangleBounds->size()};
     }
     std::size_t tracedTriangleCount() const { return tracedTriangles ? tracedTriangles->size() : triangles->size(); }

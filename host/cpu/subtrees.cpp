@@ -16,6 +16,8 @@
 namespace dacrt {
 namespace {
 
+const char* const kSubtreesLine = "subtrees side by side";
+
 // Ids per chunk of a split's filters on the pool.
 constexpr std::size_t kFilterChunk = 65536;
 
@@ -82,6 +84,7 @@ struct UpperLevels {
     const DacrtOptions& options;  // resolved
     const Hit* startHits;         // every ray's missHit (the ray filter does not read them)
     simd::SharedRayFields sharedRayFields;
+    mutable std::uint64_t rayBoxTests = 0;  // the ray filters' tests (Counters::rayBoxTests)
 
     // The rays of the (widened) cell among `ids`, as DacrtTraversal::filterRays keeps them.
     IdPartition raysCrossing(const Box& cell) const {
@@ -124,6 +127,7 @@ struct UpperLevels {
             filters.push_back({&node.triIds, trianglesReaching(cell, axis, lowChild), &children[c].triIds});
         }
         runFilters(filters, pool, scratch);
+        rayBoxTests += 2 * node.rayIds.size();
         for (Subtree& child : children) {
             const bool stalled = child.rayIds.size() == node.rayIds.size() && child.triIds.size() == node.triIds.size();
             child.depth = node.depth + 1;
@@ -143,9 +147,12 @@ struct UpperLevels {
                                 std::uint64_t& crossing) const {
         Subtree root;
         root.box = g.sceneBox;
-        std::vector<std::uint32_t> every(g.rays->size());
-        std::iota(every.begin(), every.end(), 0u);
-        runFilters({{&every, raysCrossing(widenedBox(g.sceneBox, g.margin)), &root.rayIds}}, pool, scratch);
+        {  // freed before the splits (planSubtrees counts it as one of the staged copies)
+            std::vector<std::uint32_t> every(g.rays->size());
+            std::iota(every.begin(), every.end(), 0u);
+            runFilters({{&every, raysCrossing(widenedBox(g.sceneBox, g.margin)), &root.rayIds}}, pool, scratch);
+            rayBoxTests += every.size();
+        }
         crossing = root.rayIds.size();
         fillTracedTriangleIds(g, root.triIds, &pool);
         std::vector<Subtree> subtrees;
@@ -175,18 +182,25 @@ void planSubtrees(const FrameGeometry& g, std::size_t count, unsigned workers, s
     plan.add("hits of the rays each subtree ends (at most)", count * rays * sizeof(Hit));
     plan.add("hits (per thread)", rays * sizeof(Hit) * workers);
     plan.add("partition scratch (per thread)", scratchIds * 4 * workers);
-    plan.work.push_back({"subtrees side by side", count,
+    plan.work.push_back({kSubtreesLine, count,
                          "the upper levels of one DACRT divided once, each subtree then a sequential DACRT on one of " +
                              std::to_string(workers) + " workers"});
 }
 
 }  // namespace
 
+bool tracesAsSubtrees(std::uint64_t rays, std::uint64_t triangles, HitQuery query, const DacrtOptions& options,
+                      unsigned workers) {
+    // usesSimd's rule from the counts (any-hit rays have no shared start, so no packets).
+    return workers > 1 && query == HitQuery::Any && triangles > rays && options.exactDefaults() &&
+           rays <= simd::kMaxRays && triangles <= simd::kMaxTriangles && options.split == SplitMethod::SpatialMedian &&
+           options.splitCost == SplitCost::Limits;
+}
+
 bool tracesAsSubtrees(const FrameGeometry& g, const DacrtOptions& options, unsigned workers) {
     const DacrtOptions resolved = options.resolvedFor(Backend::Cpu);
-    return workers > 1 && g.query == HitQuery::Any && g.tracedTriangleCount() > g.rays->size() &&
-           usesSimd(g, resolved) && !usesPackets(g, resolved) && resolved.split == SplitMethod::SpatialMedian &&
-           resolved.splitCost == SplitCost::Limits;
+    return tracesAsSubtrees(g.rays->size(), g.tracedTriangleCount(), g.query, options, workers) &&
+           usesSimd(g, resolved) && !usesPackets(g, resolved);
 }
 
 TraceResult traceSubtrees(const FrameGeometry& g, const DacrtOptions& options, ThreadPool& pool, const PlanHook& onPlan) {
@@ -208,6 +222,9 @@ TraceResult traceSubtrees(const FrameGeometry& g, const DacrtOptions& options, T
     std::uint64_t crossing = 0;
     std::vector<Subtree> subtrees = upper.divide(count, pool, scratch, crossing);
     result.phases.divide = msSince(start);
+    // The plan named the most there may be; the result names how many the division made.
+    for (WorkLine& line : result.memory.work)
+        if (line.name == kSubtreesLine) line.count = subtrees.size();
 
     // Costliest first, so that the dynamic hand-out ends evenly.
     std::vector<std::size_t> order(subtrees.size());
@@ -253,6 +270,7 @@ TraceResult traceSubtrees(const FrameGeometry& g, const DacrtOptions& options, T
     }
     result.phases.step1 = msSince(traceStart);
     for (const Counters& c : counters) result.counters.add(c);
+    result.counters.rayBoxTests += upper.rayBoxTests;
     result.counters.finishedStep1 = ended;
     result.counters.raysCulled = g.rays->size() - crossing;
     result.threads = workers;

@@ -5,8 +5,9 @@
 // A pass cut into ray groups, one a worker, divides every triangle again in each group: the
 // Dragon's occlusion rays cover the whole model from either half of the image, so each of two
 // groups filtered nearly all 871k triangles at every level (docs/benchmarks.md, "Subtrees
-// side by side"). Here the top of the recursion is split as sequential DACRT splits it (the
-// longest axis at the spatial median, the same leaf rules), each split's rays and triangles
+// side by side"). Here the top of the recursion is split by sequential DACRT's rules (the
+// longest axis at the spatial median, its leaf and stall rules, which count here every ray a
+// node is given, those a sibling would have ended included), each split's rays and triangles
 // filtered in chunks on the pool, until there are subtrees enough to share out; each subtree is
 // then a sequential DACRT on one worker, from its depth down.
 //
@@ -15,6 +16,8 @@
 // sequential DACRT visits first gives the ray its hit. The visibility bit is exact either way
 // (every subtree a ray crosses tests it against every triangle there where a hit could lie), and
 // the reported hit is one of the ray's own in its segment, the same on every run.
+#include <cstdint>
+
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/memory_plan.hpp"
@@ -28,9 +31,14 @@ namespace dacrt {
 // (measured: docs/benchmarks.md, "Subtrees side by side").
 constexpr unsigned kSubtreesPerWorker = 4;
 
-// Whether traceSubtrees takes this frame: any-hit rays, on the SIMD kernels of the default
+// Whether traceSubtrees takes a frame of `rays` rays over `triangles` traced triangles: any-hit
+// rays, fewer than the triangles (where rays outnumber them, the groups' own filtering of every
+// triangle costs less than the rays traced again in a second subtree: the room's occlusion pass
+// took 1.3-1.5x as long as subtrees, docs/benchmarks.md), on the SIMD kernels of the default
 // options, whose split reads no triangle order (the spatial median under the leaf limits), on
 // more than one worker.
+bool tracesAsSubtrees(std::uint64_t rays, std::uint64_t triangles, HitQuery query, const DacrtOptions& options,
+                      unsigned workers);
 bool tracesAsSubtrees(const FrameGeometry& geometry, const DacrtOptions& options, unsigned workers);
 
 // The frame's rays traced as described above, on every worker of the pool. Only where

@@ -14,7 +14,6 @@
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/image_bands.hpp"
 #include "cpu/pass_cull.hpp"
-#include "cpu/subtrees.hpp"
 #include "cpu/triangle_skips.hpp"
 #include "gpu/device_defaults.hpp"
 #include "library/triangle_batches.hpp"
@@ -516,9 +515,10 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
         !(passCull_.skips.applied && passCull_.skips.traced.empty())) {
         // Every ray at once where the cpu backend traces them as subtrees (traceCpu), which
         // filter each triangle once for every worker; else a group a worker.
-        const FrameGeometry whole = passGeometry(primary, rays, &threadPool);
-        if (tracesAsSubtrees(withSkips(whole, passCull_.skips), request.trace.dacrt, threadPool.size()))
-            return traceAfterSkips(whole, passCull_.skips, cullPlan, cullMs, request, onPlan, {});
+        const std::uint64_t traced = passCull_.skips.applied ? passCull_.skips.traced.size() : primary.triangles->size();
+        if (cpuTracesAsSubtrees(rays.size(), traced, HitQuery::Any, request.trace, threadPool.size()))
+            return traceAfterSkips(passGeometry(primary, rays, &threadPool), passCull_.skips, cullPlan, cullMs, request,
+                                   onPlan, {});
         return traceGroupsSideBySide(primary, rays, groups, live, request, onPlan, cullPlan, cullMs);
     }
     TraceResult whole;

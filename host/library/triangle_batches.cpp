@@ -84,6 +84,7 @@ TriangleBatch::TriangleBatch(const FrameGeometry& frame, std::vector<std::uint32
     geometry = frame;
     geometry.triangles = &triangles;
     geometry.triangleBounds = &bounds;
+    geometry.boundsColumns = nullptr;  // the frame's columns hold every triangle, not the batch's
     geometry.tracedTriangles = nullptr;
     geometry.sceneBox = box;
     geometry.margin = filterMargin(box, frame.farthestOrigin);

@@ -29,10 +29,11 @@ Frame denseFrame() {
     return Frame(denseShapes(), 32, 24, o);
 }
 
-bool hasWorkLine(const TraceResult& r, const std::string& name) {
+// The subtrees a trace's division made (its work line; 0 without one).
+std::uint64_t subtreesMade(const TraceResult& r) {
     for (const WorkLine& line : r.memory.work)
-        if (line.name == name) return true;
-    return false;
+        if (line.name == "subtrees side by side") return line.count;
+    return 0;
 }
 
 // Every hit of `hits` is the one its triangle gives its ray, bit for bit.
@@ -85,7 +86,7 @@ TEST(Subtrees, GiveBruteForcesVisibilityAndTheirTrianglesHits) {
             EXPECT_TRUE(identicalVisibility(reference.hits, first.hits));
             EXPECT_TRUE(hitsAreTheirTrianglesOwn(pass, first.hits));
             EXPECT_EQ(first.counters.finishedStep1, hits);
-            EXPECT_TRUE(hasWorkLine(first, "subtrees side by side"));
+            EXPECT_GT(subtreesMade(first), 1u) << "the division split the root";
             const TraceResult again = traceSubtrees(pass.geometry, {}, pool);
             EXPECT_TRUE(identicalHits(first.hits, again.hits)) << "the first subtree in the recursion's order gives the hit";
             FrameGeometry withColumns = pass.geometry;
@@ -117,6 +118,41 @@ TEST(Subtrees, TakeOnlyAnyHitFramesWithMoreTrianglesThanRaysOnSeveralWorkers) {
     ThreadPool pool(2);
     EXPECT_THROW(traceSubtrees(many.geometry, {}, pool), InternalError);
     EXPECT_THROW(traceSubtrees(pass.geometry, mora, pool), InternalError);
+}
+
+// A frame large enough for the cpu backend's threads (kSequentialBelowRays) with more triangles
+// (an 82k-triangle sphere among the shapes) than its occlusion rays: traceCpu traces them as
+// subtrees, on two workers, with the same hits as traceSubtrees and brute force's visibility
+// (every 37th ray tested against every triangle; cpu-seq's for all of them).
+TEST(Subtrees, TheCpuBackendTracesLargePassesOfFewerRaysAsSubtrees) {
+    std::vector<Mesh> meshes = shapesMeshes();
+    meshes.push_back(icosphere({0.6f, 0.3f, 0.9f}, 0.35f, 6));
+    CameraOptions o;
+    o.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(sceneFromMeshes(meshes, "dense shapes"), 128, 96, o);
+    const TraceResult primary = frame.trace(Backend::CpuSeq);
+    const PassFrame pass(frame, primary.hits, occlusionPass(4, 0.8f));
+    const std::size_t rays = pass.rays.rays.size();
+    ASSERT_GE(rays, kSequentialBelowRays);
+    ASSERT_LT(rays, pass.geometry.triangles->size());
+    const TraceResult cpu = pass.trace(Backend::Cpu, 0, 2);
+    EXPECT_GT(subtreesMade(cpu), 1u);
+    ThreadPool pool(2);
+    EXPECT_TRUE(identicalHits(traceSubtrees(pass.geometry, {}, pool).hits, cpu.hits));
+    EXPECT_TRUE(identicalVisibility(pass.trace(Backend::CpuSeq).hits, cpu.hits));
+    EXPECT_TRUE(hitsAreTheirTrianglesOwn(pass, cpu.hits));
+    std::size_t sampled = 0, differing = 0, hits = 0;
+    for (std::size_t i = 0; i < rays; i += 37, ++sampled) {
+        const Ray& ray = pass.rays.rays[i];
+        Hit best = missHit(ray);
+        for (std::uint32_t t = 0; t < pass.geometry.triangles->size() && best.prim == kMissPrim; ++t)
+            testTriangle(ray, (*pass.geometry.triangles)[t], t, best);
+        differing += (best.prim == kMissPrim) != (cpu.hits[i].prim == kMissPrim);
+        hits += best.prim != kMissPrim;
+    }
+    EXPECT_EQ(differing, 0u) << "of " << sampled << " rays tested against every triangle";
+    EXPECT_GT(hits, sampled / 20);
+    EXPECT_LT(hits, sampled);
 }
 
 }  // namespace dacrt::test

@@ -358,11 +358,11 @@ TEST(ImageBands, AreTheCpuBackendsWayForAPrimaryFrameUnlessRegionsAreAsked) {
 // The triangle filters read the bounds from columns where the frame has them
 // (FrameGeometry::boundsColumns): the same hits, bit for bit, on cpu-seq, the bands and the
 // parallel scheme (closest hits, against brute force), and for an occlusion pass's any hits,
-// the same hits as from the records on every path.
+// the same hits as from the records on every path (test_subtrees.cpp covers the subtrees').
 TEST(Tracers, BoundsColumnsGiveTheRecordsHitsBitForBit) {
     CameraOptions o;
     o.eye = glm::dvec3(0.5, 1.5, 4.0);
-    Frame frame(shapesScene(), 64, 48, o);
+    Frame frame(shapesScene(), 160, 120, o);  // rays enough for the bands (kSequentialBelowRays)
     ThreadPool pool(2);
     std::vector<Bounds> bounds;
     std::vector<float> columns;
@@ -373,7 +373,11 @@ TEST(Tracers, BoundsColumnsGiveTheRecordsHitsBitForBit) {
     const TraceResult reference = frame.trace(Backend::Brute, 0, 2);
     for (const auto& [backend, regions] : {std::pair{Backend::CpuSeq, 0u}, {Backend::Cpu, 0u}, {Backend::Cpu, 3u}}) {
         SCOPED_TRACE(toString(backend) + ", " + std::to_string(regions) + " regions");
-        EXPECT_TRUE(identicalHits(reference.hits, traceFrame(withColumns, backend, regions, 2).hits));
+        const TraceResult traced = traceFrame(withColumns, backend, regions, 2);
+        EXPECT_TRUE(identicalHits(reference.hits, traced.hits));
+        const bool bands = std::any_of(traced.memory.work.begin(), traced.memory.work.end(),
+                                       [](const WorkLine& w) { return w.name == "image bands side by side"; });
+        EXPECT_EQ(bands, backend == Backend::Cpu && regions == 0);
     }
     const PassFrame pass(frame, reference.hits, occlusionPass(4, 0.8f));
     FrameGeometry passColumns = pass.geometry;

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 
+#include "core/procedural.hpp"
 #include "cpu/backend_options.hpp"
+#include "cpu/cpu_tracers.hpp"
 #include "cpu/options.hpp"
 #include "core/errors.hpp"
 #include "core/mapped_memory.hpp"
@@ -40,12 +42,13 @@ void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
                 EXPECT_EQ(t.result.phases.groupRays.has_value(), sorts);
                 // cpu's groups side by side, unless regions are asked for: the batches (as many
                 // as the workers here) and the octants (these rays take more than one); but every
-                // ray at once where the pass has fewer rays than triangles traced (subtrees.hpp:
-                // here one sequential DACRT, the pass being small).
+                // ray at once where the cpu backend traces the pass as subtrees (subtrees.hpp),
+                // which it does not for passes this small.
                 const auto traced = std::find_if(t.result.memory.work.begin(), t.result.memory.work.end(),
                                                  [](const WorkLine& w) { return w.name == "triangles traced"; });
                 ASSERT_NE(traced, t.result.memory.work.end());
-                const bool whole = t.rays < traced->count;
+                const bool whole = cpuTracesAsSubtrees(t.rays, traced->count, HitQuery::Any, request.trace, 2);
+                EXPECT_FALSE(whole);
                 const bool sideBySide = backend == Backend::Cpu && regions == 0 && !whole &&
                                         (grouping == RayGrouping::Batches || grouping == RayGrouping::OctantCalls);
                 const auto line = std::find_if(t.result.memory.work.begin(), t.result.memory.work.end(),
@@ -171,6 +174,50 @@ TEST(PassTracing, TheRuleCountsThePassesRaysAgainstTheTriangles) {
     EXPECT_THROW(checkOptionCombinations(options), InputError);
     options.rayGrouping = RayGrouping::Batches;
     EXPECT_NO_THROW(checkOptionCombinations(options));
+}
+
+// A pass of more rays than one thread takes (kSequentialBelowRays) and fewer than its traced
+// triangles (an 82k-triangle sphere among the shapes), in batches as the cpu backend groups
+// them by default: the dispatcher traces every ray at once, as subtrees, where it would have
+// traced a batch a worker; cpu-seq's visibility slot by slot, alone and with the passes together.
+TEST(PassGrouping, PassesOfFewerRaysThanTrianglesAreTracedAsSubtrees) {
+    std::vector<Mesh> meshes = shapesMeshes();
+    meshes.push_back(icosphere({0.6f, 0.3f, 0.9f}, 0.35f, 6));
+    CameraOptions camera;
+    camera.eye = glm::dvec3(0.5, 1.5, 4.0);
+    const Frame frame(sceneFromMeshes(meshes, "dense shapes"), 128, 96, camera);
+    const TraceResult primaryHits = frame.trace(Backend::CpuSeq);
+    const FrameGeometry primary =
+        frameGeometry(frame.scene.triangles, frame.bounds, frame.rays, sceneBounds(frame.scene.triangles));
+    BackendDispatcher dispatcher({}, {Backend::Cpu});
+    const SecondaryPass occlusion = occlusionPass(4, 0.8f);
+    BackendRequest request;
+    request.trace.backend = Backend::CpuSeq;
+    const BackendDispatcher::PassTrace reference = dispatcher.traceSecondary(primary, primaryHits.hits, occlusion, request);
+    ASSERT_GE(reference.rays, kSequentialBelowRays);
+    ASSERT_LT(reference.rays, frame.scene.triangles.size());
+    request.trace.backend = Backend::Cpu;
+    request.trace.threads = 2;
+    ASSERT_EQ(request.trace.dacrt.rayGrouping, RayGrouping::Batches);
+    auto subtrees = [](const TraceResult& r) {
+        return std::any_of(r.memory.work.begin(), r.memory.work.end(),
+                           [](const WorkLine& w) { return w.name == "subtrees side by side" && w.count > 1; });
+    };
+    const BackendDispatcher::PassTrace alone = dispatcher.traceSecondary(primary, primaryHits.hits, occlusion, request);
+    EXPECT_TRUE(subtrees(alone.result));
+    EXPECT_TRUE(identicalVisibility(reference.result.hits, alone.result.hits));
+    request.trace.dacrt.passTracing = PassTracing::Together;
+    const SecondaryPass shadow = pointShadowPass({0.3f, 1.6f, 0.4f});
+    const std::vector<BackendDispatcher::PassTrace> together =
+        dispatcher.traceSecondaryTogether(primary, primaryHits.hits, {occlusion, shadow}, request);
+    ASSERT_EQ(together.size(), 2u);
+    EXPECT_TRUE(subtrees(together.back().result));
+    EXPECT_TRUE(identicalVisibility(reference.result.hits, together[0].result.hits));
+    request.trace.backend = Backend::CpuSeq;
+    request.trace.threads = 0;
+    request.trace.dacrt.passTracing = PassTracing::Auto;
+    EXPECT_TRUE(identicalVisibility(dispatcher.traceSecondary(primary, primaryHits.hits, shadow, request).result.hits,
+                                    together[1].result.hits));
 }
 
 }  // namespace
