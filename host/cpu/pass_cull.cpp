@@ -18,10 +18,12 @@ constexpr int kMostRowsLooked = 64;
 // docs/benchmarks.md, "Secondary passes").
 constexpr double kPiecesPerTriangle = 0.5;
 
-// The grid is marked for passes of fewer rays than this many triangles each: the Dragon's
-// occlusion pass (192,048 rays, 4.5 triangles each) lost more to marking than the 12% of
-// triangles it dropped saved; its shadow pass (42,331 rays, 21 each) gained.
-constexpr std::size_t kTrianglesPerRayForTheGrid = 8;
+// The grid is marked for passes of fewer rays than this many triangles each. Since the
+// Dragon's passes filter the triangles once as subtrees, from columns, a pass of its shadow
+// rays of 15-16k rays (56 triangles each) or its merged passes of 93k (9 each) lose more to
+// marking than the triangles it drops save; a shadow pass of 3.8-8.5k (100-230 each) still
+// gains (docs/benchmarks.md, "Subtrees side by side, bounds in columns").
+constexpr std::size_t kTrianglesPerRayForTheGrid = 64;
 
 // Whether marking the grid for a pass of `rays` rays pays for itself.
 bool gridPaysFor(std::uint64_t rays, std::size_t triangles) { return rays * kTrianglesPerRayForTheGrid < triangles; }
