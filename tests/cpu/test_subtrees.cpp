@@ -15,18 +15,12 @@
 namespace dacrt::test {
 namespace {
 
-// The shapes and a finely divided sphere among them, seen small: more triangles (20k of the
-// sphere's) than the passes have rays, as the Dragon's passes have.
-Scene denseShapes() {
-    std::vector<Mesh> meshes = shapesMeshes();
-    meshes.push_back(icosphere({0.6f, 0.3f, 0.9f}, 0.35f, 5));
-    return sceneFromMeshes(meshes, "dense shapes");
-}
-
+// The shapes and a sphere of 20k triangles among them, seen small: more triangles than the
+// passes have rays.
 Frame denseFrame() {
     CameraOptions o;
     o.eye = glm::dvec3(0.5, 1.5, 4.0);
-    return Frame(denseShapes(), 32, 24, o);
+    return Frame(shapesAndDenseSphere(5), 32, 24, o);
 }
 
 // The subtrees a trace's division made (its work line; 0 without one).
@@ -125,11 +119,9 @@ TEST(Subtrees, TakeOnlyAnyHitFramesWithMoreTrianglesThanRaysOnSeveralWorkers) {
 // subtrees, on two workers, with the same hits as traceSubtrees and brute force's visibility
 // (every 37th ray tested against every triangle; cpu-seq's for all of them).
 TEST(Subtrees, TheCpuBackendTracesLargePassesOfFewerRaysAsSubtrees) {
-    std::vector<Mesh> meshes = shapesMeshes();
-    meshes.push_back(icosphere({0.6f, 0.3f, 0.9f}, 0.35f, 6));
     CameraOptions o;
     o.eye = glm::dvec3(0.5, 1.5, 4.0);
-    const Frame frame(sceneFromMeshes(meshes, "dense shapes"), 128, 96, o);
+    const Frame frame(shapesAndDenseSphere(6), 128, 96, o);
     const TraceResult primary = frame.trace(Backend::CpuSeq);
     const PassFrame pass(frame, primary.hits, occlusionPass(4, 0.8f));
     const std::size_t rays = pass.rays.rays.size();

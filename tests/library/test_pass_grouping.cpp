@@ -5,7 +5,6 @@
 
 #include <algorithm>
 
-#include "core/procedural.hpp"
 #include "cpu/backend_options.hpp"
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/options.hpp"
@@ -181,11 +180,9 @@ TEST(PassTracing, TheRuleCountsThePassesRaysAgainstTheTriangles) {
 // them by default: the dispatcher traces every ray at once, as subtrees, where it would have
 // traced a batch a worker; cpu-seq's visibility slot by slot, alone and with the passes together.
 TEST(PassGrouping, PassesOfFewerRaysThanTrianglesAreTracedAsSubtrees) {
-    std::vector<Mesh> meshes = shapesMeshes();
-    meshes.push_back(icosphere({0.6f, 0.3f, 0.9f}, 0.35f, 6));
     CameraOptions camera;
     camera.eye = glm::dvec3(0.5, 1.5, 4.0);
-    const Frame frame(sceneFromMeshes(meshes, "dense shapes"), 128, 96, camera);
+    const Frame frame(shapesAndDenseSphere(6), 128, 96, camera);
     const TraceResult primaryHits = frame.trace(Backend::CpuSeq);
     const FrameGeometry primary =
         frameGeometry(frame.scene.triangles, frame.bounds, frame.rays, sceneBounds(frame.scene.triangles));

@@ -32,4 +32,12 @@ inline std::vector<Mesh> shapesMeshes() {
 }
 inline Scene shapesScene() { return sceneFromMeshes(shapesMeshes(), "shapes"); }
 
+// The shapes and a finely divided sphere among them (20 * 4^subdivisions triangles of it):
+// secondary passes of fewer rays than triangles, as the Dragon's.
+inline Scene shapesAndDenseSphere(int subdivisions) {
+    std::vector<Mesh> meshes = shapesMeshes();
+    meshes.push_back(icosphere({0.6f, 0.3f, 0.9f}, 0.35f, subdivisions));
+    return sceneFromMeshes(meshes, "shapes and a dense sphere");
+}
+
 }  // namespace dacrt::test
