@@ -106,7 +106,7 @@ TEST(Subtrees, TakeOnlyAnyHitFramesWithMoreTrianglesThanRaysOnSeveralWorkers) {
     sampled.split = SplitMethod::SampledMean;
     raySampling.splitCost = SplitCost::RaySampling;
     for (const DacrtOptions& options : {mora, sampled, raySampling}) EXPECT_FALSE(tracesAsSubtrees(pass.geometry, options, 2));
-    const PassFrame many(denseFrame(), primary.hits, occlusionPass(64, 0.8f));
+    const PassFrame many(frame, primary.hits, occlusionPass(64, 0.8f));
     ASSERT_GE(many.rays.rays.size(), many.geometry.triangles->size());
     EXPECT_FALSE(tracesAsSubtrees(many.geometry, {}, 2)) << "as many rays as triangles";
     ThreadPool pool(2);
