@@ -251,17 +251,9 @@ void primaryRays(const Camera& camera, int width, int height, ThreadPool& pool, 
     reserveMapped(rays, std::size_t(width) * std::size_t(height));
     rays.resize(std::size_t(width) * std::size_t(height));
     const PixelRays pixels(camera, width, height, offset);
-    std::exception_ptr failure;
-    std::mutex failureMutex;
-    pool.parallelFor(std::size_t(height), [&](std::size_t y, unsigned) {
-        try {
-            primaryRayRow(pixels, width, int(y), &rays[y * std::size_t(width)]);
-        } catch (...) {  // the pool's threads must not throw: the first error is rethrown here
-            const std::lock_guard<std::mutex> lock(failureMutex);
-            if (!failure) failure = std::current_exception();
-        }
+    pool.parallelForRethrowing(std::size_t(height), [&](std::size_t y, unsigned) {
+        primaryRayRow(pixels, width, int(y), &rays[y * std::size_t(width)]);
     });
-    if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace dacrt

@@ -1,5 +1,7 @@
 #include "core/thread_pool.hpp"
 
+#include <exception>
+
 namespace dacrt {
 
 ThreadPool::ThreadPool(unsigned threads) {
@@ -53,6 +55,20 @@ void ThreadPool::parallelFor(std::size_t count, const std::function<void(std::si
     std::unique_lock<std::mutex> lock(mutex_);
     done_.wait(lock, [&] { return busy_ == 0; });
     body_ = nullptr;
+}
+
+void ThreadPool::parallelForRethrowing(std::size_t count, const std::function<void(std::size_t, unsigned)>& body) {
+    std::exception_ptr failure;
+    std::mutex failureMutex;
+    parallelFor(count, [&](std::size_t i, unsigned worker) {
+        try {
+            body(i, worker);
+        } catch (...) {
+            const std::lock_guard<std::mutex> lock(failureMutex);
+            if (!failure) failure = std::current_exception();
+        }
+    });
+    if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace dacrt

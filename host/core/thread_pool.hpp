@@ -24,6 +24,9 @@ public:
     // Calls body(index, worker) for every index in [0, count), handing out indices one at a
     // time (dynamic balance); worker is in [0, size()). Returns when all calls are done.
     void parallelFor(std::size_t count, const std::function<void(std::size_t, unsigned)>& body);
+    // parallelFor for a body that may throw: each call's exception is caught on its thread (a
+    // pool's thread must not throw), and the first one is rethrown here once all calls are done.
+    void parallelForRethrowing(std::size_t count, const std::function<void(std::size_t, unsigned)>& body);
 
 private:
     void workerLoop(unsigned worker);

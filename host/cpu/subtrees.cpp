@@ -1,10 +1,8 @@
 #include "cpu/subtrees.hpp"
 
 #include <algorithm>
-#include <exception>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <numeric>
 #include <string>
 
@@ -165,7 +163,6 @@ struct UpperLevels {
                     costliest = i;
             if (costliest == subtrees.size()) break;
             if (!split(subtrees[costliest], pool, scratch, children)) continue;
-
             const auto at = subtrees.erase(subtrees.begin() + std::ptrdiff_t(costliest));
             subtrees.insert(at, std::make_move_iterator(children.begin()), std::make_move_iterator(children.end()));
         }
@@ -235,28 +232,20 @@ TraceResult traceSubtrees(const FrameGeometry& g, const DacrtOptions& options, T
     // only those are read (new Hit[]: no pass over the rest).
     std::vector<std::unique_ptr<Hit[]>> workerHits(workers);
     std::vector<Counters> counters(workers);
-    std::exception_ptr failure;
-    std::mutex failureMutex;
     const auto traceStart = Clock::now();
-    pool.parallelFor(order.size(), [&](std::size_t i, unsigned worker) {
-        try {
-            Subtree& s = subtrees[order[i]];
-            if (!workerHits[worker]) workerHits[worker].reset(new Hit[g.rays->size()]);
-            Hit* hits = workerHits[worker].get();
-            for (const std::uint32_t id : s.rayIds) hits[id] = result.hits[id];
-            DacrtTraversal traversal(g, options, {hits, s.rayIds.data(), s.triIds.data(), scratch[worker].data(), {}, raysShareSegment},
-                                     counters[worker]);
-            std::uint32_t ended = 0;
-            traversal.traceBelow(s.box, ended, std::uint32_t(s.rayIds.size()), 0, std::uint32_t(s.triIds.size()), s.depth,
-                                 s.stalls);
-            s.hits.resize(ended);
-            for (std::uint32_t k = 0; k < ended; ++k) s.hits[k] = hits[s.rayIds[k]];
-        } catch (...) {  // the pool's threads must not throw: the first error is rethrown here
-            const std::lock_guard<std::mutex> lock(failureMutex);
-            if (!failure) failure = std::current_exception();
-        }
+    pool.parallelForRethrowing(order.size(), [&](std::size_t i, unsigned worker) {
+        Subtree& s = subtrees[order[i]];
+        if (!workerHits[worker]) workerHits[worker].reset(new Hit[g.rays->size()]);
+        Hit* hits = workerHits[worker].get();
+        for (const std::uint32_t id : s.rayIds) hits[id] = result.hits[id];
+        DacrtTraversal traversal(g, options, {hits, s.rayIds.data(), s.triIds.data(), scratch[worker].data(), {}, raysShareSegment},
+                                 counters[worker]);
+        std::uint32_t ended = 0;
+        traversal.traceBelow(s.box, ended, std::uint32_t(s.rayIds.size()), 0, std::uint32_t(s.triIds.size()), s.depth,
+                             s.stalls);
+        s.hits.resize(ended);
+        for (std::uint32_t k = 0; k < ended; ++k) s.hits[k] = hits[s.rayIds[k]];
     });
-    if (failure) std::rethrow_exception(failure);
 
     // In the order the recursion visits the subtrees: a ray's first hit there is its hit.
     std::uint64_t ended = 0;

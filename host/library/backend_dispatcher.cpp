@@ -470,17 +470,9 @@ TraceResult BackendDispatcher::traceGroupsSideBySide(const FrameGeometry& primar
     if (onPlan && !onPlan(plan)) return {};
     const auto start = Clock::now();
     std::vector<TraceResult> parts(groups.size());
-    std::exception_ptr failure;
-    std::mutex failureMutex;
-    threadPool.parallelFor(live.size(), [&](std::size_t i, unsigned worker) {
-        try {
-            parts[live[i]] = traceSequential(groupOf(live[i], workerGroups_[worker]), request.trace.dacrt);
-        } catch (...) {  // the pool's threads must not throw: the first error is rethrown here
-            const std::lock_guard<std::mutex> lock(failureMutex);
-            if (!failure) failure = std::current_exception();
-        }
+    threadPool.parallelForRethrowing(live.size(), [&](std::size_t i, unsigned worker) {
+        parts[live[i]] = traceSequential(groupOf(live[i], workerGroups_[worker]), request.trace.dacrt);
     });
-    if (failure) std::rethrow_exception(failure);
     const double traceMs = msSince(start);
     TraceResult whole;
     for (std::size_t k : live) addGroup(whole, std::move(parts[k]), rays.size());
