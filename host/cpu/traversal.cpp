@@ -145,8 +145,13 @@ std::uint32_t DacrtTraversal::trace(const Box& box, std::uint32_t& terminated, s
 }
 
 std::uint32_t DacrtTraversal::filterRaysMoving(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
-                                               int moving) {
-    if (moving == 0) return filterRays(cell, begin, end);
+                                               int moving, std::uint32_t certainFrom) {
+    if (moving == 0) {
+        // [certainFrom, end) pass untested: moved behind the tested ones that pass.
+        const std::uint32_t passed = filterRays(cell, begin, certainFrom);
+        std::rotate(rayIds_ + passed, rayIds_ + certainFrom, rayIds_ + end);
+        return passed + (end - certainFrom);
+    }
     std::uint32_t* moved = std::partition(rayIds_ + begin, rayIds_ + end, [&](std::uint32_t id) {
         return (rays_[id].dir[axis] < 0.0f) == (moving < 0);
     });
@@ -248,10 +253,18 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     // first child left), so it filters the first child's triangles only, not the node's.
     std::uint32_t firstChildTris = triBegin;
     const bool secondFromFirst = visits[2].child == nullptr && triangleOrderFree_;
+    // Where the first child's items end: the node's items behind them, to itemEnd, crossed the
+    // node's widened cell but not the first child's, so (with two visits) they cross the second
+    // child's, since the two children's widened cells cover the node's. The second visit tests
+    // only the first child's items (docs/cpu-reference.md, "The second child's rays").
+    std::uint32_t firstChildItems = itemEnd;
     for (const Visit& visit : visits) {
         if (!visit.child) break;
         const Box cell = widenedBox(*visit.child, margin_);
-        const std::uint32_t childItems = filterItems(cell, itemBegin, itemEnd, axis, visit.moving);
+        const bool second = &visit == &visits[1] && visits[2].child == nullptr;
+        const std::uint32_t childItems =
+            filterItems(cell, itemBegin, itemEnd, axis, visit.moving, second ? firstChildItems : itemEnd);
+        if (&visit == &visits[0]) firstChildItems = childItems;
         if (childItems == itemBegin) continue;
         const bool lowChild = visit.child == &low;
         std::uint32_t childBegin = triBegin, childEnd = triEnd;
@@ -284,8 +297,9 @@ void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32
     if (terminated >= rayEnd || triBegin >= triEnd) return;
     const bool split = splitNode(
         box, terminated, rayEnd, triBegin, triEnd, depth, stalls, rayEnd - terminated < options_.rayLimit,
-        options_.splitCost == SplitCost::RaySampling, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving) {
-            return filterRaysMoving(cell, begin, end, axis, moving);
+        options_.splitCost == SplitCost::RaySampling, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving,
+                                                           std::uint32_t certainFrom) {
+            return filterRaysMoving(cell, begin, end, axis, moving, certainFrom);
         },
         [&](const Box& child, std::uint32_t childRays, std::uint32_t childTriBegin, std::uint32_t childTriEnd,
             std::uint32_t d, std::uint32_t s) { node(child, terminated, childRays, childTriBegin, childTriEnd, d, s); });
@@ -336,7 +350,9 @@ void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std:
     if (packetBegin >= packetEnd || triBegin >= triEnd) return;
     const bool split = splitNode(
         box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls, packetEnd - packetBegin < options_.packetFlush,
-        false, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int) { return filterPackets(cell, begin, end); },
+        false, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int, std::uint32_t) {
+            return filterPackets(cell, begin, end);
+        },
         [&](const Box& child, std::uint32_t childPackets, std::uint32_t childTriBegin, std::uint32_t childTriEnd,
             std::uint32_t d, std::uint32_t s) { nodePackets(child, packetBegin, childPackets, childTriBegin, childTriEnd, d, s); });
     if (!split) flushPackets(box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls);

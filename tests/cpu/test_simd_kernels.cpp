@@ -37,11 +37,12 @@ float adversarialCoordinate(Random& rng) {
     return rng.uniformFloat(-2.0f, 2.0f) * (rng.uniform() < 0.2 ? 1e6f : 1.0f);
 }
 
-Ray randomRay(Random& rng) {
+// parallelChance: of each component of the direction being 0 (the ray parallel to a slab).
+Ray randomRay(Random& rng, double parallelChance = 0.15) {
     glm::vec3 origin{adversarialCoordinate(rng), adversarialCoordinate(rng), adversarialCoordinate(rng)};
     glm::dvec3 dir = rng.onSphere();
     for (int a = 0; a < 3; ++a)
-        if (rng.uniform() < 0.15) dir[a] = 0.0;  // parallel to a slab
+        if (rng.uniform() < parallelChance) dir[a] = 0.0;
     if (dir == glm::dvec3(0.0)) dir.z = 1.0;
     return makeRay(origin, dir, rng.uniform() < 0.3 ? rng.uniformFloat(0.0f, 1.0f) : 0.0f);
 }
@@ -92,9 +93,11 @@ bool sameHit(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit
 }  // namespace
 
 // With their own starts, sharing one, sharing a segment with no hit yet (the broadcast
-// paths), and each with a segment of its own and no hit yet (the hits not read).
+// paths), and each with a segment of its own and no hit yet (the hits not read); with rays
+// parallel to slabs in most vectors, and in none (the kernels' short slabs).
 TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
     forEachTarget([] {
+      for (const double parallelChance : {0.15, 0.0})
       for (const simd::SharedRayFields shared :
            {simd::SharedRayFields::None, simd::SharedRayFields::Start, simd::SharedRayFields::Segment,
             simd::SharedRayFields::OwnSegment}) {
@@ -105,12 +108,13 @@ TEST_F(EveryTarget, RayPartitionKeepsTheScalarAnswerAndOrder) {
                      : shareSegment ? "rays share their segment"
                      : ownSegment   ? "rays each of its own segment"
                                     : "rays start apart");
+        SCOPED_TRACE(parallelChance > 0.0 ? "some rays parallel to slabs" : "no ray parallel to a slab");
         Random rng(11);
         PartitionTally tally;
         std::vector<Ray> rays(300);
         std::vector<Hit> hits(rays.size(), missHit());
         for (std::size_t i = 0; i < rays.size(); ++i) {
-            rays[i] = randomRay(rng);
+            rays[i] = randomRay(rng, parallelChance);
             if (shareStart && i > 0) {
                 rays[i].origin = rays[0].origin;
                 rays[i].tmin = rays[0].tmin;
