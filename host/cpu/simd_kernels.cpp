@@ -369,22 +369,29 @@ void GatherLeafTriangles(const Triangle* triangles, const std::uint32_t* triIds,
     const DU du;
     const std::size_t n = hn::Lanes(du);
     batch.count = count;
-    // Each triangle's fields copied into its lane with plain loads and stores, not ten gathers a
-    // vector of lanes (loadPerLane says why). Past count: the batch's first triangle again,
-    // whose extra lanes the tests never read as hits (FirstN).
+    // Each triangle's fields copied into its lane with a load per row and lane (loadQuadPerLane),
+    // not ten gathers a vector of lanes (loadPerLane says why). Past count: the batch's first
+    // triangle again, whose extra lanes the tests never read as hits (FirstN).
     const std::size_t lanes = (std::size_t(count) + n - 1) / n * n;
     // The batch's triangles are scattered over the scene's array (a large scene's exceeds the
     // caches): every one asked for before the first is copied, so that their misses overlap
     // instead of each copy waiting on its own (docs/benchmarks.md, "Prefetched leaves").
     for (std::size_t j = 0; j < count; ++j) prefetchTriangle(triangles[triIds[j]]);
-    for (std::size_t j = 0; j < lanes; ++j) {
-        const std::uint32_t id = triIds[j < count ? j : 0];
-        const Triangle& t = triangles[id];
-        batch.prim[j] = id;
-        const glm::vec3* v[3] = {&t.v0, &t.v1, &t.v2};
+    const DF df;
+    const float* base = reinterpret_cast<const float*>(triangles);
+    alignas(64) std::uint32_t ids[64];
+    for (std::size_t j = 0; j < lanes; j += n) {
+        for (std::size_t l = 0; l < n; ++l) ids[l] = triIds[j + l < count ? j + l : 0];
+        // A Triangle's three 16-byte rows (v0 and cullBackFace, v1, v2), each a quad per lane
+        // turned into one vector per float: the same bits, moved, not computed.
+        VF rows[3][4];
+        loadQuadPerLane<0, 12>(base, ids, rows[0]);
+        loadQuadPerLane<4, 12>(base, ids, rows[1]);
+        loadQuadPerLane<8, 12>(base, ids, rows[2]);
         for (int k = 0; k < 3; ++k)
-            for (int c = 0; c < 3; ++c) batch.vertex[k][c][j] = (*v[k])[c];
-        batch.cullBackFace[j] = t.cullBackFace;
+            for (int c = 0; c < 3; ++c) hn::Store(rows[k][c], df, &batch.vertex[k][c][j]);
+        hn::Store(hn::BitCast(du, rows[0][3]), du, &batch.cullBackFace[j]);
+        hn::Store(hn::LoadU(du, ids), du, &batch.prim[j]);
     }
 }
 

@@ -317,6 +317,43 @@ TEST_F(EveryTarget, RayBinningFindsTheWalksFirstRegion) {
     });
 }
 
+// The leaf's structure-of-arrays copy: each lane the bits of its triangle's fields (NaN
+// payloads, negative zeros and the face flag included), the lanes past the count the first
+// triangle's, for every count up to a full batch and ids in any order.
+TEST_F(EveryTarget, LeafGatherCopiesEveryFieldBitForBit) {
+    forEachTarget([] {
+        Random rng(17);
+        std::vector<Triangle> tris(300);
+        const float odd[] = {-0.0f, std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::infinity(),
+                             std::numeric_limits<float>::denorm_min()};
+        for (Triangle& t : tris) {
+            for (glm::vec3* v : {&t.v0, &t.v1, &t.v2})
+                for (int c = 0; c < 3; ++c) (*v)[c] = rng.uniform() < 0.05 ? odd[rng.index(4)] : rng.uniformFloat(-9.0f, 9.0f);
+            t.cullBackFace = std::uint32_t(rng.index(2));
+        }
+        for (std::uint32_t count = 1; count <= simd::kLeafBatch; ++count) {
+            const std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(tris.size()), count);
+            simd::LeafTriangles batch;
+            constexpr std::uint32_t kUnwritten = 0xDEADBEEFu;  // a lane past the target's last vector
+            std::fill(std::begin(batch.prim), std::end(batch.prim), kUnwritten);
+            simd::gatherLeafTriangles(tris.data(), ids.data(), count, batch);
+            ASSERT_EQ(batch.count, count);
+            for (std::size_t j = 0; j < simd::kLeafBatch; ++j) {
+                if (j >= count && batch.prim[j] == kUnwritten) break;
+                const std::uint32_t id = ids[j < count ? j : 0];
+                const Triangle& t = tris[id];
+                const glm::vec3* v[3] = {&t.v0, &t.v1, &t.v2};
+                ASSERT_EQ(batch.prim[j], id) << "count " << count << " lane " << j;
+                ASSERT_EQ(batch.cullBackFace[j], t.cullBackFace) << "count " << count << " lane " << j;
+                for (int k = 0; k < 3; ++k)
+                    for (int c = 0; c < 3; ++c)
+                        ASSERT_EQ(std::bit_cast<std::uint32_t>(batch.vertex[k][c][j]), std::bit_cast<std::uint32_t>((*v[k])[c]))
+                            << "count " << count << " lane " << j << " vertex " << k << " coordinate " << c;
+            }
+        }
+    });
+}
+
 // Rays aimed at vertices and edges shared by neighbouring triangles, duplicated triangles
 // (equal t: the tie rule decides), degenerate ones, far offsets and grazing directions.
 TEST_F(EveryTarget, LeafBatchGivesTheScalarHitsBitForBit) {
