@@ -256,7 +256,8 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     // Where the first child's items end: the node's items behind them, to itemEnd, crossed the
     // node's widened cell but not the first child's, so (with two visits) they cross the second
     // child's, since the two children's widened cells cover the node's. The second visit tests
-    // only the first child's items (docs/cpu-reference.md, "The second child's rays").
+    // only the first child's items (docs/correctness.md, "The second child's rays"). Packets
+    // ignore it: a packet's test may pass a cell none of its rays crosses.
     std::uint32_t firstChildItems = itemEnd;
     for (const Visit& visit : visits) {
         if (!visit.child) break;

@@ -148,6 +148,8 @@ private:
               std::uint32_t triEnd);
     std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);
     // filterRays over the rays moving `moving` along axis (+1: up or not at all, -1: down, 0: all).
+    // With moving 0, the rays of [certainFrom, end) are known to cross the cell: they pass
+    // untested, behind the tested ones that pass.
     std::uint32_t filterRaysMoving(const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving,
                                    std::uint32_t certainFrom);
     void tracePackets(const Box& box, std::uint32_t& terminated, std::uint32_t crossing, std::uint32_t triBegin,
