@@ -173,17 +173,26 @@ HWY_INLINE std::uint32_t stablePartition(std::uint32_t* ids, std::uint32_t count
     return std::uint32_t(kept);
 }
 
-// shared::slabInterval, lane by lane.
+// shared::slabInterval for lanes whose invDir is not 0 (no ray parallel to the slab): the
+// interval between the slab's two faces, without the parallel case's selects.
+HWY_INLINE void slabIntervalCrossing(VF origin, VF invDir, float lo, float hi, VF& tNear, VF& tFar) {
+    const DF df;
+    const VF t0 = hn::Mul(hn::Sub(hn::Set(df, lo), origin), invDir);
+    const VF t1 = hn::Mul(hn::Sub(hn::Set(df, hi), origin), invDir);
+    tNear = minLike(t0, t1);
+    tFar = maxLike(t0, t1);
+}
+
+// shared::slabInterval, lane by lane: the crossing interval, or for a lane parallel to the
+// slab every t (origin inside) or none.
 HWY_INLINE void slabInterval(VF origin, VF invDir, float lo, float hi, VF& tNear, VF& tFar) {
     const DF df;
-    const VF vlo = hn::Set(df, lo), vhi = hn::Set(df, hi);
-    const VF t0 = hn::Mul(hn::Sub(vlo, origin), invDir);
-    const VF t1 = hn::Mul(hn::Sub(vhi, origin), invDir);
+    slabIntervalCrossing(origin, invDir, lo, hi, tNear, tFar);
     const MF parallel = invDir == hn::Zero(df);
-    const MF inside = hn::And(origin >= vlo, origin <= vhi);
+    const MF inside = hn::And(origin >= hn::Set(df, lo), origin <= hn::Set(df, hi));
     const VF none = hn::Set(df, kNoHitT), all = hn::Set(df, -kNoHitT);
-    tNear = hn::IfThenElse(parallel, hn::IfThenElse(inside, all, none), minLike(t0, t1));
-    tFar = hn::IfThenElse(parallel, hn::IfThenElse(inside, none, all), maxLike(t0, t1));
+    tNear = hn::IfThenElse(parallel, hn::IfThenElse(inside, all, none), tNear);
+    tFar = hn::IfThenElse(parallel, hn::IfThenElse(inside, none, all), tFar);
 }
 
 // ids[first, first + lanes) into a vector's worth of idLanes, the lanes past `lanes` repeating
@@ -191,16 +200,6 @@ HWY_INLINE void slabInterval(VF origin, VF invDir, float lo, float hi, VF& tNear
 HWY_INLINE void laneIds(const std::uint32_t* ids, std::uint32_t first, std::uint32_t lanes, std::uint32_t* idLanes) {
     const std::size_t n = hn::Lanes(DF());
     for (std::size_t l = 0; l < n; ++l) idLanes[l] = ids[first + std::min(std::uint32_t(l), lanes - 1)];
-}
-
-// shared::slabInterval for lanes whose invDir is not 0 (no ray parallel to the slab): the
-// same two operations without the parallel case's selects.
-HWY_INLINE void slabIntervalCrossing(VF origin, VF invDir, float lo, float hi, VF& tNear, VF& tFar) {
-    const DF df;
-    const VF t0 = hn::Mul(hn::Sub(hn::Set(df, lo), origin), invDir);
-    const VF t1 = hn::Mul(hn::Sub(hn::Set(df, hi), origin), invDir);
-    tNear = minLike(t0, t1);
-    tFar = maxLike(t0, t1);
 }
 
 // shared::rayBoxIntervalRounded lane by lane. Rays with a zero component of invDir (parallel

@@ -252,7 +252,8 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     // from the first's range (those reaching past the split) and from behind it (those the
     // first child left), so it filters the first child's triangles only, not the node's.
     std::uint32_t firstChildTris = triBegin;
-    const bool secondFromFirst = visits[2].child == nullptr && triangleOrderFree_;
+    const bool twoVisits = visits[2].child == nullptr;
+    const bool secondFromFirst = twoVisits && triangleOrderFree_;
     // Where the first child's items end: the node's items behind them, to itemEnd, crossed the
     // node's widened cell but not the first child's, so (with two visits) they cross the second
     // child's, since the two children's widened cells cover the node's. The second visit tests
@@ -262,7 +263,7 @@ bool DacrtTraversal::splitNode(const Box& box, const std::uint32_t& itemBegin, s
     for (const Visit& visit : visits) {
         if (!visit.child) break;
         const Box cell = widenedBox(*visit.child, margin_);
-        const bool second = &visit == &visits[1] && visits[2].child == nullptr;
+        const bool second = twoVisits && &visit == &visits[1];
         const std::uint32_t childItems =
             filterItems(cell, itemBegin, itemEnd, axis, visit.moving, second ? firstChildItems : itemEnd);
         if (&visit == &visits[0]) firstChildItems = childItems;
