@@ -201,18 +201,27 @@ void traceRayIds(const FrameGeometry& g, const DacrtOptions& options, const Trav
 
 }  // namespace
 
+MemoryPlan sequentialPlan(const FrameGeometry& g, std::uint64_t rayCount, const DacrtOptions& options) {
+    MemoryPlan plan;
+    const std::uint64_t triCount = g.tracedTriangleCount();
+    planFrameInputs(g, rayCount, plan);
+    plan.add("ray ids", rayCount * 4);
+    plan.add("triangle ids", triCount * 4);
+    const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
+    const std::uint64_t scratchIds = usesSimd(rayCount, g.triangles->size(), resolved) ? partitionScratchIds(rayCount, triCount) : 0;
+    if (scratchIds) plan.add("partition scratch", scratchIds * 4);
+    if (packetTiles(g) > 0) planPacketBuffers(g, resolved, scratchIds, 1, plan);
+    return plan;
+}
+
 TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options, const PlanHook& onPlan) {
     TraceResult result;
     const std::uint32_t rayCount = std::uint32_t(g.rays->size());
     const std::uint32_t triCount = std::uint32_t(g.tracedTriangleCount());
-    planFrameInputs(g, result.memory);
-    result.memory.add("ray ids", std::uint64_t(rayCount) * 4);
-    result.memory.add("triangle ids", std::uint64_t(triCount) * 4);
+    result.memory = sequentialPlan(g, rayCount, options);
+    if (onPlan && !onPlan(result.memory)) return result;
     const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
     const std::uint64_t scratchIds = usesSimd(g, resolved) ? partitionScratchIds(rayCount, triCount) : 0;
-    if (scratchIds) result.memory.add("partition scratch", scratchIds * 4);
-    planPacketBuffers(g, resolved, scratchIds, 1, result.memory);
-    if (onPlan && !onPlan(result.memory)) return result;
 
     const bool raysShareSegment = startHits(g, result.hits, nullptr);
     std::vector<std::uint32_t> rayIds(rayCount), triIds;

@@ -23,6 +23,11 @@ TraceResult traceBrute(const FrameGeometry& geometry, ThreadPool& pool, const Pl
 bool cpuTracesAsSubtrees(std::uint64_t rays, std::uint64_t tracedTriangles, HitQuery query, const TraceOptions& options,
                          unsigned workers);
 
+// What traceSequential allocates for a frame of rayCount rays over g's traced triangles, from
+// the counts: g's rays are read only where they are an image's (packets), so that a pass can
+// plan a group of rays before making them (made_pass_groups.hpp).
+MemoryPlan sequentialPlan(const FrameGeometry& geometry, std::uint64_t rayCount, const DacrtOptions& options);
+
 // One DACRT over the whole scene on the calling thread.
 TraceResult traceSequential(const FrameGeometry& geometry, const DacrtOptions& options, const PlanHook& onPlan = {});
 

@@ -6,9 +6,11 @@
 
 namespace dacrt {
 
-void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) {
-    plan.add("rays", std::uint64_t(g.rays->size()) * sizeof(Ray));
-    plan.add("hits", std::uint64_t(g.rays->size()) * sizeof(Hit));
+void planFrameInputs(const FrameGeometry& g, MemoryPlan& plan) { planFrameInputs(g, g.rays->size(), plan); }
+
+void planFrameInputs(const FrameGeometry& g, std::uint64_t rayCount, MemoryPlan& plan) {
+    plan.add("rays", rayCount * sizeof(Ray));
+    plan.add("hits", rayCount * sizeof(Hit));
     plan.add("triangles", std::uint64_t(g.triangles->size()) * sizeof(Triangle));
     plan.add("triangle bounds", std::uint64_t(g.triangles->size()) * sizeof(Bounds));
     if (g.boundsColumns) plan.add("triangle bounds in columns", std::uint64_t(g.boundsColumns->size()) * sizeof(float));

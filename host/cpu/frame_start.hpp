@@ -10,8 +10,10 @@
 
 namespace dacrt {
 
-// The frame's rays, hits, triangles and triangle bounds, from the counts.
+// The frame's rays, hits, triangles and triangle bounds, from the counts (rayCount rays:
+// the frame's own where not given; its rays are then not read).
 void planFrameInputs(const FrameGeometry& geometry, MemoryPlan& plan);
+void planFrameInputs(const FrameGeometry& geometry, std::uint64_t rayCount, MemoryPlan& plan);
 
 // Every ray's best hit starts at its segment's end (missHit). Returns whether every ray has
 // the first one's segment, bit for bit (TraversalBuffers::raysShareSegment), found in the same

@@ -44,26 +44,43 @@ std::uint64_t secondarySlots(const SecondaryPass& pass, std::uint64_t primaryRay
     return slots;
 }
 
+PassRayCounts passRayCounts(const SecondaryPass& pass, const std::vector<Hit>& primaryHits, ThreadPool& pool) {
+    PassRayCounts counts;
+    counts.primaryRays = primaryHits.size();
+    counts.chunks = std::max<std::size_t>(1, std::min<std::size_t>(256, primaryHits.size() / 1024 + 1));
+    counts.atMost.assign(counts.chunks + 1, 0);
+    pool.parallelFor(counts.chunks, [&](std::size_t c, unsigned) {
+        std::size_t hits = 0;
+        for (std::size_t i = counts.chunkBegin(c), end = counts.chunkBegin(c + 1); i < end; ++i)
+            hits += hitSendsRays(primaryHits[i]);
+        counts.atMost[c + 1] = hits * pass.raysPerHit;
+    });
+    for (std::size_t c = 0; c < counts.chunks; ++c) counts.atMost[c + 1] += counts.atMost[c];
+    return counts;
+}
+
 SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray>& primary,
                                 const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
                                 ThreadPool& pool) {
+    return makeSecondaryRays(pass, primary, primaryHits, triangles, passRayCounts(pass, primaryHits, pool), pool);
+}
+
+SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray>& primary,
+                                const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
+                                const PassRayCounts& counts, ThreadPool& pool) {
     SecondaryRays out;
     out.slotCount = secondarySlots(pass, primary.size());
-    const std::uint32_t perHit = pass.raysPerHit;
     // Chunks of primary rays made in parallel, each into its own stretch of one allocation,
     // then moved down in slot order. A stretch holds raysPerHit rays for each of the chunk's
     // hits (a miss sends none), not one per slot: where few primary rays hit (the Dragon's 48k
     // of 307k), the slots' size would be mostly untouched memory, zeroed and faulted in for
     // every pass (fresh pages cost a fault each on a VM).
-    const std::size_t chunks = std::max<std::size_t>(1, std::min<std::size_t>(256, primary.size() / 1024 + 1));
-    auto chunkBegin = [&](std::size_t c) { return primary.size() * c / chunks; };
-    std::vector<std::size_t> stretch(chunks + 1, 0);
-    pool.parallelFor(chunks, [&](std::size_t c, unsigned) {
-        std::size_t hits = 0;
-        for (std::size_t i = chunkBegin(c), end = chunkBegin(c + 1); i < end; ++i) hits += hitSendsRays(primaryHits[i]);
-        stretch[c + 1] = hits * perHit;
-    });
-    for (std::size_t c = 0; c < chunks; ++c) stretch[c + 1] += stretch[c];
+    if (counts.primaryRays != primary.size() || primaryHits.size() != primary.size())
+        throw InternalError("a secondary pass counted " + std::to_string(counts.primaryRays) + " primary hits of " +
+                            std::to_string(primaryHits.size()) + " for " + std::to_string(primary.size()) + " primary rays");
+    const std::size_t chunks = counts.chunks;
+    auto chunkBegin = [&](std::size_t c) { return counts.chunkBegin(c); };
+    const std::vector<std::size_t>& stretch = counts.atMost;
     reserveMapped(out.rays, stretch[chunks]);
     reserveMapped(out.slots, stretch[chunks]);
     out.rays.resize(stretch[chunks]);
@@ -129,6 +146,14 @@ FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles, const std::
                              const std::vector<Ray>& rays, const Box& sceneBox, ThreadPool* pool) {
     FrameGeometry g = frameGeometry(triangles, bounds, rays, sceneBox, 0, pool);
     g.query = HitQuery::Any;
+    return g;
+}
+
+FrameGeometry passFrame(const FrameGeometry& primary, const std::vector<Ray>& rays, ThreadPool* pool) {
+    FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays, primary.sceneBox, pool);
+    g.boundsColumns = primary.boundsColumns;
+    g.trianglesVersion = primary.trianglesVersion;
+    g.sceneId = primary.sceneId;
     return g;
 }
 

@@ -169,9 +169,24 @@ constexpr std::uint64_t kMaxSecondarySlots = 0xFFFFFFF0ull;
 // Throws InputError when the pass has more slots than kMaxSecondarySlots.
 std::uint64_t secondarySlots(const SecondaryPass& pass, std::uint64_t primaryRays);
 
+// The primary rays in chunks, and how many rays each chunk makes in a pass at most
+// (raysPerHit for each hit that sends rays: hitSendsRays), counted in chunks side by side.
+struct PassRayCounts {
+    std::size_t primaryRays = 0;
+    std::size_t chunks = 1;
+    std::vector<std::size_t> atMost;  // chunks + 1 running totals: chunk c makes at most atMost[c + 1] - atMost[c]
+    std::size_t chunkBegin(std::size_t c) const { return primaryRays * c / chunks; }
+    std::size_t total() const { return atMost.back(); }
+};
+PassRayCounts passRayCounts(const SecondaryPass& pass, const std::vector<Hit>& primaryHits, ThreadPool& pool);
+
 SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray>& primary,
                                 const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
                                 ThreadPool& pool);
+// ... with the pass's counts of these primary hits (passRayCounts) already at hand.
+SecondaryRays makeSecondaryRays(const SecondaryPass& pass, const std::vector<Ray>& primary,
+                                const std::vector<Hit>& primaryHits, const std::vector<Triangle>& triangles,
+                                const PassRayCounts& counts, ThreadPool& pool);
 
 // A pass's slotCount slots before any hit: Hit{0, kNotTracedPrim} in each, filled in chunks
 // on the pool (filledArray).
@@ -194,5 +209,8 @@ std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& 
 // passes over the rays side by side (none: on the calling thread).
 FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
                              const std::vector<Ray>& rays, const Box& sceneBox, ThreadPool* pool = nullptr);
+// A pass's rays as a frame over the primary frame's triangles (secondaryFrame), with the
+// primary frame's bound columns, triangle version and scene.
+FrameGeometry passFrame(const FrameGeometry& primary, const std::vector<Ray>& rays, ThreadPool* pool = nullptr);
 
 }  // namespace dacrt

@@ -1,5 +1,6 @@
 #pragma once
 // What every tracer returns: hits, counters, the memory plan and timings.
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -37,6 +38,24 @@ struct Counters {
         rayTriangleTestsSkipped += o.rayTriangleTestsSkipped;
         leaves += o.leaves;
         raysFinishedWithoutHit += o.raysFinishedWithoutHit;
+    }
+    // Another trace's counters on top of these (a pass traced in groups): add's, and the rays
+    // culled and finished, the transfer work, each transfer round into the round of its name.
+    void addTrace(const Counters& o) {
+        add(o);
+        raysCulled += o.raysCulled;
+        finishedStep1 += o.finishedStep1;
+        transferWorkItems += o.transferWorkItems;
+        transferWorkItemsSkipped += o.transferWorkItemsSkipped;
+        for (std::size_t r = 0; r < o.roundNames.size(); ++r) {
+            const auto same = std::find(roundNames.begin(), roundNames.end(), o.roundNames[r]);
+            if (same == roundNames.end()) {
+                roundNames.push_back(o.roundNames[r]);
+                finishedPerRound.push_back(o.finishedPerRound[r]);
+            } else {
+                finishedPerRound[std::size_t(same - roundNames.begin())] += o.finishedPerRound[r];
+            }
+        }
     }
 };
 

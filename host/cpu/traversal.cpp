@@ -26,7 +26,11 @@ std::uint64_t packetTiles(const FrameGeometry& g) {
 }
 
 bool usesSimd(const FrameGeometry& g, const DacrtOptions& options) {
-    return options.exactDefaults() && g.rays->size() <= simd::kMaxRays && g.triangles->size() <= simd::kMaxTriangles;
+    return usesSimd(g.rays->size(), g.triangles->size(), options);
+}
+
+bool usesSimd(std::uint64_t rays, std::uint64_t triangles, const DacrtOptions& options) {
+    return options.exactDefaults() && rays <= simd::kMaxRays && triangles <= simd::kMaxTriangles;
 }
 
 bool usesPackets(const FrameGeometry& g, const DacrtOptions& options) {

@@ -45,6 +45,7 @@ struct PacketBuffers {
 // Whether a traversal of these (resolved) options on this frame runs the SIMD kernels: the
 // default tests, and counts whose ids fit the kernels' 32-bit gather offsets.
 bool usesSimd(const FrameGeometry& geometry, const DacrtOptions& options);
+bool usesSimd(std::uint64_t rays, std::uint64_t triangles, const DacrtOptions& options);
 // Tiles of the frame's image, 0 when the frame has no packets.
 std::uint64_t packetTiles(const FrameGeometry& geometry);
 // Whether a traversal of these options on this frame uses packets.

@@ -252,13 +252,24 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     const bool cpuDacrt = request.trace.backend == Backend::Cpu || request.trace.backend == Backend::CpuSeq;
     const RayGrouping grouping = cpuDacrt ? request.trace.dacrt.rayGrouping : RayGrouping::Slots;
     const bool byOctant = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
+    const std::optional<PassRayCounts> counts =
+        pass.kind == shared::kPassOcclusion ? std::optional(passRayCounts(pass, primaryHits, threadPool)) : std::nullopt;
+    if (counts && grouping == RayGrouping::Batches &&
+        tracesMadeSideBySide(pass, counts->total(), primary.triangles->size(), request.trace, threadPool.size())) {
+        MadePass made = traceMadeSideBySide(primary, primaryHits, pass, *counts, request.trace, threadPool, madeGroups_,
+                                            onPlan);
+        out.result = std::move(made.result);
+        out.rays = made.rays;
+        return out;
+    }
     if (byOctant)  // kept for the next pass
         making.add("rays and slots grouped by octant (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
     if (grouping == RayGrouping::OctantCalls || grouping == RayGrouping::Batches)
         making.add("the rays of the groups being traced (at most)", slots * sizeof(Ray));  // one, or one a worker
     if (onPlan && !onPlan(making)) return out;
     const auto start = Clock::now();
-    SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
+    SecondaryRays rays = counts ? makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, *counts, threadPool)
+                                : makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
     const double makeMs = msSince(start);
     out.rays = rays.rays.size();
     if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
@@ -391,14 +402,6 @@ namespace {
 
 // The frame a secondary pass's rays (or a group of them) are traced as. pool: its passes over
 // the rays side by side (none for a group traced on one worker of the pool, inside its loop).
-FrameGeometry passGeometry(const FrameGeometry& primary, const std::vector<Ray>& rays, ThreadPool* pool = nullptr) {
-    FrameGeometry g = secondaryFrame(*primary.triangles, *primary.triangleBounds, rays, primary.sceneBox, pool);
-    g.boundsColumns = primary.boundsColumns;
-    g.trianglesVersion = primary.trianglesVersion;
-    g.sceneId = primary.sceneId;
-    return g;
-}
-
 // One group's trace appended to the pass's: its hits after the earlier groups', its counters
 // summed, the transfer rounds of the same name together (the division and plan stay the first
 // group's).
@@ -409,22 +412,7 @@ void addGroup(TraceResult& whole, TraceResult&& part, std::size_t passRays) {
     }
     if (whole.hits.capacity() < passRays) reserveMapped(whole.hits, passRays);  // every group's hits at once
     whole.hits.insert(whole.hits.end(), part.hits.begin(), part.hits.end());
-    Counters& c = whole.counters;
-    const Counters& o = part.counters;
-    c.add(o);
-    c.raysCulled += o.raysCulled;
-    c.finishedStep1 += o.finishedStep1;
-    c.transferWorkItems += o.transferWorkItems;
-    c.transferWorkItemsSkipped += o.transferWorkItemsSkipped;
-    for (std::size_t r = 0; r < o.roundNames.size(); ++r) {
-        const auto same = std::find(c.roundNames.begin(), c.roundNames.end(), o.roundNames[r]);
-        if (same == c.roundNames.end()) {
-            c.roundNames.push_back(o.roundNames[r]);
-            c.finishedPerRound.push_back(o.finishedPerRound[r]);
-        } else {
-            c.finishedPerRound[std::size_t(same - c.roundNames.begin())] += o.finishedPerRound[r];
-        }
-    }
+    whole.counters.addTrace(part.counters);
     whole.phases.add(part.phases);
 }
 
@@ -432,7 +420,7 @@ void addGroup(TraceResult& whole, TraceResult&& part, std::size_t passRays) {
 
 TraceResult BackendDispatcher::tracePassRays(const FrameGeometry& primary, const std::vector<Ray>& rays,
                                              const BackendRequest& request, const PlanHook& onPlan) {
-    const FrameGeometry g = passGeometry(primary, rays, &pool(threadsOf(request.trace)));
+    const FrameGeometry g = passFrame(primary, rays, &pool(threadsOf(request.trace)));
     return isPeer(request.trace.backend) ? traceOnBackend(g, request, onPlan, {}, PeerFrame::SamePass)
                                          : traceCulled(g, request, onPlan);
 }
@@ -451,7 +439,7 @@ TraceResult BackendDispatcher::traceGroupsSideBySide(const FrameGeometry& primar
     auto groupOf = [&](std::size_t k, std::vector<Ray>& into) {
         reserveMapped(into, groups[k + 1] - groups[k]);
         into.assign(rays.begin() + std::ptrdiff_t(groups[k]), rays.begin() + std::ptrdiff_t(groups[k + 1]));
-        return withSkips(passGeometry(primary, into), passCull_.skips);
+        return withSkips(passFrame(primary, into), passCull_.skips);
     };
     // The plan: the largest group's sequential plan once a worker (a bound: the triangles' own
     // arrays are shared), after the pass cull's lines.
@@ -494,7 +482,7 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
     const auto start = Clock::now();
     ThreadPool& threadPool = pool(threadsOf(request.trace));
     if (passCullTests(rays, primary.triangles->size(), primary.sceneBox, request.trace.skips))
-        cullForPass(passGeometry(primary, rays, &threadPool), request.trace.skips, threadPool, passCull_);
+        cullForPass(passFrame(primary, rays, &threadPool), request.trace.skips, threadPool, passCull_);
     else
         cullNothing(passCull_);
     MemoryPlan cullPlan;
@@ -509,7 +497,7 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
         // filter each triangle once for every worker; else a group a worker.
         const std::uint64_t traced = passCull_.skips.applied ? passCull_.skips.traced.size() : primary.triangles->size();
         if (cpuTracesAsSubtrees(rays.size(), traced, HitQuery::Any, request.trace, threadPool.size()))
-            return traceAfterSkips(passGeometry(primary, rays, &threadPool), passCull_.skips, cullPlan, cullMs, request,
+            return traceAfterSkips(passFrame(primary, rays, &threadPool), passCull_.skips, cullPlan, cullMs, request,
                                    onPlan, {});
         return traceGroupsSideBySide(primary, rays, groups, live, request, onPlan, cullPlan, cullMs);
     }
@@ -518,7 +506,7 @@ TraceResult BackendDispatcher::traceGroups(const FrameGeometry& primary, const s
         if (groups[k] == groups[k + 1]) continue;
         reserveMapped(grouping_.group, groups[k + 1] - groups[k]);
         grouping_.group.assign(rays.begin() + std::ptrdiff_t(groups[k]), rays.begin() + std::ptrdiff_t(groups[k + 1]));
-        TraceResult part = traceAfterSkips(passGeometry(primary, grouping_.group, &threadPool), passCull_.skips,
+        TraceResult part = traceAfterSkips(passFrame(primary, grouping_.group, &threadPool), passCull_.skips,
                                            cullPlan, cullMs, request, onPlan, {});
         cullMs = 0.0;  // counted once, with the first group
         if (part.hits.empty()) return {};  // stopped at the plan

@@ -13,6 +13,7 @@
 #include "core/thread_pool.hpp"
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/frame_geometry.hpp"
+#include "cpu/made_pass_groups.hpp"
 #include "cpu/memory_plan.hpp"
 #include "cpu/options.hpp"
 #include "cpu/pass_cull.hpp"
@@ -149,6 +150,7 @@ private:
     std::unique_ptr<gpu::BufferArena> arena_;           // gpu: every other buffer, kept for the next frame
     GroupingBuffers grouping_;                          // cpu: a pass's rays grouped (--ray-grouping)
     std::vector<std::vector<Ray>> workerGroups_;        // cpu: each worker's group (traceGroupsSideBySide)
+    std::vector<MadeGroupBuffers> madeGroups_;          // cpu: each worker's made group (traceMadeSideBySide)
     GpuPassSourcePtr passSource_;                       // gpu: the last frame kept for its secondary passes
     PeerScenes peers_;                                  // embree, rayquery: their structures
     PassCull passCull_;                                 // the last pass's cull, its buffers reused

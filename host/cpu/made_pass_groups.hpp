@@ -1,0 +1,62 @@
+#pragma once
+// An occlusion pass made and traced in groups side by side, as a renderer on a BVH makes its
+// rays in its tracing loop: each worker makes the rays of a run of primary pixels into arrays of
+// its own, traces them at once as a sequential DACRT, and writes each answer to its slot. No
+// array of the pass's rays is made, copied into groups or scanned for the plan, and no array of
+// its hits is gathered before the slots are filled (docs/benchmarks.md, "Occlusion rays made
+// by the worker that traces them").
+#include <cstdint>
+#include <vector>
+
+#include "core/thread_pool.hpp"
+#include "cpu/frame_geometry.hpp"
+#include "cpu/options.hpp"
+#include "cpu/secondary_rays.hpp"
+#include "cpu/trace_result.hpp"
+
+namespace dacrt {
+
+// What a worker keeps from pass to pass: its group's rays and their slots.
+struct MadeGroupBuffers {
+    std::vector<Ray> rays;
+    std::vector<std::uint32_t> slots;
+};
+
+// Whether the cpu backend makes and traces a pass of at most raysAtMost rays over `triangles`
+// triangles so: an occlusion pass (its rays go every way: the pass cull's back-face test needs
+// a shared direction or end) in batches (RayGrouping::Batches), on more than one worker without
+// regions asked for, which the pass cull's grid would not survey and which is not traced as
+// subtrees (cpuTracesAsSubtrees: fewer rays than triangles). Elsewhere the pass's rays are made
+// first, then traced (BackendDispatcher::traceSecondary).
+bool tracesMadeSideBySide(const SecondaryPass& pass, std::uint64_t raysAtMost, std::size_t triangles,
+                          const TraceOptions& options, unsigned workers);
+
+// Where the groups of a pass's primary rays start: as many groups as rayBatches gives for the
+// pass's rays at most, in batches of passBatchRays(triangles), each group the primary rays up
+// to its batch's end (found in counts' chunks, then ray by ray in primaryHits). first[k] is
+// group k's first primary ray (first.back(): every primary ray), raysBefore[k] the rays at
+// most the groups before it make. Every group but the last makes rays.
+struct MadeGroups {
+    std::vector<std::size_t> first;
+    std::vector<std::size_t> raysBefore;
+    std::size_t count() const { return first.size() - 1; }
+    std::size_t raysAtMost(std::size_t k) const { return raysBefore[k + 1] - raysBefore[k]; }
+};
+MadeGroups madeGroups(const PassRayCounts& counts, const std::vector<Hit>& primaryHits, std::uint32_t raysPerHit,
+                      std::size_t triangles, unsigned workers);
+
+struct MadePass {
+    TraceResult result;  // hits per slot (hitsPerSlot's), the groups' counters summed
+    std::uint64_t rays = 0;
+};
+
+// The pass made and traced as tracesMadeSideBySide says, on the pool's workers (buffers: one
+// each, kept for the next pass). onPlan sees the plan of what is made (the hits per slot, each
+// worker's group) and then of the trace (each worker's sequential DACRT of the largest group,
+// from the counts), both before any ray is made. The hits are cpu-seq's visibility, bit for
+// bit (the rays are makeSecondaryRays', traced for any hit).
+MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
+                             const SecondaryPass& pass, const PassRayCounts& counts, const TraceOptions& options,
+                             ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, const PlanHook& onPlan);
+
+}  // namespace dacrt

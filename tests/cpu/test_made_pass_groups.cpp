@@ -1,0 +1,195 @@
+// An occlusion pass made and traced in groups side by side (made_pass_groups.hpp): which passes
+// go that way, how the primary rays are cut into groups, and that each group's worker makes the
+// rays makeSecondaryRays makes and writes brute force's visibility to every slot.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "core/thread_pool.hpp"
+#include "cpu/cpu_tracers.hpp"
+#include "cpu/made_pass_groups.hpp"
+#include "cpu/ray_grouping.hpp"
+#include "support/frames.hpp"
+
+namespace dacrt {
+namespace {
+
+using namespace test;
+
+// Primary hits of n rays, ray i hitting a surface where sends(i), else missing.
+template <typename Sends>
+std::vector<Hit> primaryHitsWhere(std::size_t n, Sends sends) {
+    std::vector<Hit> hits(n);
+    for (std::size_t i = 0; i < n; ++i) hits[i] = Hit{1.0f, sends(i) ? 0u : kMissPrim, 0.0f, 0.0f};
+    return hits;
+}
+
+// Every primary ray in exactly one group, in order, each group's rays so far counted exactly,
+// every group but the last making rays, and each group cut at the first ray that reaches its
+// batch's start.
+void expectGroupsCutAtTheBatches(const MadeGroups& groups, const std::vector<Hit>& hits, const SecondaryPass& pass,
+                                 const std::vector<std::size_t>& batchStarts) {
+    ASSERT_GE(groups.first.size(), 2u);
+    ASSERT_EQ(groups.raysBefore.size(), groups.first.size());
+    EXPECT_EQ(groups.first.front(), 0u);
+    EXPECT_EQ(groups.first.back(), hits.size());
+    std::size_t rays = 0, k = 0;
+    for (std::size_t i = 0; i <= hits.size(); ++i) {
+        if (k < groups.first.size() && groups.first[k] == i) {
+            EXPECT_EQ(groups.raysBefore[k], rays) << "group " << k;
+            ++k;
+        }
+        if (i < hits.size()) rays += hitSendsRays(hits[i]) ? pass.raysPerHit : 0;
+    }
+    EXPECT_EQ(k, groups.first.size());  // the starts strictly increase
+    for (std::size_t g = 0; g + 1 < groups.count(); ++g) EXPECT_GT(groups.raysAtMost(g), 0u) << "group " << g;
+    // A group starts at the ray after the one whose rays first reach a batch's start.
+    for (std::size_t g = 1; g < groups.count(); ++g) {
+        const std::size_t before = groups.raysBefore[g] - (hitSendsRays(hits[groups.first[g] - 1]) ? pass.raysPerHit : 0);
+        const auto batch = std::upper_bound(batchStarts.begin(), batchStarts.end(), before);
+        ASSERT_NE(batch, batchStarts.end());
+        EXPECT_LE(*batch, groups.raysBefore[g]) << "group " << g << " starts past its batch";
+    }
+}
+
+TEST(MadePassGroups, GroupsCutThePrimaryRaysWhereTheBatchesCutTheirRays) {
+    ThreadPool pool(2);
+    const SecondaryPass pass = occlusionPass(4, 0.8f);
+    // Every ray of a 640x480 image hitting: 1,228,800 rays in batches of passBatchRays(1000) =
+    // 65,536 for two workers: rayBatches gives 20, a group each.
+    const std::vector<Hit> every = primaryHitsWhere(307200, [](std::size_t) { return true; });
+    const PassRayCounts counts = passRayCounts(pass, every, pool);
+    const std::vector<std::size_t> batches = rayBatches(counts.total(), passBatchRays(1000), 2);
+    const MadeGroups groups = madeGroups(counts, every, pass.raysPerHit, 1000, 2);
+    EXPECT_EQ(groups.count(), batches.size() - 1);
+    expectGroupsCutAtTheBatches(groups, every, pass, batches);
+    // An object in the middle of the image: the first and last groups hold the misses before
+    // and after it (whose slots they fill), the cut lies among its rays.
+    const std::vector<Hit> middle = primaryHitsWhere(307200, [](std::size_t i) { return i >= 100000 && i < 110000 && i % 3; });
+    const PassRayCounts middleCounts = passRayCounts(pass, middle, pool);
+    const std::vector<std::size_t> middleBatches = rayBatches(middleCounts.total(), passBatchRays(1000), 2);
+    const MadeGroups cut = madeGroups(middleCounts, middle, pass.raysPerHit, 1000, 2);
+    EXPECT_EQ(cut.count(), 2u);
+    expectGroupsCutAtTheBatches(cut, middle, pass, middleBatches);
+    // Ten primary rays for four workers: four groups within one chunk of the counts.
+    const std::vector<Hit> few = primaryHitsWhere(10, [](std::size_t i) { return i != 4; });
+    const PassRayCounts fewCounts = passRayCounts(pass, few, pool);
+    ASSERT_EQ(fewCounts.chunks, 1u);
+    const MadeGroups fewGroups = madeGroups(fewCounts, few, pass.raysPerHit, 1000, 4);
+    EXPECT_EQ(fewGroups.count(), 4u);
+    expectGroupsCutAtTheBatches(fewGroups, few, pass, rayBatches(fewCounts.total(), passBatchRays(1000), 4));
+}
+
+TEST(MadePassGroups, TakesOcclusionBatchesOnCpuWorkersThatNoCullOrSubtreeTakes) {
+    TraceOptions options;
+    options.backend = Backend::Cpu;
+    options.dacrt.rayGrouping = RayGrouping::Batches;
+    const SecondaryPass occlusion = occlusionPass(4, 0.8f);
+    EXPECT_TRUE(tracesMadeSideBySide(occlusion, 300000, 12000, options, 2));
+    EXPECT_FALSE(tracesMadeSideBySide(occlusion, 300000, 12000, options, 1));  // one worker
+    EXPECT_FALSE(tracesMadeSideBySide(occlusion, 1, 12000, options, 2));       // one ray
+    EXPECT_FALSE(tracesMadeSideBySide(pointShadowPass({0.0f, 1.0f, 0.0f}), 300000, 12000, options, 2));
+    // Fewer rays than triangles: subtrees (cpuTracesAsSubtrees) ...
+    ASSERT_TRUE(cpuTracesAsSubtrees(200000, 300000, HitQuery::Any, options, 2));
+    EXPECT_FALSE(tracesMadeSideBySide(occlusion, 200000, 300000, options, 2));
+    // ... or so few that the pass cull's grid pays for itself.
+    EXPECT_FALSE(tracesMadeSideBySide(occlusion, 1000, 100000, options, 2));
+    TraceOptions other = options;
+    other.regions = 3;
+    EXPECT_FALSE(tracesMadeSideBySide(occlusion, 300000, 12000, other, 2));
+    other = options;
+    other.backend = Backend::CpuSeq;
+    EXPECT_FALSE(tracesMadeSideBySide(occlusion, 300000, 12000, other, 2));
+    other = options;
+    other.dacrt.rayGrouping = RayGrouping::Slots;
+    EXPECT_FALSE(tracesMadeSideBySide(occlusion, 300000, 12000, other, 2));
+}
+
+// Brute force's answer per slot, from the rays makeSecondaryRays makes (how many: rays).
+std::vector<Hit> bruteForcePerSlot(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
+                                   const SecondaryPass& pass, ThreadPool& pool, std::uint64_t& rays) {
+    const SecondaryRays made = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, pool);
+    rays = made.rays.size();
+    const TraceResult brute = traceBrute(passFrame(primary, made.rays), pool);
+    return hitsPerSlot(made, brute.hits, &pool);
+}
+
+// The shapes' occlusion passes at 96x72.
+SecondaryPassSet shapesOcclusionPasses() {
+    CameraOptions camera;
+    camera.eye = glm::dvec3(0.5, 1.5, 4.0);
+    return SecondaryPassSet("shapes", shapesScene(), camera,
+                            {{"occlusion 0.8", occlusionPass(4, 0.8f)}, {"occlusion unbounded", occlusionPass(4, kNoHitT)}},
+                            96, 72);
+}
+
+TEST(MadePassGroups, EachWorkerWritesBruteForcesVisibilityToItsSlots) {
+    const SecondaryPassSet set = shapesOcclusionPasses();
+    const FrameGeometry primary = frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays,
+                                                sceneBounds(set.frame.scene.triangles));
+    TraceOptions options;
+    options.backend = Backend::Cpu;
+    options.dacrt.rayGrouping = RayGrouping::Batches;
+    for (const unsigned threads : {2u, 3u, 4u}) {
+        ThreadPool pool(threads);
+        std::vector<MadeGroupBuffers> buffers;  // kept from pass to pass, as the dispatcher keeps them
+        for (const auto& [name, pass] : set.passes) {
+            SCOPED_TRACE(name + ", " + std::to_string(threads) + " threads");
+            std::uint64_t rays = 0;
+            const std::vector<Hit> reference = bruteForcePerSlot(primary, set.primary.hits, pass, pool, rays);
+            const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
+            ASSERT_TRUE(tracesMadeSideBySide(pass, counts.total(), primary.triangles->size(), options, threads));
+            std::vector<MemoryPlan> plans;
+            const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers,
+                                                      [&](const MemoryPlan& p) {
+                                                          plans.push_back(p);
+                                                          return true;
+                                                      });
+            EXPECT_EQ(made.rays, rays);
+            ASSERT_EQ(made.result.hits.size(), reference.size());
+            EXPECT_TRUE(identicalVisibility(reference, made.result.hits));
+            std::size_t untracedApart = 0;
+            for (std::size_t i = 0; i < reference.size(); ++i)
+                untracedApart += (reference[i].prim == kNotTracedPrim) != (made.result.hits[i].prim == kNotTracedPrim);
+            EXPECT_EQ(untracedApart, 0u);
+            // The plans: what is made, then the trace, whose last line counts the groups.
+            ASSERT_EQ(plans.size(), 2u);
+            const std::size_t groups = madeGroups(counts, set.primary.hits, pass.raysPerHit, primary.triangles->size(), threads).count();
+            EXPECT_EQ(groups, threads);  // fewer rays than a batch: a group a worker
+            ASSERT_FALSE(plans[1].work.empty());
+            EXPECT_EQ(plans[1].work.back().name, "ray groups made and traced side by side");
+            EXPECT_EQ(plans[1].work.back().count, groups);
+            EXPECT_EQ(made.result.threads, threads);
+            // The groups' counters summed: every ray that hit finished in its group's trace.
+            std::uint64_t hit = 0;
+            for (const Hit& h : made.result.hits) hit += h.prim != kMissPrim && h.prim != kNotTracedPrim;
+            EXPECT_EQ(made.result.counters.finishedStep1, hit);
+            EXPECT_GT(made.result.counters.leaves, 0u);
+        }
+    }
+}
+
+TEST(MadePassGroups, APlanRefusedMakesAndTracesNothing) {
+    const SecondaryPassSet set = shapesOcclusionPasses();
+    const FrameGeometry primary = frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays,
+                                                sceneBounds(set.frame.scene.triangles));
+    TraceOptions options;
+    options.backend = Backend::Cpu;
+    options.dacrt.rayGrouping = RayGrouping::Batches;
+    ThreadPool pool(2);
+    std::vector<MadeGroupBuffers> buffers;
+    const SecondaryPass& pass = set.passes.front().second;
+    const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
+    for (const int refused : {0, 1}) {
+        int asked = 0;
+        const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers,
+                                                  [&](const MemoryPlan&) { return asked++ != refused; });
+        EXPECT_EQ(asked, refused + 1);
+        EXPECT_TRUE(made.result.hits.empty());
+        EXPECT_EQ(made.rays, 0u);
+        for (const MadeGroupBuffers& b : buffers) EXPECT_TRUE(b.rays.empty());
+    }
+}
+
+}  // namespace
+}  // namespace dacrt
