@@ -28,6 +28,12 @@ FrameGeometry unmadePassFrame(const FrameGeometry& primary) {
 
 }  // namespace
 
+DacrtOptions madeGroupOptions(const DacrtOptions& options) {
+    DacrtOptions o = options;
+    if (o.triLimit == 0 && o.exactDefaults()) o.triLimit = kCpuSimdOcclusionTriangleLimit;
+    return o;
+}
+
 bool tracesMadeSideBySide(const SecondaryPass& pass, std::uint64_t raysAtMost, std::size_t triangles,
                           const TraceOptions& options, unsigned workers) {
     return options.backend == Backend::Cpu && options.regions == 0 && workers > 1 &&
@@ -61,6 +67,7 @@ MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit
                              const SecondaryPass& pass, const PassRayCounts& counts, const TraceOptions& options,
                              ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, const PlanHook& onPlan) {
     MadePass out;
+    const DacrtOptions dacrt = madeGroupOptions(options.dacrt);
     const MadeGroups cut = madeGroups(counts, primaryHits, pass.raysPerHit, primary.triangles->size(), pool.size());
     const std::size_t groups = cut.count();
     const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), groups));
@@ -79,7 +86,7 @@ MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit
     PassCull none;
     cullNothing(none);
     planPassCull(primary, options.skips, none, plan);
-    const MemoryPlan one = sequentialPlan(unmadePassFrame(primary), largest, options.dacrt);
+    const MemoryPlan one = sequentialPlan(unmadePassFrame(primary), largest, dacrt);
     for (const auto& [name, bytes] : one.buffers) plan.add(name + each, bytes * workers);
     plan.work.insert(plan.work.end(), one.work.begin(), one.work.end());
     plan.addWork("ray groups made and traced side by side", groups,
@@ -114,7 +121,7 @@ MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit
         Hit* const slots = out.result.hits.data();
         std::fill(slots + first * pass.raysPerHit, slots + end * pass.raysPerHit, notTraced);
         if (b.rays.empty()) return;
-        TraceResult part = traceSequential(passFrame(primary, b.rays), options.dacrt);
+        TraceResult part = traceSequential(passFrame(primary, b.rays), dacrt);
         for (std::size_t i = 0; i < b.rays.size(); ++i) slots[b.slots[i]] = part.hits[i];
         part.hits = {};
         parts[k] = std::move(part);

@@ -50,6 +50,10 @@ enum class Precision { F32, F64 };
 constexpr std::uint32_t kCpuLeafLimit = 8;
 constexpr std::uint32_t kCpuSimdRayLimit = 16;
 constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
+// ... and for occlusion rays made and traced side by side (cpu/made_pass_groups.hpp): rays
+// that start on the surfaces in a cell, so that a split divides them with its triangles (the
+// Bunny's occlusion pass 9% faster than at 64, the room's as fast; docs/benchmarks.md).
+constexpr std::uint32_t kCpuSimdOcclusionTriangleLimit = 48;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 constexpr std::uint32_t kPacketFlushDefault = 16;
 // RayGrouping::Batches: the most rays one DACRT of a secondary pass takes, this many or
