@@ -28,12 +28,6 @@ FrameGeometry unmadePassFrame(const FrameGeometry& primary) {
 
 }  // namespace
 
-DacrtOptions madeGroupOptions(const DacrtOptions& options) {
-    DacrtOptions o = options;
-    if (o.triLimit == 0 && o.exactDefaults()) o.triLimit = kCpuSimdOcclusionTriangleLimit;
-    return o;
-}
-
 bool tracesMadeSideBySide(const SecondaryPass& pass, std::uint64_t raysAtMost, std::size_t triangles,
                           const TraceOptions& options, unsigned workers) {
     return options.backend == Backend::Cpu && options.regions == 0 && workers > 1 &&
@@ -67,7 +61,7 @@ MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit
                              const SecondaryPass& pass, const PassRayCounts& counts, const TraceOptions& options,
                              ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, const PlanHook& onPlan) {
     MadePass out;
-    const DacrtOptions dacrt = madeGroupOptions(options.dacrt);
+    const DacrtOptions& dacrt = options.dacrt;
     const MadeGroups cut = madeGroups(counts, primaryHits, pass.raysPerHit, primary.triangles->size(), pool.size());
     const std::size_t groups = cut.count();
     const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), groups));

@@ -45,11 +45,6 @@ struct MadeGroups {
 MadeGroups madeGroups(const PassRayCounts& counts, const std::vector<Hit>& primaryHits, std::uint32_t raysPerHit,
                       std::size_t triangles, unsigned workers);
 
-// The options each group's sequential DACRT runs with: the caller's, with the occlusion rays'
-// triangle limit (kCpuSimdOcclusionTriangleLimit) where none was asked for and the default
-// tests run (the others keep their own default, kCpuLeafLimit).
-DacrtOptions madeGroupOptions(const DacrtOptions& options);
-
 struct MadePass {
     TraceResult result;  // hits per slot (hitsPerSlot's), the groups' counters summed
     std::uint64_t rays = 0;
@@ -58,7 +53,7 @@ struct MadePass {
 // The pass made and traced as tracesMadeSideBySide says, on the pool's workers (buffers: one
 // each, kept for the next pass). onPlan sees the plan of what is made (the hits per slot, each
 // worker's group) and then of the trace (each worker's sequential DACRT of the largest group,
-// from the counts, with madeGroupOptions), both before any ray is made. The hits are cpu-seq's visibility, bit for
+// from the counts), both before any ray is made. The hits are cpu-seq's visibility, bit for
 // bit (the rays are makeSecondaryRays', traced for any hit).
 MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
                              const SecondaryPass& pass, const PassRayCounts& counts, const TraceOptions& options,

@@ -30,6 +30,13 @@ std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, 
     return primary * perHit + pass.firstSample + k;
 }
 
+DacrtOptions passDacrtOptions(const SecondaryPass& pass, const DacrtOptions& options) {
+    DacrtOptions o = options;
+    if (pass.kind == shared::kPassOcclusion && o.triLimit == 0 && o.exactDefaults())
+        o.triLimit = kCpuSimdOcclusionTriangleLimit;
+    return o;
+}
+
 float passSegmentEnd(const SecondaryPass& pass) {
     return pass.kind == shared::kPassShadow ? shared::shadowSegmentEnd(pass.light) : pass.occlusionDistance;
 }

@@ -13,6 +13,7 @@
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/occlusion_ray_rows.hpp"
+#include "cpu/options.hpp"
 #include "cpu/predicates.hpp"
 #include "cpu/simd_kernels.hpp"
 
@@ -160,6 +161,12 @@ struct SecondaryRays {
     std::vector<std::uint32_t> slots;      // rays[i] fills slots[i]
     std::uint64_t slotCount = 0;
 };
+
+// The DACRT options the cpu backends trace the pass with: for occlusion rays, which start on
+// the surfaces in a cell (so that a split divides them with its triangles), the triangle limit
+// kCpuSimdOcclusionTriangleLimit where none was asked for and the default tests run (the
+// others keep their own default); a shadow pass's as given.
+DacrtOptions passDacrtOptions(const SecondaryPass& pass, const DacrtOptions& options);
 
 // Where every ray of the pass ends (each starts at shared::kSegmentStart).
 float passSegmentEnd(const SecondaryPass& pass);

@@ -246,18 +246,20 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
         !culledOnTheHost(pass, primaryHits, *primary.triangles, request.trace.skips))
         return traceMadeOnDevice(primary, pass, request, onPlan);
     PassTrace out;
+    const bool cpuDacrt = request.trace.backend == Backend::Cpu || request.trace.backend == Backend::CpuSeq;
+    BackendRequest passRequest = request;
+    if (cpuDacrt) passRequest.trace.dacrt = passDacrtOptions(pass, request.trace.dacrt);
     // The slot arrays are allocated before the tracer plans: checked first, as its plan is.
     const std::uint64_t slots = secondarySlots(pass, primary.rays->size());
     MemoryPlan making = makingPlan(pass, primary.rays->size());
-    const bool cpuDacrt = request.trace.backend == Backend::Cpu || request.trace.backend == Backend::CpuSeq;
     const RayGrouping grouping = cpuDacrt ? request.trace.dacrt.rayGrouping : RayGrouping::Slots;
     const bool byOctant = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
     const std::optional<PassRayCounts> counts =
         pass.kind == shared::kPassOcclusion ? std::optional(passRayCounts(pass, primaryHits, threadPool)) : std::nullopt;
     if (counts && grouping == RayGrouping::Batches &&
-        tracesMadeSideBySide(pass, counts->total(), primary.triangles->size(), request.trace, threadPool.size())) {
-        MadePass made = traceMadeSideBySide(primary, primaryHits, pass, *counts, request.trace, threadPool, madeGroups_,
-                                            onPlan);
+        tracesMadeSideBySide(pass, counts->total(), primary.triangles->size(), passRequest.trace, threadPool.size())) {
+        MadePass made = traceMadeSideBySide(primary, primaryHits, pass, *counts, passRequest.trace, threadPool,
+                                            madeGroups_, onPlan);
         out.result = std::move(made.result);
         out.rays = made.rays;
         return out;
@@ -286,10 +288,8 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
             groups = rayBatches(rays.rays.size(), passBatchRays(primary.triangles->size()),
                                 sideBySideWorkers(request, threadPool.size()));
         }
-        const BackendRequest passRequest =
-            request.trace.backend == Backend::Gpu && gpu_
-                ? gpuPassRequest(request, gpu_->info(), rays.rays.size(), primary.triangles->size())
-                : request;
+        if (request.trace.backend == Backend::Gpu && gpu_)
+            passRequest = gpuPassRequest(request, gpu_->info(), rays.rays.size(), primary.triangles->size());
         out.result = groups.size() > 2 ? traceGroups(primary, rays.rays, groups, passRequest, onPlan)
                                        : tracePassRays(primary, rays.rays, passRequest, onPlan);
         if (out.result.hits.empty()) return out;  // stopped at the plan

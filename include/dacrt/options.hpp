@@ -50,9 +50,9 @@ enum class Precision { F32, F64 };
 constexpr std::uint32_t kCpuLeafLimit = 8;
 constexpr std::uint32_t kCpuSimdRayLimit = 16;
 constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
-// ... and for occlusion rays made and traced side by side (cpu/made_pass_groups.hpp): rays
-// that start on the surfaces in a cell, so that a split divides them with its triangles (the
-// Bunny's occlusion pass 9% faster than at 64, the room's as fast; docs/benchmarks.md).
+// ... and for occlusion rays (cpu/secondary_rays.hpp, passDacrtOptions): rays that start on
+// the surfaces in a cell, so that a split divides them with its triangles (the Bunny's
+// occlusion pass about 9% faster than at 64, the room's as fast; docs/benchmarks.md).
 constexpr std::uint32_t kCpuSimdOcclusionTriangleLimit = 48;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 constexpr std::uint32_t kPacketFlushDefault = 16;

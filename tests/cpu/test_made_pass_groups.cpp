@@ -105,18 +105,6 @@ TEST(MadePassGroups, TakesOcclusionBatchesOnCpuWorkersThatNoCullOrSubtreeTakes) 
     EXPECT_FALSE(tracesMadeSideBySide(occlusion, 300000, 12000, other, 2));
 }
 
-TEST(MadePassGroups, GroupsTakeTheOcclusionTriangleLimitWhereNoneWasAskedFor) {
-    DacrtOptions options;
-    EXPECT_EQ(madeGroupOptions(options).triLimit, kCpuSimdOcclusionTriangleLimit);
-    EXPECT_EQ(madeGroupOptions(options).resolvedFor(Backend::CpuSeq).triLimit, kCpuSimdOcclusionTriangleLimit);
-    EXPECT_EQ(madeGroupOptions(options).rayLimit, 0u);  // the backend's default
-    options.triLimit = 20;
-    EXPECT_EQ(madeGroupOptions(options).triLimit, 20u);
-    options.triLimit = 0;
-    options.intersector = Intersector::MollerTrumbore;  // not the SIMD kernels: their own default
-    EXPECT_EQ(madeGroupOptions(options).resolvedFor(Backend::CpuSeq).triLimit, kCpuLeafLimit);
-}
-
 // Brute force's answer per slot, from the rays makeSecondaryRays makes (how many: rays).
 std::vector<Hit> bruteForcePerSlot(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
                                    const SecondaryPass& pass, ThreadPool& pool, std::uint64_t& rays) {
