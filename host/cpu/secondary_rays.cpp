@@ -30,10 +30,9 @@ std::uint32_t occlusionStream(const SecondaryPass& pass, std::uint32_t primary, 
     return primary * perHit + pass.firstSample + k;
 }
 
-DacrtOptions passDacrtOptions(const SecondaryPass& pass, const DacrtOptions& options) {
+DacrtOptions passDacrtOptions(const DacrtOptions& options) {
     DacrtOptions o = options;
-    if (pass.kind == shared::kPassOcclusion && o.triLimit == 0 && o.exactDefaults())
-        o.triLimit = kCpuSimdOcclusionTriangleLimit;
+    if (o.triLimit == 0 && o.exactDefaults()) o.triLimit = kCpuSimdSecondaryTriangleLimit;
     return o;
 }
 

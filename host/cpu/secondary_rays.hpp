@@ -162,11 +162,12 @@ struct SecondaryRays {
     std::uint64_t slotCount = 0;
 };
 
-// The DACRT options the cpu backends trace the pass with: for occlusion rays, which start on
-// the surfaces in a cell (so that a split divides them with its triangles), the triangle limit
-// kCpuSimdOcclusionTriangleLimit where none was asked for and the default tests run (the
-// others keep their own default); a shadow pass's as given.
-DacrtOptions passDacrtOptions(const SecondaryPass& pass, const DacrtOptions& options);
+// The DACRT options the cpu backends trace a pass alone with: its rays start on the surfaces
+// in a cell (so that a split divides them with its triangles), hence the triangle limit
+// kCpuSimdSecondaryTriangleLimit where none was asked for and the default tests run (the
+// others keep their own default, kCpuLeafLimit). Passes traced together (the Dragon's: fewer
+// rays than triangles, as subtrees) keep the backend's default, measured faster there.
+DacrtOptions passDacrtOptions(const DacrtOptions& options);
 
 // Where every ray of the pass ends (each starts at shared::kSegmentStart).
 float passSegmentEnd(const SecondaryPass& pass);

@@ -248,7 +248,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     PassTrace out;
     const bool cpuDacrt = request.trace.backend == Backend::Cpu || request.trace.backend == Backend::CpuSeq;
     BackendRequest passRequest = request;
-    if (cpuDacrt) passRequest.trace.dacrt = passDacrtOptions(pass, request.trace.dacrt);
+    if (cpuDacrt) passRequest.trace.dacrt = passDacrtOptions(request.trace.dacrt);
     // The slot arrays are allocated before the tracer plans: checked first, as its plan is.
     const std::uint64_t slots = secondarySlots(pass, primary.rays->size());
     MemoryPlan making = makingPlan(pass, primary.rays->size());

@@ -50,10 +50,11 @@ enum class Precision { F32, F64 };
 constexpr std::uint32_t kCpuLeafLimit = 8;
 constexpr std::uint32_t kCpuSimdRayLimit = 16;
 constexpr std::uint32_t kCpuSimdTriangleLimit = 64;
-// ... and for occlusion rays (cpu/secondary_rays.hpp, passDacrtOptions): rays that start on
-// the surfaces in a cell, so that a split divides them with its triangles (the Bunny's
-// occlusion pass about 9% faster than at 64, the room's as fast; docs/benchmarks.md).
-constexpr std::uint32_t kCpuSimdOcclusionTriangleLimit = 48;
+// ... and for a secondary pass traced alone (cpu/secondary_rays.hpp, passDacrtOptions): rays
+// that start on the surfaces in a cell, so that a split divides them with its triangles (the
+// Bunny's occlusion pass about 9% faster than at 64 and the room's shadow pass 4%, the others
+// as fast; docs/benchmarks.md).
+constexpr std::uint32_t kCpuSimdSecondaryTriangleLimit = 48;
 constexpr std::uint32_t kGpuLeafLimit = 64;
 constexpr std::uint32_t kPacketFlushDefault = 16;
 // RayGrouping::Batches: the most rays one DACRT of a secondary pass takes, this many or

@@ -477,18 +477,16 @@ TEST(SecondaryRays, GroupingByOctantIsAStablePermutationThatHitsPerSlotUndoes) {
 // first slot to the last, with no ray, with rays in slot order and out of it; on the calling
 // thread and on a pool of 2, with slot counts of several fill chunks and rays of several scan
 // chunks.
-TEST(SecondaryRays, OcclusionPassesTakeTheirTriangleLimitWhereNoneWasAskedFor) {
-    const SecondaryPass occlusion = occlusionPass(4, 0.8f), shadow = pointShadowPass({0.0f, 1.0f, 0.0f});
+TEST(SecondaryRays, PassesTakeTheirTriangleLimitWhereNoneWasAskedFor) {
     DacrtOptions options;
-    EXPECT_EQ(passDacrtOptions(occlusion, options).triLimit, kCpuSimdOcclusionTriangleLimit);
-    EXPECT_EQ(passDacrtOptions(occlusion, options).resolvedFor(Backend::Cpu).triLimit, kCpuSimdOcclusionTriangleLimit);
-    EXPECT_EQ(passDacrtOptions(occlusion, options).rayLimit, 0u);  // the backend's default
-    EXPECT_EQ(passDacrtOptions(shadow, options).triLimit, 0u);
+    EXPECT_EQ(passDacrtOptions(options).triLimit, kCpuSimdSecondaryTriangleLimit);
+    EXPECT_EQ(passDacrtOptions(options).resolvedFor(Backend::Cpu).triLimit, kCpuSimdSecondaryTriangleLimit);
+    EXPECT_EQ(passDacrtOptions(options).rayLimit, 0u);  // the backend's default
     options.triLimit = 20;  // asked for: kept
-    EXPECT_EQ(passDacrtOptions(occlusion, options).triLimit, 20u);
+    EXPECT_EQ(passDacrtOptions(options).triLimit, 20u);
     options.triLimit = 0;
     options.intersector = Intersector::MollerTrumbore;  // not the SIMD leaf: its own default
-    EXPECT_EQ(passDacrtOptions(occlusion, options).resolvedFor(Backend::CpuSeq).triLimit, kCpuLeafLimit);
+    EXPECT_EQ(passDacrtOptions(options).resolvedFor(Backend::CpuSeq).triLimit, kCpuLeafLimit);
 }
 
 TEST(SecondaryRays, HitsPerSlotPutsEveryHitInItsSlotInOrderOrNot) {
