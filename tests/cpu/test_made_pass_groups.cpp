@@ -123,13 +123,22 @@ SecondaryPassSet shapesOcclusionPasses() {
                             96, 72);
 }
 
-TEST(MadePassGroups, EachWorkerWritesBruteForcesVisibilityToItsSlots) {
-    const SecondaryPassSet set = shapesOcclusionPasses();
-    const FrameGeometry primary = frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays,
-                                                sceneBounds(set.frame.scene.triangles));
+FrameGeometry primaryFrameOf(const SecondaryPassSet& set) {
+    return frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays, sceneBounds(set.frame.scene.triangles));
+}
+
+// The cpu backend's options whose occlusion passes go made side by side.
+TraceOptions madeSideBySideOptions() {
     TraceOptions options;
     options.backend = Backend::Cpu;
     options.dacrt.rayGrouping = RayGrouping::Batches;
+    return options;
+}
+
+TEST(MadePassGroups, EachWorkerWritesBruteForcesVisibilityToItsSlots) {
+    const SecondaryPassSet set = shapesOcclusionPasses();
+    const FrameGeometry primary = primaryFrameOf(set);
+    const TraceOptions options = madeSideBySideOptions();
     for (const unsigned threads : {2u, 3u, 4u}) {
         ThreadPool pool(threads);
         std::vector<MadeGroupBuffers> buffers;  // kept from pass to pass, as the dispatcher keeps them
@@ -171,11 +180,8 @@ TEST(MadePassGroups, EachWorkerWritesBruteForcesVisibilityToItsSlots) {
 
 TEST(MadePassGroups, APlanRefusedMakesAndTracesNothing) {
     const SecondaryPassSet set = shapesOcclusionPasses();
-    const FrameGeometry primary = frameGeometry(set.frame.scene.triangles, set.frame.bounds, set.frame.rays,
-                                                sceneBounds(set.frame.scene.triangles));
-    TraceOptions options;
-    options.backend = Backend::Cpu;
-    options.dacrt.rayGrouping = RayGrouping::Batches;
+    const FrameGeometry primary = primaryFrameOf(set);
+    const TraceOptions options = madeSideBySideOptions();
     ThreadPool pool(2);
     std::vector<MadeGroupBuffers> buffers;
     const SecondaryPass& pass = set.passes.front().second;
