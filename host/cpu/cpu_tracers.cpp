@@ -201,14 +201,23 @@ void traceRayIds(const FrameGeometry& g, const DacrtOptions& options, const Trav
 
 }  // namespace
 
+namespace {
+
+// The partition scratch, in ids, of a sequential DACRT of rayCount rays over g's traced
+// triangles (0: the scalar path runs, without scratch).
+std::uint64_t sequentialScratchIds(const FrameGeometry& g, std::uint64_t rayCount, const DacrtOptions& resolved) {
+    return usesSimd(rayCount, g.triangles->size(), resolved) ? partitionScratchIds(rayCount, g.tracedTriangleCount()) : 0;
+}
+
+}  // namespace
+
 MemoryPlan sequentialPlan(const FrameGeometry& g, std::uint64_t rayCount, const DacrtOptions& options) {
     MemoryPlan plan;
-    const std::uint64_t triCount = g.tracedTriangleCount();
     planFrameInputs(g, rayCount, plan);
     plan.add("ray ids", rayCount * 4);
-    plan.add("triangle ids", triCount * 4);
+    plan.add("triangle ids", std::uint64_t(g.tracedTriangleCount()) * 4);
     const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
-    const std::uint64_t scratchIds = usesSimd(rayCount, g.triangles->size(), resolved) ? partitionScratchIds(rayCount, triCount) : 0;
+    const std::uint64_t scratchIds = sequentialScratchIds(g, rayCount, resolved);
     if (scratchIds) plan.add("partition scratch", scratchIds * 4);
     if (packetTiles(g) > 0) planPacketBuffers(g, resolved, scratchIds, 1, plan);
     return plan;
@@ -221,7 +230,7 @@ TraceResult traceSequential(const FrameGeometry& g, const DacrtOptions& options,
     result.memory = sequentialPlan(g, rayCount, options);
     if (onPlan && !onPlan(result.memory)) return result;
     const DacrtOptions resolved = options.resolvedFor(Backend::CpuSeq);
-    const std::uint64_t scratchIds = usesSimd(g, resolved) ? partitionScratchIds(rayCount, triCount) : 0;
+    const std::uint64_t scratchIds = sequentialScratchIds(g, rayCount, resolved);
 
     const bool raysShareSegment = startHits(g, result.hits, nullptr);
     std::vector<std::uint32_t> rayIds(rayCount), triIds;

@@ -4,7 +4,7 @@
 // its own, traces them at once as a sequential DACRT, and writes each answer to its slot. No
 // array of the pass's rays is made, copied into groups or scanned for the plan, and no array of
 // its hits is gathered before the slots are filled (docs/benchmarks.md, "Occlusion rays made
-// by the worker that traces them").
+// where they are traced, a pass's own triangle limit").
 #include <cstdint>
 #include <vector>
 

@@ -217,8 +217,9 @@ std::vector<Hit> hitsPerSlot(const SecondaryRays& rays, const std::vector<Hit>& 
 // passes over the rays side by side (none: on the calling thread).
 FrameGeometry secondaryFrame(const std::vector<Triangle>& triangles, const std::vector<Bounds>& bounds,
                              const std::vector<Ray>& rays, const Box& sceneBox, ThreadPool* pool = nullptr);
-// A pass's rays as a frame over the primary frame's triangles (secondaryFrame), with the
-// primary frame's bound columns, triangle version and scene.
+// A pass's rays (or a group of them) as a frame over the primary frame's triangles
+// (secondaryFrame), with the primary frame's bound columns, triangle version and scene. pool:
+// its passes over the rays side by side (none for a group traced on one worker of the pool).
 FrameGeometry passFrame(const FrameGeometry& primary, const std::vector<Ray>& rays, ThreadPool* pool = nullptr);
 
 }  // namespace dacrt

@@ -254,11 +254,9 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     MemoryPlan making = makingPlan(pass, primary.rays->size());
     const RayGrouping grouping = cpuDacrt ? request.trace.dacrt.rayGrouping : RayGrouping::Slots;
     const bool byOctant = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
-    const std::optional<PassRayCounts> counts =
-        pass.kind == shared::kPassOcclusion ? std::optional(passRayCounts(pass, primaryHits, threadPool)) : std::nullopt;
-    if (counts && grouping == RayGrouping::Batches &&
-        tracesMadeSideBySide(pass, counts->total(), primary.triangles->size(), passRequest.trace, threadPool.size())) {
-        MadePass made = traceMadeSideBySide(primary, primaryHits, pass, *counts, passRequest.trace, threadPool,
+    const PassRayCounts counts = passRayCounts(pass, primaryHits, threadPool);
+    if (tracesMadeSideBySide(pass, counts.total(), primary.triangles->size(), passRequest.trace, threadPool.size())) {
+        MadePass made = traceMadeSideBySide(primary, primaryHits, pass, counts, passRequest.trace, threadPool,
                                             madeGroups_, onPlan);
         out.result = std::move(made.result);
         out.rays = made.rays;
@@ -270,8 +268,7 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
         making.add("the rays of the groups being traced (at most)", slots * sizeof(Ray));  // one, or one a worker
     if (onPlan && !onPlan(making)) return out;
     const auto start = Clock::now();
-    SecondaryRays rays = counts ? makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, *counts, threadPool)
-                                : makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, threadPool);
+    SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, counts, threadPool);
     const double makeMs = msSince(start);
     out.rays = rays.rays.size();
     if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
@@ -400,8 +397,6 @@ std::vector<BackendDispatcher::PassTrace> BackendDispatcher::traceSecondaryToget
 
 namespace {
 
-// The frame a secondary pass's rays (or a group of them) are traced as. pool: its passes over
-// the rays side by side (none for a group traced on one worker of the pool, inside its loop).
 // One group's trace appended to the pass's: its hits after the earlier groups', its counters
 // summed, the transfer rounds of the same name together (the division and plan stay the first
 // group's).
