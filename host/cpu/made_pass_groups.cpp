@@ -31,7 +31,8 @@ FrameGeometry unmadePassFrame(const FrameGeometry& primary) {
 bool tracesMadeSideBySide(const SecondaryPass& pass, std::uint64_t raysAtMost, std::size_t triangles,
                           const TraceOptions& options, unsigned workers) {
     return options.backend == Backend::Cpu && options.regions == 0 && workers > 1 &&
-           options.dacrt.rayGrouping == RayGrouping::Batches && pass.kind == shared::kPassOcclusion &&
+           options.dacrt.rayGrouping == RayGrouping::Batches &&
+           (pass.kind == shared::kPassOcclusion || pass.kind == shared::kPassShadow) &&
            raysAtMost > 1 && !passCullMayDrop(raysAtMost, triangles, false, options.skips) &&
            !cpuTracesAsSubtrees(raysAtMost, triangles, HitQuery::Any, options, workers);
 }
@@ -57,68 +58,86 @@ MadeGroups madeGroups(const PassRayCounts& counts, const std::vector<Hit>& prima
     return groups;
 }
 
-MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
-                             const SecondaryPass& pass, const PassRayCounts& counts, const TraceOptions& options,
-                             ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, const PlanHook& onPlan) {
+namespace {
+
+// Group k's rays into b (its arrays cleared first, then grown to the group's most rays), with
+// survey, where asked for, taking each ray as it is made.
+void makeGroupRays(const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const SecondaryPass& pass,
+                   const MadeGroups& cut, std::size_t k, MadeGroupBuffers& b, RaySurvey* survey) {
+    b.rays.clear();
+    b.slots.clear();
+    reserveMapped(b.rays, cut.raysAtMost(k));
+    reserveMapped(b.slots, cut.raysAtMost(k));
+    secondaryRaysOfRange(
+        pass, cut.first[k], cut.first[k + 1], primaryHits.data(),
+        [&](std::size_t i) -> const Ray& { return (*primary.rays)[i]; }, *primary.triangles,
+        [&](std::uint32_t slot, const Ray& ray) {
+            b.rays.push_back(ray);
+            b.slots.push_back(slot);
+            if (survey) survey->add(ray);
+        });
+}
+
+// Group k's slots (its primary rays', slot = primary index * raysPerHit + sample) marked
+// untraced, then its rays traced as a sequential DACRT (over the kept triangles where skips
+// applies) and each answer written to its slot. Returns the trace's counters, its hits dropped.
+TraceResult traceGroupToSlots(const FrameGeometry& primary, const SecondaryPass& pass, const MadeGroups& cut,
+                              std::size_t k, const MadeGroupBuffers& b, const TriangleSkips* skips,
+                              const DacrtOptions& dacrt, Hit* slots) {
+    const Hit notTraced{0.0f, kNotTracedPrim, 0.0f, 0.0f};
+    std::fill(slots + cut.first[k] * pass.raysPerHit, slots + cut.first[k + 1] * pass.raysPerHit, notTraced);
+    if (b.rays.empty()) return {};
+    const FrameGeometry g = passFrame(primary, b.rays);
+    TraceResult part = traceSequential(skips ? withSkips(g, *skips) : g, dacrt);
+    for (std::size_t i = 0; i < b.rays.size(); ++i) slots[b.slots[i]] = part.hits[i];
+    part.hits = {};
+    return part;
+}
+
+// The trace's plan: the cull's lines, then each worker's sequential DACRT of `largest` rays
+// over g's triangles (a bound: the triangles' own arrays are shared), then the groups' line.
+MemoryPlan groupsTracePlan(const FrameGeometry& g, const SkipSwitches& switches, const PassCull& cull,
+                           std::size_t largest, std::size_t groups, unsigned workers, const DacrtOptions& dacrt,
+                           const std::string& how) {
+    MemoryPlan plan;
+    planPassCull(g, switches, cull, plan);
+    const std::string each = " (x" + std::to_string(workers) + " workers, at most)";
+    const MemoryPlan one = sequentialPlan(g, largest, dacrt);
+    for (const auto& [name, bytes] : one.buffers) plan.add(name + each, bytes * workers);
+    plan.work.insert(plan.work.end(), one.work.begin(), one.work.end());
+    plan.addWork("ray groups made and traced side by side", groups,
+                 "each made by one of " + std::to_string(workers) + " workers " + how);
+    return plan;
+}
+
+// An occlusion pass: each worker makes a group into its arrays and traces it at once.
+MadePass traceOcclusionGroups(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
+                              const SecondaryPass& pass, const MadeGroups& cut, const TraceOptions& options,
+                              ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, const PlanHook& onPlan) {
     MadePass out;
-    const DacrtOptions& dacrt = options.dacrt;
-    const MadeGroups cut = madeGroups(counts, primaryHits, pass.raysPerHit, primary.triangles->size(), pool.size());
     const std::size_t groups = cut.count();
     const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), groups));
     std::size_t largest = 0;
     for (std::size_t k = 0; k < groups; ++k) largest = std::max(largest, cut.raysAtMost(k));
-
-    // The plans, from the counts, before any ray is made.
-    const std::uint64_t slotCount = secondarySlots(pass, counts.primaryRays);
-    const std::string each = " (x" + std::to_string(workers) + " workers, at most)";
-    MemoryPlan making;
-    making.add("hits per slot", slotCount * sizeof(Hit));
-    making.add("rays and slots of the group being made" + each,
-               std::uint64_t(largest) * (sizeof(Ray) + sizeof(std::uint32_t)) * workers);
-    if (onPlan && !onPlan(making)) return out;
-    MemoryPlan plan;
     PassCull none;
     cullNothing(none);
-    planPassCull(primary, options.skips, none, plan);
-    const MemoryPlan one = sequentialPlan(unmadePassFrame(primary), largest, dacrt);
-    for (const auto& [name, bytes] : one.buffers) plan.add(name + each, bytes * workers);
-    plan.work.insert(plan.work.end(), one.work.begin(), one.work.end());
-    plan.addWork("ray groups made and traced side by side", groups,
-                 "each made by one of " + std::to_string(workers) +
-                     " workers and traced at once as a sequential DACRT: no array of the pass's rays");
+    MemoryPlan plan = groupsTracePlan(unmadePassFrame(primary), options.skips, none, largest, groups, workers,
+                                      options.dacrt, "and traced at once as a sequential DACRT: no array of the pass's rays");
     if (onPlan && !onPlan(plan)) return out;
 
     const auto start = Clock::now();
-    out.result.hits = mappedArray<Hit>(slotCount);  // every slot written by its group's worker
+    out.result.hits = mappedArray<Hit>(secondarySlots(pass, cut.first.back()));  // every slot written by its group's worker
     std::vector<TraceResult> parts(groups);
     std::vector<double> makeMs(groups, 0.0);
     std::vector<std::uint64_t> made(groups, 0);
     if (buffers.size() < pool.size()) buffers.resize(pool.size());
-    const Hit notTraced{0.0f, kNotTracedPrim, 0.0f, 0.0f};
     pool.parallelForRethrowing(groups, [&](std::size_t k, unsigned worker) {
         const auto makeStart = Clock::now();
         MadeGroupBuffers& b = buffers[worker];
-        const std::size_t first = cut.first[k], end = cut.first[k + 1];
-        b.rays.clear();
-        b.slots.clear();
-        reserveMapped(b.rays, cut.raysAtMost(k));
-        reserveMapped(b.slots, cut.raysAtMost(k));
-        secondaryRaysOfRange(
-            pass, first, end, primaryHits.data(), [&](std::size_t i) -> const Ray& { return (*primary.rays)[i]; },
-            *primary.triangles, [&](std::uint32_t slot, const Ray& ray) {
-                b.rays.push_back(ray);
-                b.slots.push_back(slot);
-            });
+        makeGroupRays(primary, primaryHits, pass, cut, k, b, nullptr);
         makeMs[k] = msSince(makeStart);
         made[k] = b.rays.size();
-        // The group's slots are its primary rays' (slot = primary index * raysPerHit + sample).
-        Hit* const slots = out.result.hits.data();
-        std::fill(slots + first * pass.raysPerHit, slots + end * pass.raysPerHit, notTraced);
-        if (b.rays.empty()) return;
-        TraceResult part = traceSequential(passFrame(primary, b.rays), dacrt);
-        for (std::size_t i = 0; i < b.rays.size(); ++i) slots[b.slots[i]] = part.hits[i];
-        part.hits = {};
-        parts[k] = std::move(part);
+        parts[k] = traceGroupToSlots(primary, pass, cut, k, b, nullptr, options.dacrt, out.result.hits.data());
     });
     const double wallMs = msSince(start);
     double makeSum = 0.0;
@@ -134,6 +153,109 @@ MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit
     out.result.phases.makeRays = makeSum / double(workers);
     out.result.phases.step1 = std::max(0.0, wallMs - *out.result.phases.makeRays);
     return out;
+}
+
+// The groups' rays one after another in slot order: the array makeSecondaryRays makes.
+SecondaryRays groupsInOrder(const std::vector<MadeGroupBuffers>& buffers, std::size_t groups, std::uint64_t slotCount) {
+    SecondaryRays rays;
+    rays.slotCount = slotCount;
+    std::size_t total = 0;
+    for (std::size_t k = 0; k < groups; ++k) total += buffers[k].rays.size();
+    reserveMapped(rays.rays, total);
+    reserveMapped(rays.slots, total);
+    for (std::size_t k = 0; k < groups; ++k) {
+        rays.rays.insert(rays.rays.end(), buffers[k].rays.begin(), buffers[k].rays.end());
+        rays.slots.insert(rays.slots.end(), buffers[k].slots.begin(), buffers[k].slots.end());
+    }
+    return rays;
+}
+
+// A shadow pass: every group made first (each surveying its rays for the cull's back-face
+// tests), then the cull from the surveys, then the groups traced over the triangles it keeps.
+MadePass traceShadowGroups(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
+                           const SecondaryPass& pass, const MadeGroups& cut, const TraceOptions& options,
+                           ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, PassCull& cull,
+                           const PlanHook& onPlan) {
+    MadePass out;
+    const std::size_t groups = cut.count();
+    const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), groups));
+    if (buffers.size() < groups) buffers.resize(groups);
+    std::vector<RaySurvey> surveys(groups);
+    const auto start = Clock::now();
+    pool.parallelForRethrowing(groups, [&](std::size_t k, unsigned) {
+        makeGroupRays(primary, primaryHits, pass, cut, k, buffers[k], &surveys[k]);
+    });
+    const double makeWallMs = msSince(start);
+    RaySurvey survey;
+    std::size_t largest = 0;
+    for (std::size_t k = 0; k < groups; ++k) {
+        survey.merge(surveys[k]);
+        largest = std::max(largest, buffers[k].rays.size());
+    }
+    out.rays = survey.rays;
+
+    const auto cullStart = Clock::now();
+    const FrameGeometry unmade = unmadePassFrame(primary);
+    cullFromSurvey(unmade, survey, options.skips, pool, cull);
+    const std::size_t traced = cull.skips.applied ? cull.skips.traced.size() : primary.triangles->size();
+    // Where the rays made are few enough for the grid to pay, or fewer than the triangles kept
+    // (subtrees), the pass goes on as its rays made first would: from their array.
+    if (passCullMayDrop(survey.rays, primary.triangles->size(), false, options.skips) ||
+        cpuTracesAsSubtrees(survey.rays, traced, HitQuery::Any, options, pool.size())) {
+        out.unmade = groupsInOrder(buffers, groups, secondarySlots(pass, cut.first.back()));
+        out.makeMs = makeWallMs;
+        return out;
+    }
+    const FrameGeometry culled = cull.skips.applied ? withSkips(unmade, cull.skips) : unmade;
+    MemoryPlan plan = groupsTracePlan(culled, options.skips, cull, largest, groups, workers, options.dacrt,
+                                      "before the pass's cull, then traced as a sequential DACRT: no array of the pass's rays");
+    const double cullMs = msSince(cullStart);
+    if (onPlan && !onPlan(plan)) return out;
+
+    const auto traceStart = Clock::now();
+    out.result.hits = mappedArray<Hit>(secondarySlots(pass, cut.first.back()));
+    std::vector<TraceResult> parts(groups);
+    const TriangleSkips* skips = cull.skips.applied ? &cull.skips : nullptr;
+    pool.parallelForRethrowing(groups, [&](std::size_t k, unsigned) {
+        parts[k] = traceGroupToSlots(primary, pass, cut, k, buffers[k], skips, options.dacrt, out.result.hits.data());
+    });
+    const double traceMs = msSince(traceStart);
+    for (const TraceResult& part : parts) out.result.counters.addTrace(part.counters);
+    out.result.memory = std::move(plan);
+    out.result.threads = workers;
+    out.result.regions = 1;
+    // Making, the cull and the trace one after another, each on every worker.
+    out.result.phases.makeRays = makeWallMs;
+    out.result.phases.skips = cullMs;
+    out.result.phases.step1 = traceMs;
+    return out;
+}
+
+}  // namespace
+
+MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
+                             const SecondaryPass& pass, const PassRayCounts& counts, const TraceOptions& options,
+                             ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, PassCull& cull,
+                             const PlanHook& onPlan) {
+    const MadeGroups cut = madeGroups(counts, primaryHits, pass.raysPerHit, primary.triangles->size(), pool.size());
+    const std::size_t groups = cut.count();
+    const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), groups));
+    std::size_t largest = 0;
+    for (std::size_t k = 0; k < groups; ++k) largest = std::max(largest, cut.raysAtMost(k));
+    const bool shadow = pass.kind == shared::kPassShadow;
+    // What is made, from the counts, before any ray is: a shadow pass keeps every group's rays
+    // until its cull has surveyed them all; an occlusion pass one group a worker.
+    MemoryPlan making;
+    making.add("hits per slot", secondarySlots(pass, counts.primaryRays) * sizeof(Hit));
+    if (shadow)
+        making.add("rays and slots of every group, made before the pass's cull (at most)",
+                   std::uint64_t(counts.total()) * (sizeof(Ray) + sizeof(std::uint32_t)));
+    else
+        making.add("rays and slots of the group being made (x" + std::to_string(workers) + " workers, at most)",
+                   std::uint64_t(largest) * (sizeof(Ray) + sizeof(std::uint32_t)) * workers);
+    if (onPlan && !onPlan(making)) return {};
+    return shadow ? traceShadowGroups(primary, primaryHits, pass, cut, options, pool, buffers, cull, onPlan)
+                  : traceOcclusionGroups(primary, primaryHits, pass, cut, options, pool, buffers, onPlan);
 }
 
 }  // namespace dacrt

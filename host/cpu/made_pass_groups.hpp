@@ -1,16 +1,21 @@
 #pragma once
-// An occlusion pass made and traced in groups side by side, as a renderer on a BVH makes its
+// A secondary pass made and traced in groups side by side, as a renderer on a BVH makes its
 // rays in its tracing loop: each worker makes the rays of a run of primary pixels into arrays of
-// its own, traces them at once as a sequential DACRT, and writes each answer to its slot. No
-// array of the pass's rays is made, copied into groups or scanned for the plan, and no array of
-// its hits is gathered before the slots are filled (docs/benchmarks.md, "Occlusion rays made
-// where they are traced, a pass's own triangle limit").
+// its own and traces them as a sequential DACRT, writing each answer to its slot. An occlusion
+// pass's worker traces its group as soon as it is made; a shadow pass's groups are all made
+// first, each surveying its rays for the pass cull's back-face tests (RaySurvey), then culled
+// once from the surveys and traced. No array of the pass's rays is made, copied into groups or
+// scanned (for the plan or the cull), and no array of its hits is gathered before the slots
+// are filled (docs/benchmarks.md, "Occlusion rays made where they are traced, a pass's own
+// triangle limit", and "Shadow rays made where they are traced").
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/thread_pool.hpp"
 #include "cpu/frame_geometry.hpp"
 #include "cpu/options.hpp"
+#include "cpu/pass_cull.hpp"
 #include "cpu/secondary_rays.hpp"
 #include "cpu/trace_result.hpp"
 
@@ -23,11 +28,12 @@ struct MadeGroupBuffers {
 };
 
 // Whether the cpu backend makes and traces a pass of at most raysAtMost rays over `triangles`
-// triangles so: an occlusion pass (its rays go every way: the pass cull's back-face test needs
-// a shared direction or end) in batches (RayGrouping::Batches), on more than one worker without
-// regions asked for, which the pass cull's grid would not survey and which is not traced as
-// subtrees (cpuTracesAsSubtrees: fewer rays than triangles). Elsewhere the pass's rays are made
-// first, then traced (BackendDispatcher::traceSecondary).
+// triangles so: an occlusion or shadow pass in batches (RayGrouping::Batches), on more than one
+// worker without regions asked for, which the pass cull's grid would not survey and which is
+// not traced as subtrees (cpuTracesAsSubtrees: fewer rays than triangles), both judged from the
+// most rays it can make. Elsewhere the pass's rays are made first, then traced
+// (BackendDispatcher::traceSecondary); so is a shadow pass whose rays, once made, are few
+// enough for either (MadePass::unmade).
 bool tracesMadeSideBySide(const SecondaryPass& pass, std::uint64_t raysAtMost, std::size_t triangles,
                           const TraceOptions& options, unsigned workers);
 
@@ -48,15 +54,23 @@ MadeGroups madeGroups(const PassRayCounts& counts, const std::vector<Hit>& prima
 struct MadePass {
     TraceResult result;  // hits per slot (hitsPerSlot's), the groups' counters summed
     std::uint64_t rays = 0;
+    // A shadow pass whose rays, once made, are few enough for the cull's grid or for subtrees:
+    // its rays in slot order (makeSecondaryRays'), untraced, and how long making them took.
+    std::optional<SecondaryRays> unmade;
+    double makeMs = 0.0;
 };
 
 // The pass made and traced as tracesMadeSideBySide says, on the pool's workers (buffers: one
-// each, kept for the next pass). onPlan sees the plan of what is made (the hits per slot, each
-// worker's group) and then of the trace (each worker's sequential DACRT of the largest group,
-// from the counts), both before any ray is made. The hits are cpu-seq's visibility, bit for
-// bit (the rays are makeSecondaryRays', traced for any hit).
+// a worker for an occlusion pass, one a group for a shadow pass; kept for the next pass; cull:
+// the shadow pass's, its buffers reused). onPlan sees the plan of what is made (the hits per
+// slot, and each worker's group or every group's rays), from the counts before any ray is made,
+// then the plan of the trace (the cull's lines, each worker's sequential DACRT of the largest
+// group): an occlusion pass's from the counts too, a shadow pass's after its cull. The hits are
+// cpu-seq's visibility, bit for bit (the rays are makeSecondaryRays', traced for any hit, over
+// the triangles the cull of their array would keep: cullFromSurvey).
 MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit>& primaryHits,
                              const SecondaryPass& pass, const PassRayCounts& counts, const TraceOptions& options,
-                             ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, const PlanHook& onPlan);
+                             ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, PassCull& cull,
+                             const PlanHook& onPlan);
 
 }  // namespace dacrt

@@ -51,17 +51,6 @@ Interval clipped(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi) {
     return iv;
 }
 
-// A box of points in float64.
-struct PointBox {
-    glm::dvec3 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
-    void extend(const glm::dvec3& p) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-    void extend(const PointBox& b) { extend(b.lo), extend(b.hi); }
-    double diagonal() const { return glm::length(hi - lo); }
-};
-
 // Calls scan(begin, end, c) for the chunks c of a pass over `count` rays (up to 64, of at least
 // 4096 rays) on the pool's threads, or as one chunk on the calling thread without a pool.
 // Returns how many chunks there are.
@@ -108,6 +97,16 @@ struct SharedEnd {
     bool shared = false;
     PointBox ends, origins;
 };
+
+// The shared end of rays whose ends' box is `end.ends`: shared, the box a float64 step wider on
+// every side, so that it holds the exact ends (each is one rounding of exact terms: tmax dir is
+// exact in float64).
+SharedEnd endsShared(SharedEnd end) {
+    end.shared = true;
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) end.ends.lo[a] = std::nextafter(end.ends.lo[a], -inf), end.ends.hi[a] = std::nextafter(end.ends.hi[a], inf);
+    return end;
+}
 SharedEnd raysShareEnd(std::span<const Ray> rays, const Box& sceneBox, ThreadPool* pool) {
     SharedEnd out;
     const float tmax = rays.front().tmax;
@@ -129,11 +128,24 @@ SharedEnd raysShareEnd(std::span<const Ray> rays, const Box& sceneBox, ThreadPoo
         parts[c] = part;
     });
     if (!shared.load()) return out;
-    out.shared = true;
     for (std::size_t c = 0; c < chunks; ++c) out.ends.extend(parts[c].ends), out.origins.extend(parts[c].origins);
-    constexpr double inf = std::numeric_limits<double>::infinity();
-    for (int a = 0; a < 3; ++a) out.ends.lo[a] = std::nextafter(out.ends.lo[a], -inf), out.ends.hi[a] = std::nextafter(out.ends.hi[a], inf);
-    return out;
+    return endsShared(out);
+}
+
+// The survey's shared end, as raysShareEnd finds it over the same rays: every ray's tmax the
+// first's and finite, and every end within the spread of the first's on every axis. Rounded
+// subtraction is monotone, so the ends farthest from the first on an axis are the box's faces:
+// the faces within the spread put every end within it.
+SharedEnd sharedEndOf(const RaySurvey& survey, const Box& sceneBox) {
+    SharedEnd out;
+    if (survey.rays == 0 || !survey.sameTmax || !(survey.firstTmax < kNoHitT)) return out;
+    const double spread = kEndSpread * glm::length(glm::dvec3(sceneBox.hi) - glm::dvec3(sceneBox.lo));
+    const glm::dvec3 first = glm::dvec3(survey.firstOrigin) + double(survey.firstTmax) * glm::dvec3(survey.firstDir);
+    for (int a = 0; a < 3; ++a)
+        if (!(survey.ends.hi[a] - first[a] <= spread) || !(first[a] - survey.ends.lo[a] <= spread)) return out;
+    out.ends = survey.ends;
+    out.origins = survey.origins;
+    return endsShared(out);
 }
 
 // The largest distance between a ray's origin, a point of the scene and a ray's end (where
@@ -340,6 +352,48 @@ bool passCullTests(const std::vector<Ray>& rays, std::size_t triangles, const Bo
     // The first rays only, on this thread: cullForPass asks every one.
     const std::span<const Ray> first(rays.data(), std::min<std::size_t>(rays.size(), 64));
     return raysShareDirection(first, nullptr) || raysShareEnd(first, sceneBox, nullptr).shared;
+}
+
+void RaySurvey::add(const Ray& ray) {
+    if (rays == 0) {
+        firstOrigin = ray.origin;
+        firstDir = ray.dir;
+        firstTmax = ray.tmax;
+    } else {
+        sameDirection = sameDirection && std::memcmp(&ray.dir, &firstDir, sizeof(Ray::dir)) == 0;
+        sameTmax = sameTmax && ray.tmax == firstTmax;
+    }
+    ++rays;
+    const glm::dvec3 origin(ray.origin);
+    origins.extend(origin);
+    ends.extend(origin + double(ray.tmax) * glm::dvec3(ray.dir));
+}
+
+void RaySurvey::merge(const RaySurvey& later) {
+    if (later.rays == 0) return;
+    if (rays == 0) {
+        *this = later;
+        return;
+    }
+    sameDirection = sameDirection && later.sameDirection && std::memcmp(&later.firstDir, &firstDir, sizeof(Ray::dir)) == 0;
+    sameTmax = sameTmax && later.sameTmax && later.firstTmax == firstTmax;
+    rays += later.rays;
+    origins.extend(later.origins);
+    ends.extend(later.ends);
+}
+
+void cullFromSurvey(const FrameGeometry& g, const RaySurvey& survey, const SkipSwitches& switches, ThreadPool& pool,
+                    PassCull& cull) {
+    cullNothing(cull);
+    if (survey.rays == 0 || g.triangles->empty() || !switches.backFaces) return;
+    cull.directionShared = survey.sameDirection;
+    SharedFacing facing;
+    if (!cull.directionShared) facing.end = sharedEndOf(survey, g.sceneBox);
+    cull.endShared = facing.end.shared;
+    if (!cull.directionShared && !cull.endShared) return;
+    facing.direction = glm::dvec3(survey.firstDir);
+    facing.reach = reachOf(survey.origins, g.sceneBox, facing.end);
+    keepTriangles(g, nullptr, &facing, pool, cull);
 }
 
 void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool, PassCull& cull,

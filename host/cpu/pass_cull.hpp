@@ -8,6 +8,7 @@
 // the margin of its triangle's bounds. Where the rays share one direction (a directional
 // light's shadow rays), single-sided triangles facing away from it are dropped as well.
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/thread_pool.hpp"
@@ -54,6 +55,32 @@ private:
     std::uint64_t* rows_ = nullptr;
 };
 
+// A box of points in float64.
+struct PointBox {
+    glm::dvec3 lo{std::numeric_limits<double>::infinity()}, hi{-std::numeric_limits<double>::infinity()};
+    void extend(const glm::dvec3& p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    void extend(const PointBox& b) { extend(b.lo), extend(b.hi); }
+    double diagonal() const { return glm::length(hi - lo); }
+};
+
+// What the cull's back-face tests read of a pass's rays, gathered ray by ray where they are
+// made (add, in the pass's order; merge, the survey of the rays that follow): the first ray's
+// origin, direction and tmax, whether every ray has that direction and that tmax bit for bit,
+// and the boxes of the origins and of the ends (origin + tmax dir in float64, as the cull's own
+// survey computes them). cullFromSurvey then needs no pass over the rays.
+struct RaySurvey {
+    std::uint64_t rays = 0;
+    glm::vec3 firstOrigin{0.0f}, firstDir{0.0f};
+    float firstTmax = 0.0f;
+    bool sameDirection = true, sameTmax = true;
+    PointBox origins, ends;
+    void add(const Ray& ray);
+    void merge(const RaySurvey& later);
+};
+
 // What a pass's cull keeps, with the buffers it reuses from pass to pass (fresh memory is
 // slow to touch on a VM: a pass must not allocate in proportion to the scene each time).
 struct PassCull {
@@ -78,6 +105,13 @@ struct PassCull {
 // marking them costs a fraction of the pass over the triangles.
 void cullForPass(const FrameGeometry& g, const SkipSwitches& switches, ThreadPool& pool, PassCull& cull,
                  unsigned cellsAlongLongest = 0);
+
+// cullForPass without the grid (the caller has found that it does not pay for the pass's
+// rays), its back-face tests decided from a survey of the rays taken as they were made: the
+// same verdicts as cullForPass's for those rays with the grid off (the survey's boxes and
+// flags are what its passes over the rays find).
+void cullFromSurvey(const FrameGeometry& g, const RaySurvey& survey, const SkipSwitches& switches, ThreadPool& pool,
+                    PassCull& cull);
 
 // Whether cullForPass may test anything for a pass of these rays over `triangles` triangles
 // (the grid pays for itself, or the first rays share a direction or an end): it reads a few of

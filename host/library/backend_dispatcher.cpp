@@ -255,12 +255,18 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
     const RayGrouping grouping = cpuDacrt ? request.trace.dacrt.rayGrouping : RayGrouping::Slots;
     const bool byOctant = grouping == RayGrouping::Octant || grouping == RayGrouping::OctantCalls;
     const PassRayCounts counts = passRayCounts(pass, primaryHits, threadPool);
+    std::optional<SecondaryRays> madeAlready;  // a made pass's rays that go on from their array
+    double makeMs = 0.0;
     if (tracesMadeSideBySide(pass, counts.total(), primary.triangles->size(), passRequest.trace, threadPool.size())) {
         MadePass made = traceMadeSideBySide(primary, primaryHits, pass, counts, passRequest.trace, threadPool,
-                                            madeGroups_, onPlan);
-        out.result = std::move(made.result);
-        out.rays = made.rays;
-        return out;
+                                            madeGroups_, passCull_, onPlan);
+        if (!made.unmade) {
+            out.result = std::move(made.result);
+            out.rays = made.rays;
+            return out;
+        }
+        madeAlready = std::move(made.unmade);
+        makeMs = made.makeMs;
     }
     if (byOctant)  // kept for the next pass
         making.add("rays and slots grouped by octant (at most)", slots * (sizeof(Ray) + sizeof(std::uint32_t)));
@@ -268,8 +274,9 @@ BackendDispatcher::PassTrace BackendDispatcher::traceSecondary(const FrameGeomet
         making.add("the rays of the groups being traced (at most)", slots * sizeof(Ray));  // one, or one a worker
     if (onPlan && !onPlan(making)) return out;
     const auto start = Clock::now();
-    SecondaryRays rays = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, counts, threadPool);
-    const double makeMs = msSince(start);
+    SecondaryRays rays = madeAlready ? std::move(*madeAlready)
+                                     : makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, counts, threadPool);
+    if (!madeAlready) makeMs = msSince(start);
     out.rays = rays.rays.size();
     if (rays.rays.empty()) {  // no surface sends a ray: nothing to plan or trace
         out.result.hits = hitsPerSlot(rays, {}, &threadPool);

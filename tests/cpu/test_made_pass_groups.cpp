@@ -1,13 +1,17 @@
-// An occlusion pass made and traced in groups side by side (made_pass_groups.hpp): which passes
-// go that way, how the primary rays are cut into groups, and that each group's worker makes the
-// rays makeSecondaryRays makes and writes brute force's visibility to every slot.
+// Occlusion and shadow passes made and traced in groups side by side (made_pass_groups.hpp):
+// which passes go that way, how the primary rays are cut into groups, that each group's worker
+// makes the rays makeSecondaryRays makes and writes brute force's visibility to every slot, and
+// that a shadow pass's cull, taken from the groups' surveys, keeps what the cull of its array
+// keeps.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 
 #include "core/thread_pool.hpp"
 #include "cpu/cpu_tracers.hpp"
 #include "cpu/made_pass_groups.hpp"
+#include "cpu/pass_cull.hpp"
 #include "cpu/ray_grouping.hpp"
 #include "support/frames.hpp"
 
@@ -80,7 +84,7 @@ TEST(MadePassGroups, GroupsCutThePrimaryRaysWhereTheBatchesCutTheirRays) {
     expectGroupsCutAtTheBatches(fewGroups, few, pass, rayBatches(fewCounts.total(), passBatchRays(1000), 4));
 }
 
-TEST(MadePassGroups, TakesOcclusionBatchesOnCpuWorkersThatNoCullOrSubtreeTakes) {
+TEST(MadePassGroups, TakesOcclusionAndShadowBatchesOnCpuWorkersThatNoGridOrSubtreeTakes) {
     TraceOptions options;
     options.backend = Backend::Cpu;
     options.dacrt.rayGrouping = RayGrouping::Batches;
@@ -88,7 +92,10 @@ TEST(MadePassGroups, TakesOcclusionBatchesOnCpuWorkersThatNoCullOrSubtreeTakes) 
     EXPECT_TRUE(tracesMadeSideBySide(occlusion, 300000, 12000, options, 2));
     EXPECT_FALSE(tracesMadeSideBySide(occlusion, 300000, 12000, options, 1));  // one worker
     EXPECT_FALSE(tracesMadeSideBySide(occlusion, 1, 12000, options, 2));       // one ray
-    EXPECT_FALSE(tracesMadeSideBySide(pointShadowPass({0.0f, 1.0f, 0.0f}), 300000, 12000, options, 2));
+    // Shadow passes too: their cull's back-face tests read the groups' surveys.
+    EXPECT_TRUE(tracesMadeSideBySide(pointShadowPass({0.0f, 1.0f, 0.0f}), 300000, 12000, options, 2));
+    EXPECT_TRUE(tracesMadeSideBySide(directionalShadowPass({0.2, -1.0, -0.1}), 300000, 12000, options, 2));
+    EXPECT_FALSE(tracesMadeSideBySide(pointShadowPass({0.0f, 1.0f, 0.0f}), 200000, 300000, options, 2));
     // Fewer rays than triangles: subtrees (cpuTracesAsSubtrees) ...
     ASSERT_TRUE(cpuTracesAsSubtrees(200000, 300000, HitQuery::Any, options, 2));
     EXPECT_FALSE(tracesMadeSideBySide(occlusion, 200000, 300000, options, 2));
@@ -142,6 +149,7 @@ TEST(MadePassGroups, EachWorkerWritesBruteForcesVisibilityToItsSlots) {
     for (const unsigned threads : {2u, 3u, 4u}) {
         ThreadPool pool(threads);
         std::vector<MadeGroupBuffers> buffers;  // kept from pass to pass, as the dispatcher keeps them
+        PassCull cull;
         for (const auto& [name, pass] : set.passes) {
             SCOPED_TRACE(name + ", " + std::to_string(threads) + " threads");
             std::uint64_t rays = 0;
@@ -150,7 +158,7 @@ TEST(MadePassGroups, EachWorkerWritesBruteForcesVisibilityToItsSlots) {
             ASSERT_TRUE(tracesMadeSideBySide(pass, counts.total(), primary.triangles->size(), options, threads));
             std::vector<MemoryPlan> plans;
             const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers,
-                                                      [&](const MemoryPlan& p) {
+                                                      cull, [&](const MemoryPlan& p) {
                                                           plans.push_back(p);
                                                           return true;
                                                       });
@@ -186,15 +194,120 @@ TEST(MadePassGroups, APlanRefusedMakesAndTracesNothing) {
     std::vector<MadeGroupBuffers> buffers;
     const SecondaryPass& pass = set.passes.front().second;
     const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
+    PassCull cull;
     for (const int refused : {0, 1}) {
         int asked = 0;
-        const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers,
+        const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers, cull,
                                                   [&](const MemoryPlan&) { return asked++ != refused; });
         EXPECT_EQ(asked, refused + 1);
         EXPECT_TRUE(made.result.hits.empty());
         EXPECT_EQ(made.rays, 0u);
         for (const MadeGroupBuffers& b : buffers) EXPECT_TRUE(b.rays.empty());
     }
+}
+
+// The shapes under a single-sided ceiling of 2 x cells x cells triangles (whose back every
+// upward shadow ray meets) at `width` x 3/4 of it, with shadow passes toward a light above the
+// ceiling, one among the shapes, and a directional light.
+SecondaryPassSet ceilingShadowPasses(int width, int cells = 4) {
+    CameraOptions camera;
+    camera.eye = glm::dvec3(0.5, 0.6, 4.0);
+    std::vector<Mesh> meshes = shapesMeshes();
+    meshes.push_back(grid({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, cells, cells));
+    return SecondaryPassSet("shapes under a ceiling", sceneFromMeshes(meshes, "shapes under a ceiling"), camera,
+                            {{"point light above the ceiling", pointShadowPass({0.3f, 2.0f, 0.4f})},
+                             {"point light among the shapes", pointShadowPass({0.0f, -0.2f, 0.0f})},
+                             {"directional light", directionalShadowPass({0.2, -1.0, -0.1})}},
+                            width, width * 3 / 4);
+}
+
+TEST(MadePassGroups, AShadowPassIsCulledFromItsGroupsSurveysAndTracedWithBruteForcesVisibility) {
+    const SecondaryPassSet set = ceilingShadowPasses(160);
+    const FrameGeometry primary = primaryFrameOf(set);
+    const TraceOptions options = madeSideBySideOptions();
+    SkipSwitches facesOnly;
+    facesOnly.passRays = false;
+    std::size_t traced = 0, droppedByFaces = 0;
+    for (const unsigned threads : {2u, 3u}) {
+        ThreadPool pool(threads);
+        std::vector<MadeGroupBuffers> buffers;
+        PassCull cull;
+        for (const auto& [name, pass] : set.passes) {
+            SCOPED_TRACE(name + ", " + std::to_string(threads) + " threads");
+            std::uint64_t rays = 0;
+            const std::vector<Hit> reference = bruteForcePerSlot(primary, set.primary.hits, pass, pool, rays);
+            const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
+            if (!tracesMadeSideBySide(pass, counts.total(), primary.triangles->size(), options, threads)) continue;
+            std::vector<MemoryPlan> plans;
+            MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers, cull,
+                                                [&](const MemoryPlan& p) {
+                                                    plans.push_back(p);
+                                                    return true;
+                                                });
+            EXPECT_EQ(made.rays, rays);
+            // The cull from the surveys keeps what the cull of the pass's array keeps.
+            const SecondaryRays array = makeSecondaryRays(pass, *primary.rays, set.primary.hits, *primary.triangles, pool);
+            PassCull scanned;
+            cullForPass(passFrame(primary, array.rays), facesOnly, pool, scanned);
+            EXPECT_EQ(cull.endShared, scanned.endShared);
+            EXPECT_EQ(cull.directionShared, scanned.directionShared);
+            EXPECT_EQ(cull.skips.traced, scanned.skips.traced);
+            EXPECT_EQ(cull.skips.backFacing, scanned.skips.backFacing);
+            if (made.unmade) {
+                // Too few rays made for groups (subtrees, or the grid): the array, bit for bit.
+                EXPECT_TRUE(made.result.hits.empty());
+                EXPECT_EQ(made.unmade->slotCount, array.slotCount);
+                EXPECT_EQ(made.unmade->slots, array.slots);
+                ASSERT_EQ(made.unmade->rays.size(), array.rays.size());
+                EXPECT_EQ(std::memcmp(made.unmade->rays.data(), array.rays.data(), array.rays.size() * sizeof(Ray)), 0);
+                continue;
+            }
+            ++traced;
+            droppedByFaces += cull.skips.backFacing;
+            ASSERT_EQ(made.result.hits.size(), reference.size());
+            EXPECT_TRUE(identicalVisibility(reference, made.result.hits));
+            std::size_t untracedApart = 0;
+            for (std::size_t i = 0; i < reference.size(); ++i)
+                untracedApart += (reference[i].prim == kNotTracedPrim) != (made.result.hits[i].prim == kNotTracedPrim);
+            EXPECT_EQ(untracedApart, 0u);
+            // What is made, then (after the cull) the trace, with the cull's lines first.
+            ASSERT_EQ(plans.size(), 2u);
+            ASSERT_GE(plans[1].work.size(), 3u);
+            EXPECT_EQ(plans[1].work[1].name, "skipped: back-facing");
+            EXPECT_EQ(plans[1].work[1].count, cull.skips.backFacing);
+            EXPECT_EQ(plans[1].work.back().name, "ray groups made and traced side by side");
+        }
+    }
+    EXPECT_GT(traced, 0u) << "no shadow pass was traced in made groups: the test proves nothing";
+    EXPECT_GT(droppedByFaces, 0u) << "the cull dropped no back face: the test proves little";
+}
+
+TEST(MadePassGroups, AShadowPassOfFewerRaysThanItsKeptTrianglesGoesOnFromItsArray) {
+    // A ceiling of 80,000 triangles that a light among the shapes sees from behind (the cull
+    // keeps them), over a few thousand shadow rays: subtrees, which take the pass's array.
+    const SecondaryPassSet set = ceilingShadowPasses(128, 200);
+    const FrameGeometry primary = primaryFrameOf(set);
+    const TraceOptions options = madeSideBySideOptions();
+    ThreadPool pool(2);
+    std::vector<MadeGroupBuffers> buffers;
+    PassCull cull;
+    std::size_t unmade = 0;
+    for (const auto& [name, pass] : set.passes) {
+        SCOPED_TRACE(name);
+        const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
+        const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers, cull, {});
+        const SecondaryRays array = makeSecondaryRays(pass, *primary.rays, set.primary.hits, *primary.triangles, pool);
+        const std::size_t kept = cull.skips.applied ? cull.skips.traced.size() : primary.triangles->size();
+        const bool subtrees = cpuTracesAsSubtrees(array.rays.size(), kept, HitQuery::Any, options, 2);
+        EXPECT_EQ(made.unmade.has_value(),
+                  subtrees || passCullMayDrop(array.rays.size(), primary.triangles->size(), false, options.skips));
+        if (!made.unmade) continue;
+        ++unmade;
+        EXPECT_EQ(made.unmade->slots, array.slots);
+        ASSERT_EQ(made.unmade->rays.size(), array.rays.size());
+        EXPECT_EQ(std::memcmp(made.unmade->rays.data(), array.rays.data(), array.rays.size() * sizeof(Ray)), 0);
+    }
+    EXPECT_GT(unmade, 0u) << "every pass was traced in made groups: the test proves nothing";
 }
 
 }  // namespace

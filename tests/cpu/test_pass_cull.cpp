@@ -383,6 +383,85 @@ TEST(PassCull, SharesNoEndWhereTheSegmentsEndApartOrAreWhole) {
     }
 }
 
+namespace {
+
+// The survey of rays as a pass's groups make them: the rays cut at `cuts` (ascending), each
+// piece surveyed ray by ray, then the pieces merged in order (an empty piece among them).
+RaySurvey surveyInPieces(const std::vector<Ray>& rays, std::vector<std::size_t> cuts) {
+    cuts.insert(cuts.begin(), 0);
+    cuts.push_back(rays.size());
+    RaySurvey whole;
+    for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
+        RaySurvey piece;
+        for (std::size_t i = cuts[c]; i < cuts[c + 1]; ++i) piece.add(rays[i]);
+        whole.merge(piece);
+    }
+    return whole;
+}
+
+// cullFromSurvey's verdicts against cullForPass's over the same rays with the grid off: the
+// same tests decided, the same triangles kept, in the same order.
+void expectSurveyGivesTheScansCull(const FrameGeometry& g, const SkipSwitches& switches) {
+    ThreadPool pool(2);
+    PassCull scanned, surveyed;
+    cullForPass(g, switches, pool, scanned);
+    const std::vector<Ray>& rays = *g.rays;
+    for (const std::vector<std::size_t>& cuts :
+         {std::vector<std::size_t>{}, {rays.size() / 7, rays.size() / 7, rays.size() * 4 / 7}, {1}, {rays.size()}}) {
+        cullFromSurvey(g, surveyInPieces(rays, cuts), switches, pool, surveyed);
+        EXPECT_EQ(surveyed.directionShared, scanned.directionShared);
+        EXPECT_EQ(surveyed.endShared, scanned.endShared);
+        EXPECT_FALSE(surveyed.raysTested);
+        EXPECT_EQ(surveyed.skips.applied, scanned.skips.applied);
+        EXPECT_EQ(surveyed.skips.backFacing, scanned.skips.backFacing);
+        EXPECT_EQ(surveyed.skips.traced, scanned.skips.traced);
+    }
+}
+
+}  // namespace
+
+TEST(PassCull, ASurveyTakenAsTheRaysAreMadeGivesTheScansVerdicts) {
+    // The passes of both sets and two directional lights (a shared direction), point lights
+    // (a shared end), occlusion rays (neither), with the back-face test on and off.
+    SkipSwitches facesOnly, none;
+    facesOnly.passRays = false;
+    none.passRays = none.backFaces = false;
+    std::size_t shared = 0, dropped = 0;
+    SecondaryPassSet shapes = shapesSecondaryPasses(), ceiling = shapesUnderACeilingPasses();
+    for (SecondaryPassSet* set : {&shapes, &ceiling}) {
+        set->passes.push_back({"directional, from above", directionalShadowPass({0.2, -1.0, -0.1})});
+        set->passes.push_back({"directional, grazing", directionalShadowPass({1.0, -0.05, 0.0})});
+        for (const auto& [name, p] : set->passes) {
+            SCOPED_TRACE(set->name + ": " + name);
+            const PassFrame pass(set->frame, set->primary.hits, p);
+            ASSERT_GT(pass.rays.rays.size(), 10u);
+            expectSurveyGivesTheScansCull(pass.geometry, facesOnly);
+            expectSurveyGivesTheScansCull(pass.geometry, none);
+            const PassCull cull = cullOf(pass.geometry, facesOnly);
+            shared += cull.directionShared || cull.endShared;
+            dropped += cull.skips.backFacing;
+        }
+    }
+    EXPECT_GT(shared, 0u);
+    EXPECT_GT(dropped, 0u) << "no back face dropped: the comparison proves little";
+    // Segments that end at one light but one (a longer segment, or a whole ray), and ends one
+    // spread apart: the survey must refuse the shared end where the scan does.
+    const glm::vec3 light(0.0f, 10.0f, 0.0f);
+    const std::vector<Triangle> tris{Triangle{{-5, 12, -5}, 1, {5, 12, -5}, 0, {0, 12, 5}, 0}};
+    for (float tmaxOfOne : {1.0f, 1.0f + 0x1p-20f, 2.5f, kNoHitT}) {
+        for (std::size_t odd : {std::size_t(0), std::size_t(25), std::size_t(49)}) {
+            SCOPED_TRACE("ray " + std::to_string(odd) + " ends at t = " + std::to_string(tmaxOfOne));
+            std::vector<Ray> rays;
+            for (std::size_t i = 0; i < 50; ++i) {
+                const glm::vec3 origin(float(i % 7) - 3.0f, 0.0f, float(i % 5) - 2.0f);
+                rays.push_back(shared::segmentRay(origin, light - origin, i == odd ? tmaxOfOne : 1.0f));
+            }
+            const FacesOnlyPass pass(tris, rays);
+            expectSurveyGivesTheScansCull(pass.geometry, facesOnly);
+        }
+    }
+}
+
 TEST(PassCull, FacesTowardEndsAsksEveryPointOfTheEndBox) {
     // n = (1, 1, 1): a box whose centre lies in front of the plane x + y + z = 0 but whose
     // lowest corner lies behind it keeps the triangle; a box wholly in front drops it.

@@ -51,9 +51,10 @@ void expectEveryGroupingAgrees(const SecondaryPassSet& set) {
                 EXPECT_FALSE(whole);
                 const bool sideBySide = backend == Backend::Cpu && regions == 0 && !whole &&
                                         (grouping == RayGrouping::Batches || grouping == RayGrouping::OctantCalls);
-                // An occlusion pass's batches are made by the workers that trace them
-                // (made_pass_groups.hpp); every other pass's groups are its made rays'.
-                const bool made = sideBySide && grouping == RayGrouping::Batches && pass.kind == shared::kPassOcclusion;
+                // Batches are made by the workers that trace them (made_pass_groups.hpp; a
+                // shadow pass's after its cull, from their surveys); octants are the made
+                // rays' groups.
+                const bool made = sideBySide && grouping == RayGrouping::Batches;
                 const std::string lineName = made ? "ray groups made and traced side by side" : "ray groups side by side";
                 const auto line = std::find_if(t.result.memory.work.begin(), t.result.memory.work.end(),
                                                [&](const WorkLine& w) { return w.name == lineName; });
