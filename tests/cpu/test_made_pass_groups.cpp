@@ -121,6 +121,46 @@ std::vector<Hit> bruteForcePerSlot(const FrameGeometry& primary, const std::vect
     return hitsPerSlot(made, brute.hits, &pool);
 }
 
+// The slots brute force's: the same size, the same visibility, untraced where it is.
+void expectBruteForcesSlots(const std::vector<Hit>& reference, const std::vector<Hit>& slots) {
+    ASSERT_EQ(slots.size(), reference.size());
+    EXPECT_TRUE(identicalVisibility(reference, slots));
+    std::size_t untracedApart = 0;
+    for (std::size_t i = 0; i < reference.size(); ++i)
+        untracedApart += (reference[i].prim == kNotTracedPrim) != (slots[i].prim == kNotTracedPrim);
+    EXPECT_EQ(untracedApart, 0u);
+}
+
+// The rays and slots makeSecondaryRays' array holds, bit for bit.
+void expectTheArray(const SecondaryRays& rays, const SecondaryRays& array) {
+    EXPECT_EQ(rays.slotCount, array.slotCount);
+    EXPECT_EQ(rays.slots, array.slots);
+    ASSERT_EQ(rays.rays.size(), array.rays.size());
+    EXPECT_EQ(std::memcmp(rays.rays.data(), array.rays.data(), array.rays.size() * sizeof(Ray)), 0);
+}
+
+// A pass made and traced on the pool's workers, its plans kept, beside brute force's answer per
+// slot and the rays makeSecondaryRays makes (rays).
+struct MadeRun {
+    std::vector<Hit> reference;
+    std::uint64_t rays = 0;
+    PassRayCounts counts;
+    std::vector<MemoryPlan> plans;
+    MadePass made;
+};
+MadeRun runMade(const FrameGeometry& primary, const std::vector<Hit>& primaryHits, const SecondaryPass& pass,
+                const TraceOptions& options, ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, PassCull& cull) {
+    MadeRun run;
+    run.reference = bruteForcePerSlot(primary, primaryHits, pass, pool, run.rays);
+    run.counts = passRayCounts(pass, primaryHits, pool);
+    run.made = traceMadeSideBySide(primary, primaryHits, pass, run.counts, options, pool, buffers, cull,
+                                   [&](const MemoryPlan& p) {
+                                       run.plans.push_back(p);
+                                       return true;
+                                   });
+    return run;
+}
+
 // The shapes' occlusion passes at 96x72.
 SecondaryPassSet shapesOcclusionPasses() {
     CameraOptions camera;
@@ -152,23 +192,13 @@ TEST(MadePassGroups, EachWorkerWritesBruteForcesVisibilityToItsSlots) {
         PassCull cull;
         for (const auto& [name, pass] : set.passes) {
             SCOPED_TRACE(name + ", " + std::to_string(threads) + " threads");
-            std::uint64_t rays = 0;
-            const std::vector<Hit> reference = bruteForcePerSlot(primary, set.primary.hits, pass, pool, rays);
-            const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
+            const MadeRun run = runMade(primary, set.primary.hits, pass, options, pool, buffers, cull);
+            const PassRayCounts& counts = run.counts;
+            const std::vector<MemoryPlan>& plans = run.plans;
+            const MadePass& made = run.made;
             ASSERT_TRUE(tracesMadeSideBySide(pass, counts.total(), primary.triangles->size(), options, threads));
-            std::vector<MemoryPlan> plans;
-            const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers,
-                                                      cull, [&](const MemoryPlan& p) {
-                                                          plans.push_back(p);
-                                                          return true;
-                                                      });
-            EXPECT_EQ(made.rays, rays);
-            ASSERT_EQ(made.result.hits.size(), reference.size());
-            EXPECT_TRUE(identicalVisibility(reference, made.result.hits));
-            std::size_t untracedApart = 0;
-            for (std::size_t i = 0; i < reference.size(); ++i)
-                untracedApart += (reference[i].prim == kNotTracedPrim) != (made.result.hits[i].prim == kNotTracedPrim);
-            EXPECT_EQ(untracedApart, 0u);
+            EXPECT_EQ(made.rays, run.rays);
+            expectBruteForcesSlots(run.reference, made.result.hits);
             // The plans: what is made, then the trace, whose last line counts the groups.
             ASSERT_EQ(plans.size(), 2u);
             const std::size_t groups = madeGroups(counts, set.primary.hits, pass.raysPerHit, primary.triangles->size(), threads).count();
@@ -206,23 +236,31 @@ TEST(MadePassGroups, APlanRefusedMakesAndTracesNothing) {
     }
 }
 
-// The shapes under a single-sided ceiling of 2 x cells x cells triangles (whose back every
-// upward shadow ray meets) at `width` x 3/4 of it, with shadow passes toward a light above the
-// ceiling, one among the shapes, and a directional light.
-SecondaryPassSet ceilingShadowPasses(int width, int cells = 4) {
-    CameraOptions camera;
-    camera.eye = glm::dvec3(0.5, 0.6, 4.0);
+// The shapes under a single-sided ceiling of 2 x cells x cells triangles, whose back every
+// upward shadow ray meets, seen from below it.
+Scene shapesUnderACeiling(int cells) {
     std::vector<Mesh> meshes = shapesMeshes();
     meshes.push_back(grid({-2, 1, 2}, {4, 0, 0}, {0, 0, -4}, cells, cells));
-    return SecondaryPassSet("shapes under a ceiling", sceneFromMeshes(meshes, "shapes under a ceiling"), camera,
-                            {{"point light above the ceiling", pointShadowPass({0.3f, 2.0f, 0.4f})},
-                             {"point light among the shapes", pointShadowPass({0.0f, -0.2f, 0.0f})},
-                             {"directional light", directionalShadowPass({0.2, -1.0, -0.1})}},
-                            width, width * 3 / 4);
+    return sceneFromMeshes(meshes, "shapes under a ceiling");
+}
+CameraOptions underTheCeiling() {
+    CameraOptions camera;
+    camera.eye = glm::dvec3(0.5, 0.6, 4.0);
+    return camera;
+}
+// Shadow passes toward a light above the ceiling, one among the shapes and a directional light.
+std::vector<std::pair<std::string, SecondaryPass>> ceilingShadowPasses() {
+    return {{"point light above the ceiling", pointShadowPass({0.3f, 2.0f, 0.4f})},
+            {"point light among the shapes", pointShadowPass({0.0f, -0.2f, 0.0f})},
+            {"directional light", directionalShadowPass({0.2, -1.0, -0.1})}};
+}
+SecondaryPassSet ceilingShadowPassSet() {
+    return SecondaryPassSet("shapes under a ceiling", shapesUnderACeiling(4), underTheCeiling(), ceilingShadowPasses(),
+                            160, 120);
 }
 
 TEST(MadePassGroups, AShadowPassIsCulledFromItsGroupsSurveysAndTracedWithBruteForcesVisibility) {
-    const SecondaryPassSet set = ceilingShadowPasses(160);
+    const SecondaryPassSet set = ceilingShadowPassSet();
     const FrameGeometry primary = primaryFrameOf(set);
     const TraceOptions options = madeSideBySideOptions();
     SkipSwitches facesOnly;
@@ -234,17 +272,13 @@ TEST(MadePassGroups, AShadowPassIsCulledFromItsGroupsSurveysAndTracedWithBruteFo
         PassCull cull;
         for (const auto& [name, pass] : set.passes) {
             SCOPED_TRACE(name + ", " + std::to_string(threads) + " threads");
-            std::uint64_t rays = 0;
-            const std::vector<Hit> reference = bruteForcePerSlot(primary, set.primary.hits, pass, pool, rays);
-            const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
-            if (!tracesMadeSideBySide(pass, counts.total(), primary.triangles->size(), options, threads)) continue;
-            std::vector<MemoryPlan> plans;
-            MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers, cull,
-                                                [&](const MemoryPlan& p) {
-                                                    plans.push_back(p);
-                                                    return true;
-                                                });
-            EXPECT_EQ(made.rays, rays);
+            if (!tracesMadeSideBySide(pass, passRayCounts(pass, set.primary.hits, pool).total(), primary.triangles->size(),
+                                      options, threads))
+                continue;
+            const MadeRun run = runMade(primary, set.primary.hits, pass, options, pool, buffers, cull);
+            const std::vector<MemoryPlan>& plans = run.plans;
+            const MadePass& made = run.made;
+            EXPECT_EQ(made.rays, run.rays);
             // The cull from the surveys keeps what the cull of the pass's array keeps.
             const SecondaryRays array = makeSecondaryRays(pass, *primary.rays, set.primary.hits, *primary.triangles, pool);
             PassCull scanned;
@@ -256,20 +290,12 @@ TEST(MadePassGroups, AShadowPassIsCulledFromItsGroupsSurveysAndTracedWithBruteFo
             if (made.unmade) {
                 // Too few rays made for groups (subtrees, or the grid): the array, bit for bit.
                 EXPECT_TRUE(made.result.hits.empty());
-                EXPECT_EQ(made.unmade->slotCount, array.slotCount);
-                EXPECT_EQ(made.unmade->slots, array.slots);
-                ASSERT_EQ(made.unmade->rays.size(), array.rays.size());
-                EXPECT_EQ(std::memcmp(made.unmade->rays.data(), array.rays.data(), array.rays.size() * sizeof(Ray)), 0);
+                expectTheArray(*made.unmade, array);
                 continue;
             }
             ++traced;
             droppedByFaces += cull.skips.backFacing;
-            ASSERT_EQ(made.result.hits.size(), reference.size());
-            EXPECT_TRUE(identicalVisibility(reference, made.result.hits));
-            std::size_t untracedApart = 0;
-            for (std::size_t i = 0; i < reference.size(); ++i)
-                untracedApart += (reference[i].prim == kNotTracedPrim) != (made.result.hits[i].prim == kNotTracedPrim);
-            EXPECT_EQ(untracedApart, 0u);
+            expectBruteForcesSlots(run.reference, made.result.hits);
             // What is made, then (after the cull) the trace, with the cull's lines first.
             ASSERT_EQ(plans.size(), 2u);
             ASSERT_GE(plans[1].work.size(), 3u);
@@ -282,30 +308,56 @@ TEST(MadePassGroups, AShadowPassIsCulledFromItsGroupsSurveysAndTracedWithBruteFo
     EXPECT_GT(droppedByFaces, 0u) << "the cull dropped no back face: the test proves little";
 }
 
+TEST(MadePassGroups, AShadowPassRefusedAtItsFirstPlanMakesNothingAndAtItsSecondTracesNothing) {
+    // The plan of what is made comes before any ray; the trace's after the cull, before any trace.
+    const SecondaryPassSet set = ceilingShadowPassSet();
+    const FrameGeometry primary = primaryFrameOf(set);
+    const TraceOptions options = madeSideBySideOptions();
+    ThreadPool pool(2);
+    const SecondaryPass& pass = set.passes.front().second;
+    const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
+    ASSERT_TRUE(tracesMadeSideBySide(pass, counts.total(), primary.triangles->size(), options, 2));
+    for (const int refused : {0, 1}) {
+        std::vector<MadeGroupBuffers> buffers;
+        PassCull cull;
+        int asked = 0;
+        const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers, cull,
+                                                  [&](const MemoryPlan&) { return asked++ != refused; });
+        EXPECT_EQ(asked, refused + 1);
+        EXPECT_TRUE(made.result.hits.empty());
+        EXPECT_FALSE(made.unmade.has_value());
+        std::size_t rays = 0;
+        for (const MadeGroupBuffers& b : buffers) rays += b.rays.size();
+        if (refused == 0) EXPECT_EQ(rays, 0u);
+        else EXPECT_GT(rays, 0u) << "the cull needs every ray made before the trace's plan";
+    }
+}
+
 TEST(MadePassGroups, AShadowPassOfFewerRaysThanItsKeptTrianglesGoesOnFromItsArray) {
     // A ceiling of 80,000 triangles that a light among the shapes sees from behind (the cull
-    // keeps them), over a few thousand shadow rays: subtrees, which take the pass's array.
-    const SecondaryPassSet set = ceilingShadowPasses(128, 200);
-    const FrameGeometry primary = primaryFrameOf(set);
+    // keeps them), over a few thousand shadow rays: subtrees, which take the pass's array. The
+    // primary hits are cpu-seq's (brute force's, faster over so many triangles).
+    const Frame frame(shapesUnderACeiling(200), 128, 96, underTheCeiling());
+    const std::vector<Hit> primaryHits = frame.trace(Backend::CpuSeq).hits;
+    const FrameGeometry primary =
+        frameGeometry(frame.scene.triangles, frame.bounds, frame.rays, sceneBounds(frame.scene.triangles));
     const TraceOptions options = madeSideBySideOptions();
     ThreadPool pool(2);
     std::vector<MadeGroupBuffers> buffers;
     PassCull cull;
     std::size_t unmade = 0;
-    for (const auto& [name, pass] : set.passes) {
+    for (const auto& [name, pass] : ceilingShadowPasses()) {
         SCOPED_TRACE(name);
-        const PassRayCounts counts = passRayCounts(pass, set.primary.hits, pool);
-        const MadePass made = traceMadeSideBySide(primary, set.primary.hits, pass, counts, options, pool, buffers, cull, {});
-        const SecondaryRays array = makeSecondaryRays(pass, *primary.rays, set.primary.hits, *primary.triangles, pool);
+        const PassRayCounts counts = passRayCounts(pass, primaryHits, pool);
+        const MadePass made = traceMadeSideBySide(primary, primaryHits, pass, counts, options, pool, buffers, cull, {});
+        const SecondaryRays array = makeSecondaryRays(pass, *primary.rays, primaryHits, *primary.triangles, pool);
         const std::size_t kept = cull.skips.applied ? cull.skips.traced.size() : primary.triangles->size();
         const bool subtrees = cpuTracesAsSubtrees(array.rays.size(), kept, HitQuery::Any, options, 2);
         EXPECT_EQ(made.unmade.has_value(),
                   subtrees || passCullMayDrop(array.rays.size(), primary.triangles->size(), false, options.skips));
         if (!made.unmade) continue;
         ++unmade;
-        EXPECT_EQ(made.unmade->slots, array.slots);
-        ASSERT_EQ(made.unmade->rays.size(), array.rays.size());
-        EXPECT_EQ(std::memcmp(made.unmade->rays.data(), array.rays.data(), array.rays.size() * sizeof(Ray)), 0);
+        expectTheArray(*made.unmade, array);
     }
     EXPECT_GT(unmade, 0u) << "every pass was traced in made groups: the test proves nothing";
 }
