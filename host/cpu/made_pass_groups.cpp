@@ -117,11 +117,9 @@ MadePass traceOcclusionGroups(const FrameGeometry& primary, const std::vector<Hi
     MadePass out;
     const std::size_t groups = cut.count();
     const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), groups));
-    std::size_t largest = 0;
-    for (std::size_t k = 0; k < groups; ++k) largest = std::max(largest, cut.raysAtMost(k));
     PassCull none;
     cullNothing(none);
-    MemoryPlan plan = groupsTracePlan(unmadePassFrame(primary), options.skips, none, largest, groups, workers,
+    MemoryPlan plan = groupsTracePlan(unmadePassFrame(primary), options.skips, none, cut.largestAtMost(), groups, workers,
                                       options.dacrt, "and traced at once as a sequential DACRT: no array of the pass's rays");
     if (onPlan && !onPlan(plan)) return out;
 
@@ -238,10 +236,7 @@ MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit
                              ThreadPool& pool, std::vector<MadeGroupBuffers>& buffers, PassCull& cull,
                              const PlanHook& onPlan) {
     const MadeGroups cut = madeGroups(counts, primaryHits, pass.raysPerHit, primary.triangles->size(), pool.size());
-    const std::size_t groups = cut.count();
-    const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), groups));
-    std::size_t largest = 0;
-    for (std::size_t k = 0; k < groups; ++k) largest = std::max(largest, cut.raysAtMost(k));
+    const unsigned workers = unsigned(std::min<std::size_t>(pool.size(), cut.count()));
     const bool shadow = pass.kind == shared::kPassShadow;
     // What is made, from the counts, before any ray is: a shadow pass keeps every group's rays
     // until its cull has surveyed them all; an occlusion pass one group a worker.
@@ -252,7 +247,7 @@ MadePass traceMadeSideBySide(const FrameGeometry& primary, const std::vector<Hit
                    std::uint64_t(counts.total()) * (sizeof(Ray) + sizeof(std::uint32_t)));
     else
         making.add("rays and slots of the group being made (x" + std::to_string(workers) + " workers, at most)",
-                   std::uint64_t(largest) * (sizeof(Ray) + sizeof(std::uint32_t)) * workers);
+                   std::uint64_t(cut.largestAtMost()) * (sizeof(Ray) + sizeof(std::uint32_t)) * workers);
     if (onPlan && !onPlan(making)) return {};
     return shadow ? traceShadowGroups(primary, primaryHits, pass, cut, options, pool, buffers, cull, onPlan)
                   : traceOcclusionGroups(primary, primaryHits, pass, cut, options, pool, buffers, onPlan);

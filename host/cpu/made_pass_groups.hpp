@@ -8,6 +8,7 @@
 // scanned (for the plan or the cull), and no array of its hits is gathered before the slots
 // are filled (docs/benchmarks.md, "Occlusion rays made where they are traced, a pass's own
 // triangle limit", and "Shadow rays made where they are traced").
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -47,6 +48,11 @@ struct MadeGroups {
     std::vector<std::size_t> raysBefore;
     std::size_t count() const { return first.size() - 1; }
     std::size_t raysAtMost(std::size_t k) const { return raysBefore[k + 1] - raysBefore[k]; }
+    std::size_t largestAtMost() const {
+        std::size_t largest = 0;
+        for (std::size_t k = 0; k < count(); ++k) largest = std::max(largest, raysAtMost(k));
+        return largest;
+    }
 };
 MadeGroups madeGroups(const PassRayCounts& counts, const std::vector<Hit>& primaryHits, std::uint32_t raysPerHit,
                       std::size_t triangles, unsigned workers);
