@@ -257,7 +257,8 @@ std::vector<BenchConfig> animationConfigs(Backend b, unsigned hardwareThreads) {
     return out;
 }
 
-// The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes).
+// The source's Table 5.1 (threads, and two regions per thread) and Figure 5.3 (division axes),
+// with the cpu backend's default beside them.
 std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads) {
     std::vector<BenchConfig> out;
     if (b == Backend::CpuSeq) {
@@ -276,6 +277,9 @@ std::vector<BenchConfig> table51Configs(Backend b, unsigned hardwareThreads) {
     };
     const DivisionAxis axes[] = {DivisionAxis::Best, DivisionAxis::X, DivisionAxis::Y, DivisionAxis::Z};
     if (b == Backend::Cpu) {
+        // The backend as it runs by default (image bands on every core, no division), beside
+        // the source's setups of threads and regions.
+        out.push_back(baseConfig(b, hardwareThreads));
         const std::pair<unsigned, unsigned> setups[] = {{1, 1}, {2, 2}, {4, 4}, {1, 2}, {2, 4}, {4, 8}};
         for (const auto& [threads, regions] : setups)
             for (DivisionAxis a : axes) config(threads, regions, a);

@@ -127,8 +127,14 @@ TEST(Bench, Table51SuiteReportsSpeedupsOverSequential) {
                                                  out.args());
     ASSERT_EQ(r.code, 0) << r.output;
     const nlohmann::json j = out.json();
-    EXPECT_EQ(j["rows"].size(), 1u + 6u * 4u);  // sequential, then six thread/region setups by four axes
-    for (const auto& row : j["rows"]) EXPECT_TRUE(row["speedup_over_cpu_seq"].is_number());
+    // sequential, the cpu default, then six thread/region setups by four axes
+    EXPECT_EQ(j["rows"].size(), 1u + 1u + 6u * 4u);
+    std::set<std::string> defaults;
+    for (const auto& row : j["rows"]) {
+        EXPECT_TRUE(row["speedup_over_cpu_seq"].is_number());
+        if (row["default"].get<bool>()) defaults.insert(row["series"].get<std::string>() + " " + row["config"].get<std::string>());
+    }
+    EXPECT_EQ(defaults, (std::set<std::string>{"cpu-seq default", "cpu default"}));
 }
 
 TEST(Bench, PeersSuiteRunsEachDefaultAgainstEveryPeerMode) {
