@@ -22,8 +22,16 @@ tools/mesa25.sh build/dacrt bench $S/dragon.glb --suite peers --backends cpu,gpu
 /usr/bin/python3 tools/bench/plot.py $out/peers_mesa25_dragon.json -o $out/peers_mesa25_dragon.png
 tools/mesa25.sh build/dacrt bench $S/bunny.glb $S/dragon.glb --backends gpu --orbit 4 --repeat 2 \
   --csv $out/gpu_sweep_mesa25.csv --json $out/gpu_sweep_mesa25.json | tee $out/gpu_sweep_mesa25.txt
-"${mesa22[@]}" build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --orbit 4 --repeat 2 \
+# Table 5.1: the cpu backends in a run of their own (a cpu frame after the gpu's frames and
+# their pauses runs slower: docs/benchmarks.md, "Frames after a pause"), then the gpu's rows.
+build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --backends cpu-seq,cpu --orbit 4 --repeat 2 \
   --csv $out/table51.csv --json $out/table51.json | tee $out/table51.txt
+"${mesa22[@]}" build/dacrt bench $S/bunny.glb $S/dragon.glb --suite table51 --orbit 4 --repeat 2 \
+  --csv $out/table51_gpu.csv --json $out/table51_gpu.json | tee $out/table51_gpu.txt
+# What two threads can give here: cpu-seq alone against two copies at once (issue 32, item 3).
+mkdir -p $out/ceiling
+tools/bench/core_ceiling.py build/dacrt $out/ceiling --with-cpu -- $S/bunny.glb $S/dragon.glb scenes/room.glb \
+  --suite passes --ao 4 --orbit 2 --repeat 3 | tee $out/ceiling/ceiling_passes.md
 # A lit frame's passes timed apart (the primary pass, the default key light's shadow pass, 4
 # occlusion rays per hit), each checked against cpu-seq's, on both lavapipes, one camera (the
 # front view): 3 and 10 minutes, the Mesa 25.0.7 run mostly the Bunny's ray queries.
