@@ -3,6 +3,7 @@
 // takes part, so a pool of size 1 runs everything inline.
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
@@ -31,6 +32,7 @@ public:
 private:
     void workerLoop(unsigned worker);
     void drain(unsigned worker);
+    void steerWorkersAwayFromCaller();
 
     std::vector<std::thread> workers_;
     std::mutex mutex_;
@@ -42,6 +44,11 @@ private:
     unsigned busy_ = 0;
     unsigned long generation_ = 0;
     bool stopping_ = false;
+    // Where the workers may run (the process's CPUs when the pool was made), when the last loop
+    // ended, and which workers were steered away from the caller's CPU for their next wake.
+    std::vector<unsigned char> allowedCpus_;  // a cpu_set_t's bytes
+    std::chrono::steady_clock::time_point lastLoopEnd_;
+    std::vector<std::atomic<bool>> steered_;
 };
 
 // Elements per chunk of a frame's passes over its rays, hits or triangles (1 MiB of 64-byte
