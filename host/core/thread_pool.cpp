@@ -10,37 +10,43 @@ namespace dacrt {
 namespace {
 
 // How long the workers may have slept before a loop steers them off the caller's CPU: the
-// slowdown was measured after 30 ms and not after 10 (docs/benchmarks.md).
+// slowdown was measured after sleeps of 30 ms and more, not after 10 (docs/benchmarks.md); a
+// steer costs the caller two system calls a worker, so it is kept to loops after such spells.
 constexpr auto kIdleSpell = std::chrono::milliseconds(5);
 
 }  // namespace
 
-ThreadPool::ThreadPool(unsigned threads) : steered_(std::max(threads, 1u)) {
-    cpu_set_t allowed;
-    CPU_ZERO(&allowed);
-    if (sched_getaffinity(0, sizeof(allowed), &allowed) == 0 && CPU_COUNT(&allowed) > 1) {
-        allowedCpus_.resize(sizeof(allowed));
-        std::memcpy(allowedCpus_.data(), &allowed, sizeof(allowed));
-    }
-    lastLoopEnd_ = std::chrono::steady_clock::now();
-    for (std::atomic<bool>& s : steered_) s.store(false);
+ThreadPool::ThreadPool(unsigned threads)
+    : lastLoopEnd_(std::chrono::steady_clock::now()),
+      cpusBeforeSteer_(std::max(threads, 1u), std::vector<unsigned char>(sizeof(cpu_set_t))),
+      steered_(std::max(threads, 1u)) {
     for (unsigned w = 1; w < std::max(threads, 1u); ++w) workers_.emplace_back([this, w] { workerLoop(w); });
 }
 
 // A loop after an idle spell: a worker that slept long may be woken onto the caller's own CPU,
 // and on a VM whose other vCPUs went idle the guest's scheduler left it there for tens of
 // milliseconds, the loop running on one core (docs/benchmarks.md, "Frames after a pause").
-// Each sleeping worker is allowed every CPU but the caller's for this wake; it takes back the
-// pool's CPUs once running (workerLoop).
+// Each sleeping worker is allowed the CPUs it could run on, but the caller's, for this wake; it
+// takes those CPUs back once running (workerLoop). A worker with no other CPU is left alone, and
+// so is one whose earlier restore failed (it is still flagged, and retries at this wake).
 void ThreadPool::steerWorkersAwayFromCaller() {
-    if (allowedCpus_.empty()) return;
     const int here = sched_getcpu();
-    cpu_set_t away;
-    std::memcpy(&away, allowedCpus_.data(), sizeof(away));
-    if (here < 0 || !CPU_ISSET(here, &away)) return;
-    CPU_CLR(here, &away);
-    for (std::size_t w = 0; w < workers_.size(); ++w)
-        if (pthread_setaffinity_np(workers_[w].native_handle(), sizeof(away), &away) == 0) steered_[w + 1] = true;
+    if (here < 0) return;
+    bool steered = false;
+    for (std::size_t w = 0; w < workers_.size(); ++w) {
+        if (steered_[w + 1]) continue;
+        cpu_set_t before;
+        CPU_ZERO(&before);
+        if (pthread_getaffinity_np(workers_[w].native_handle(), sizeof(before), &before) != 0) continue;
+        cpu_set_t away = before;
+        CPU_CLR(here, &away);
+        if (CPU_COUNT(&away) == 0 || CPU_EQUAL(&away, &before)) continue;
+        std::memcpy(cpusBeforeSteer_[w + 1].data(), &before, sizeof(before));
+        if (pthread_setaffinity_np(workers_[w].native_handle(), sizeof(away), &away) != 0) continue;
+        steered_[w + 1] = true;
+        steered = true;
+    }
+    if (steered) ++steers_;
 }
 
 ThreadPool::~ThreadPool() {
@@ -65,10 +71,10 @@ void ThreadPool::workerLoop(unsigned worker) {
             if (stopping_) return;
             seen = generation_;
         }
-        if (steered_[worker].exchange(false)) {
-            cpu_set_t allowed;
-            std::memcpy(&allowed, allowedCpus_.data(), sizeof(allowed));
-            pthread_setaffinity_np(pthread_self(), sizeof(allowed), &allowed);
+        if (steered_[worker]) {
+            cpu_set_t before;
+            std::memcpy(&before, cpusBeforeSteer_[worker].data(), sizeof(before));
+            if (pthread_setaffinity_np(pthread_self(), sizeof(before), &before) == 0) steered_[worker] = false;
         }
         drain(worker);
         std::lock_guard<std::mutex> lock(mutex_);

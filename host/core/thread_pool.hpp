@@ -6,6 +6,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -21,6 +22,8 @@ public:
     ThreadPool& operator=(const ThreadPool&) = delete;
 
     unsigned size() const { return unsigned(workers_.size()) + 1; }
+    // How many loops so far steered their workers off the caller's CPU (after an idle spell).
+    std::uint64_t steers() const { return steers_; }
 
     // Calls body(index, worker) for every index in [0, count), handing out indices one at a
     // time (dynamic balance); worker is in [0, size()). Returns when all calls are done.
@@ -44,11 +47,13 @@ private:
     unsigned busy_ = 0;
     unsigned long generation_ = 0;
     bool stopping_ = false;
-    // Where the workers may run (the process's CPUs when the pool was made), when the last loop
-    // ended, and which workers were steered away from the caller's CPU for their next wake.
-    std::vector<unsigned char> allowedCpus_;  // a cpu_set_t's bytes
+    // When the last loop ended (read and written by the one thread that calls parallelFor at a
+    // time), and for each worker steered off the caller's CPU for its next wake, the CPUs it
+    // could run on before, which it takes back once running (a cpu_set_t's bytes).
     std::chrono::steady_clock::time_point lastLoopEnd_;
+    std::vector<std::vector<unsigned char>> cpusBeforeSteer_;
     std::vector<std::atomic<bool>> steered_;
+    std::uint64_t steers_ = 0;
 };
 
 // Elements per chunk of a frame's passes over its rays, hits or triangles (1 MiB of 64-byte

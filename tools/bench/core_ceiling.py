@@ -4,7 +4,7 @@
     tools/bench/core_ceiling.py build/dacrt OUT -- SCENES... --suite passes --ao 4 --orbit 2 --repeat 3
 
 runs the bench's `cpu-seq` rows (one thread) alone, then two copies at once, then alone again,
-each writing OUT/<run>.json, and prints per scene and pass the one-thread time alone, the time
+each writing OUT/<run>.json and .csv, and prints per scene and pass the one-thread time alone, the time
 of each copy while the other runs, and the ceiling: 2 x alone / together, what two workers of
 the sequential DACRT with no shared work and nothing to wait for would give over one (the
 faster of the lone runs against the mean of the two copies: the ceiling leans high, never in
@@ -21,14 +21,18 @@ import sys
 
 
 def run_bench(dacrt, bench_args, path, backends="cpu-seq"):
-    cmd = [dacrt, "bench", *bench_args, "--backends", backends, "--json", path]
+    cmd = [dacrt, "bench", *bench_args, "--backends", backends, "--json", path,
+           "--csv", os.path.splitext(path)[0] + ".csv", "--out", os.path.dirname(os.path.abspath(path))]
     return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
 
 def wait_all(procs):
-    for p in procs:
+    for i, p in enumerate(procs):
         _, err = p.communicate()
         if p.returncode != 0:
+            for other in procs[i + 1:]:
+                other.kill()
+                other.wait()
             sys.exit(f"core_ceiling: a bench run failed ({p.returncode}): {err.strip()}")
 
 
@@ -37,14 +41,19 @@ def row_ms(r):
     return r.get("ms_min", r.get("frame_ms_min"))
 
 
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
 def cpu_seq_times(path):
-    j = json.load(open(path))
+    j = load(path)
     return {(r["scene"], r.get("pass", "frame")): row_ms(r) for r in j["rows"]
             if r["series"] == "cpu-seq" and r["default"] and row_ms(r)}
 
 
 def cpu_speedups(path):
-    j = json.load(open(path))
+    j = load(path)
     seq = {(r["scene"], r.get("pass", "frame")): row_ms(r) for r in j["rows"]
            if r["series"] == "cpu-seq" and r["default"]}
     out = {}
@@ -67,8 +76,9 @@ def main():
     split = argv.index("--")
     a = ap.parse_args(argv[:split])
     bench_args = argv[split + 1:]
-    if "--backends" in bench_args or "--json" in bench_args:
-        sys.exit("core_ceiling: the script sets --backends and --json itself")
+    own = ("--backends", "--json", "--csv", "--out")
+    if any(a == o or a.startswith(o + "=") for a in bench_args for o in own):
+        sys.exit("core_ceiling: the script sets --backends, --json, --csv and --out itself")
     os.makedirs(a.out, exist_ok=True)
     path = lambda name: os.path.join(a.out, name + ".json")
     if a.with_cpu:
@@ -87,11 +97,12 @@ def main():
         rule += "---:|"
     print(head)
     print(rule)
-    for key in alone[0]:
+    # The rows every run has (a pass with no time of its own, as the Dragon's shadow pass traced
+    # with its occlusion rays, has none).
+    keys = [k for k in alone[0] if all(k in t for t in alone + together)]
+    for key in keys:
         one = min(t[key] for t in alone)
         two = sum(t[key] for t in together) / len(together)
-        if not one or not two:
-            continue
         line = (f"| {key[0]} | {key[1]} | {alone[0][key]:.1f} / {alone[1][key]:.1f} | "
                 f"{together[0][key]:.1f} / {together[1][key]:.1f} | {2.0 * one / two:.2f}x |")
         if speedups:
