@@ -4,14 +4,15 @@
     tools/bench/core_ceiling.py build/dacrt OUT -- SCENES... --suite passes --ao 4 --orbit 2 --repeat 3
 
 runs the bench's `cpu-seq` rows (one thread) alone, then two copies at once, then alone again,
-each writing OUT/<run>.json and .csv, and prints per scene and pass the one-thread time alone, the time
-of each copy while the other runs, and the ceiling: 2 x alone / together, what two workers of
+each writing OUT/<run>.json and .csv, and prints per scene and pass the one-thread time alone,
+the time of each copy while the other runs, and the ceiling: 2 x alone / together, what two workers of
 the sequential DACRT with no shared work and nothing to wait for would give over one (the
 faster of the lone runs against the mean of the two copies: the ceiling leans high, never in
 the parallel backend's favour). Cores that share caches, memory bandwidth or a physical core (a
 VM's two vCPUs may) put it below 2, and a parallel backend's speedup over `cpu-seq` (issue 32
-asks 1.85x of the `cpu` backend) is bounded by it. With --with-cpu, a run of both backends comes first (OUT/cpu.json), and the `cpu`
-backend's speedups in it (its default rows against its `cpu-seq` rows) are printed beside.
+asks 1.85x of the `cpu` backend) is bounded by it. With --with-cpu, a run of both backends
+comes first (OUT/cpu.json), and the `cpu` backend's speedups in it (its default rows against
+its `cpu-seq` rows) are printed beside.
 """
 import argparse
 import json
@@ -46,22 +47,16 @@ def load(path):
         return json.load(f)
 
 
-def cpu_seq_times(path):
+def default_times(path, series):
+    """The minimum ms of each (scene, pass) of the series' default rows that have a time."""
     j = load(path)
     return {(r["scene"], r.get("pass", "frame")): row_ms(r) for r in j["rows"]
-            if r["series"] == "cpu-seq" and r["default"] and row_ms(r)}
+            if r["series"] == series and r["default"] and row_ms(r)}
 
 
 def cpu_speedups(path):
-    j = load(path)
-    seq = {(r["scene"], r.get("pass", "frame")): row_ms(r) for r in j["rows"]
-           if r["series"] == "cpu-seq" and r["default"]}
-    out = {}
-    for r in j["rows"]:
-        key = (r["scene"], r.get("pass", "frame"))
-        if r["series"] == "cpu" and r["default"] and row_ms(r) and seq.get(key):
-            out[key] = seq[key] / row_ms(r)
-    return out
+    seq, cpu = default_times(path, "cpu-seq"), default_times(path, "cpu")
+    return {key: seq[key] / ms for key, ms in cpu.items() if key in seq}
 
 
 def main():
@@ -77,7 +72,7 @@ def main():
     a = ap.parse_args(argv[:split])
     bench_args = argv[split + 1:]
     own = ("--backends", "--json", "--csv", "--out")
-    if any(a == o or a.startswith(o + "=") for a in bench_args for o in own):
+    if any(arg == o or arg.startswith(o + "=") for arg in bench_args for o in own):
         sys.exit("core_ceiling: the script sets --backends, --json, --csv and --out itself")
     os.makedirs(a.out, exist_ok=True)
     path = lambda name: os.path.join(a.out, name + ".json")
@@ -87,8 +82,8 @@ def main():
     wait_all([run_bench(a.dacrt, bench_args, path("together_1")), run_bench(a.dacrt, bench_args, path("together_2"))])
     wait_all([run_bench(a.dacrt, bench_args, path("alone_2"))])
 
-    alone = [cpu_seq_times(path("alone_1")), cpu_seq_times(path("alone_2"))]
-    together = [cpu_seq_times(path("together_1")), cpu_seq_times(path("together_2"))]
+    alone = [default_times(path(name), "cpu-seq") for name in ("alone_1", "alone_2")]
+    together = [default_times(path(name), "cpu-seq") for name in ("together_1", "together_2")]
     speedups = cpu_speedups(path("cpu")) if a.with_cpu else {}
     head = "| model | pass | cpu-seq alone ms (two runs) | each of two at once ms | ceiling: 2 x alone / together |"
     rule = "|---|---|---:|---:|---:|"
