@@ -40,6 +40,7 @@ std::string optionText(const BenchConfig& c) {
       << " threads=" << c.threads();
     if (d.splitCost != SplitCost::Limits) s << " split_cost=" << toString(d.splitCost);
     if (!d.packets) s << " packets=off";
+    if (!d.tightBoxes && !gpu) s << " tight_boxes=off";
     if (d.packets && d.packetFlush != kPacketFlushDefault) s << " packet_flush=" << d.packetFlush;
     if (d.rayGrouping != DacrtOptions{}.rayGrouping) s << " ray_grouping=" << toString(d.rayGrouping);
     if (d.passTracing != DacrtOptions{}.passTracing) s << " pass_tracing=" << toString(d.passTracing);
@@ -153,6 +154,7 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
             c.options.trace.dacrt.splitCost = SplitCost::RaySampling;
             c.options.trace.dacrt.packets = false;
         });
+        variant("tight-boxes=off", [](BenchConfig& c) { c.options.trace.dacrt.tightBoxes = false; });
     }
     const DacrtOptions defaults = base.options.trace.dacrt.resolvedFor(b);
     variant("packets=off", [](BenchConfig& c) { c.options.trace.dacrt.packets = false; });
@@ -243,6 +245,8 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
     // passes traced together").
     for (PassTracing tracing : {PassTracing::Apart, PassTracing::Together})
         variant("pass-tracing=" + toString(tracing), [tracing](DacrtOptions& d) { d.passTracing = tracing; });
+    // The nodes' own boxes, without the box of their triangles (docs/benchmarks.md, "Tight node boxes").
+    variant("tight-boxes=off", [](DacrtOptions& d) { d.tightBoxes = false; });
     return out;
 }
 

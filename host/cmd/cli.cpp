@@ -105,6 +105,7 @@ void addDacrtOptions(CLI::App* cmd, DacrtOptions& o) {
         ->default_str(std::to_string(kCpuSimdTriangleLimit) + " on the cpu backends (" + std::to_string(kCpuLeafLimit) +
                       " with a non-default intersector, filter or precision)" + gpu);
     cmd->add_option("--packets", o.packets)->default_str("on");
+    cmd->add_option("--tight-boxes", o.tightBoxes)->default_str("on");
     cmd->add_option("--packet-flush", o.packetFlush)
         ->check(CLI::Range(1u, 1u << 30))
         ->default_str(std::to_string(kPacketFlushDefault));

@@ -21,7 +21,7 @@ constexpr bool kDacrtOption = true;
 static_assert(kPassBatchRays == 65536 && kPassBatchRaysPerTriangle == 8, "--ray-grouping's help names the batch size");
 
 // The order is the help's, and the order in which a refusal names the options.
-constexpr std::array<BackendOption, 22> kBackendOptions{{
+constexpr std::array<BackendOption, 23> kBackendOptions{{
     {"--regions", kSubScenes, "sub-scenes", "default: one per thread, on gpu one per core of a CPU device (a secondary pass's rays there: one, with --ray-groups as the cpu backend's batches), 64 on a GPU",
      !kAdvanced, !kDacrtOption, [](const RequestedOptions& r) { return r.trace.regions != 0; }},
     {"--axis", kSubScenes, "division axis", "", !kAdvanced, !kDacrtOption,
@@ -50,6 +50,11 @@ constexpr std::array<BackendOption, 22> kBackendOptions{{
     {"--packets", kDacrt, "filter primary rays 8x8 pixels at a time high in the recursion, one by one below: on or off",
      "cpu: with the default tests only; gpu: not on a device with a loop limiter, such as lavapipe before Mesa 25",
      !kAdvanced, kDacrtOption, [](const RequestedOptions& r) { return r.trace.dacrt.packets != DacrtOptions{}.packets; }},
+    {"--tight-boxes", kCpuDacrt,
+     "a node whose live rays number at least twice its triangles traces inside the box of its triangles' bounds "
+     "rather than its whole cell: on or off",
+     "", !kAdvanced, kDacrtOption,
+     [](const RequestedOptions& r) { return r.trace.dacrt.tightBoxes != DacrtOptions{}.tightBoxes; }},
     {"--packet-flush", kDacrt, "a node with fewer packets goes on ray by ray", "", kAdvanced, kDacrtOption,
      [](const RequestedOptions& r) { return r.trace.dacrt.packetFlush != 0; }},
     {"--ray-grouping", kCpuDacrt,

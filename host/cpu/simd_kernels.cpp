@@ -1094,6 +1094,41 @@ void BandsOfBounds(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t
     }
 }
 
+// The box of the triangles' bounds of ids[0, count): the smallest lo and largest hi, lanes at
+// a time, the lanes past the count repeating the last id (which changes no minimum or maximum).
+// Minimum and maximum of finite floats are exact, so any order gives the same box but, where
+// +0 and -0 meet, a zero's sign, which no comparison sees.
+void BoundsOfTriangles(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count, Box& box) {
+    const DF df;
+    const std::size_t n = hn::Lanes(df);
+    const float* b = reinterpret_cast<const float*>(bounds);
+    VF lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = hn::Set(df, kNoHitT);
+        hi[a] = hn::Set(df, -kNoHitT);
+    }
+    alignas(64) std::uint32_t idLanes[64];
+    for (std::uint32_t i = 0; i < count; i += std::uint32_t(n)) {
+        laneIds(ids, i, std::min(std::uint32_t(n), count - i), idLanes);
+        // The records four vectors ahead asked for, as bandsOfBounds does: a node's ids skip
+        // through the frame's bounds.
+        for (std::uint32_t k = i + 4 * std::uint32_t(n); k < std::min(count, i + 5 * std::uint32_t(n)); ++k)
+            __builtin_prefetch(bounds + ids[k]);
+        // A Bounds is 8 floats: lo and a pad, hi and a pad.
+        VF loFields[4], hiFields[4];
+        loadQuadPerLane<0, 8>(b, idLanes, loFields);
+        loadQuadPerLane<4, 8>(b, idLanes, hiFields);
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = hn::Min(lo[a], loFields[a]);
+            hi[a] = hn::Max(hi[a], hiFields[a]);
+        }
+    }
+    for (int a = 0; a < 3; ++a) {
+        box.lo[a] = hn::GetLane(hn::MinOfLanes(df, lo[a]));
+        box.hi[a] = hn::GetLane(hn::MaxOfLanes(df, hi[a]));
+    }
+}
+
 std::int64_t CompiledTarget() { return HWY_TARGET; }
 
 }  // namespace HWY_NAMESPACE
@@ -1113,6 +1148,7 @@ HWY_EXPORT(BoundsOfRays);
 HWY_EXPORT(GatherLeafTriangles);
 HWY_EXPORT(CompiledTarget);
 HWY_EXPORT(BandsOfBounds);
+HWY_EXPORT(BoundsOfTriangles);
 HWY_EXPORT(ClassifyFacing);
 HWY_EXPORT(FirstRegions);
 
@@ -1160,6 +1196,12 @@ void classifyFacing(const Triangle* triangles, std::uint32_t count, const glm::v
 void bandsOfBounds(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count, const glm::vec3& apex,
                    const glm::vec3* up, std::uint32_t edges, std::uint32_t* first, std::uint32_t* last) {
     HWY_DYNAMIC_DISPATCH(BandsOfBounds)(bounds, ids, count, apex, up, edges, first, last);
+}
+
+Box boundsOfTriangles(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count) {
+    Box box;
+    if (count > 0) HWY_DYNAMIC_DISPATCH(BoundsOfTriangles)(bounds, ids, count, box);
+    return box;
 }
 
 std::uint32_t endRaysHitInBox(const Ray* rays, const Hit* hits, std::uint32_t* ids, std::uint32_t count, const Box& box,

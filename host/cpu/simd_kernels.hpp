@@ -117,6 +117,10 @@ std::uint64_t intersectBatchInSegmentGroups(const Ray* rays, Hit* hits, const st
                                             std::uint32_t rayCount, const LeafTriangles& batch, const Box& cell,
                                             float widening, bool anyHit);
 
+// The box of the bounds of triangles ids[0, count): the smallest lo and the largest hi, exactly
+// (an empty Box where count is 0).
+Box boundsOfTriangles(const Bounds* bounds, const std::uint32_t* ids, std::uint32_t count);
+
 // For the bounds of ids[0, count) (bounds[0, count) where ids is null), the first and the
 // last of the bands between `edges` band edges that BandEdges::bandsOf finds (image_bands.hpp:
 // the edges' normals up[0, edges) through apex), into first[0, count) and last[0, count).

@@ -21,6 +21,7 @@ struct Counters {
     // triangle's bounds (simd::intersectBatchInGroups).
     std::uint64_t rayTriangleTestsSkipped = 0;
     std::uint64_t leaves = 0;
+    std::uint64_t tightBoxes = 0;  // nodes traced inside the box of their triangles (cpu: tightenedBox)
     // A ray is finished once it has its final hit (or none): the parallel scheme finishes rays
     // early, without a further hit, when they cannot reach the next region.
     std::uint64_t raysFinishedWithoutHit = 0;
@@ -37,6 +38,7 @@ struct Counters {
         rayTriangleTests += o.rayTriangleTests;
         rayTriangleTestsSkipped += o.rayTriangleTestsSkipped;
         leaves += o.leaves;
+        tightBoxes += o.tightBoxes;
         raysFinishedWithoutHit += o.raysFinishedWithoutHit;
     }
     // Another trace's counters on top of these (a pass traced in groups): add's, and the rays

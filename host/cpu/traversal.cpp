@@ -298,9 +298,41 @@ bool DacrtTraversal::sampledSplit(const Box& box, int& axis, std::uint32_t rayBe
     return choice.split;
 }
 
-void DacrtTraversal::node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
-                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
+// Only where the rays outnumber the triangles (kTightBoxRaysPerTriangle): the box costs a pass
+// over the triangles' bounds and saves tests of rays. The cell itself where the shrunk box would
+// be empty on an axis (triangles that only reach into the cell's margin).
+Box DacrtTraversal::shrunkBox(const Box& cell, std::uint64_t rays, std::uint32_t triBegin, std::uint32_t triEnd) {
+    if (!options_.tightBoxes || rays < kTightBoxRaysPerTriangle * std::uint64_t(triEnd - triBegin)) return cell;
+    Box bounds;
+    if (simd_) {
+        bounds = simd::boundsOfTriangles(triangleBounds_, triIds_ + triBegin, triEnd - triBegin);
+    } else {
+        for (std::uint32_t k = triBegin; k < triEnd; ++k) {
+            bounds.lo = glm::min(bounds.lo, triangleBounds_[triIds_[k]].lo);
+            bounds.hi = glm::max(bounds.hi, triangleBounds_[triIds_[k]].hi);
+        }
+    }
+    const Box reach = widenedBox(bounds, margin_);
+    Box tight;
+    tight.lo = glm::max(cell.lo, reach.lo);
+    tight.hi = glm::min(cell.hi, reach.hi);
+    if (tight.empty() || (tight.lo == cell.lo && tight.hi == cell.hi)) return cell;
+    ++counters_.tightBoxes;
+    return tight;
+}
+
+Box DacrtTraversal::tightenedBox(const Box& cell, std::uint32_t& terminated, std::uint32_t& rayEnd,
+                                 std::uint32_t triBegin, std::uint32_t triEnd) {
+    const Box tight = shrunkBox(cell, rayEnd - terminated, triBegin, triEnd);
+    if (tight.lo != cell.lo || tight.hi != cell.hi) rayEnd = filterRays(widenedBox(tight, margin_), terminated, rayEnd);
+    return tight;
+}
+
+void DacrtTraversal::node(const Box& nodeCell, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool tightened) {
     if (terminated >= rayEnd || triBegin >= triEnd) return;
+    const Box box = tightened ? nodeCell : tightenedBox(nodeCell, terminated, rayEnd, triBegin, triEnd);
+    if (terminated >= rayEnd) return;
     const bool split = splitNode(
         box, terminated, rayEnd, triBegin, triEnd, depth, stalls, rayEnd - terminated < options_.rayLimit,
         options_.splitCost == SplitCost::RaySampling, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int axis, int moving,
@@ -350,10 +382,21 @@ std::uint32_t DacrtTraversal::filterPackets(const Box& cell, std::uint32_t begin
     return std::uint32_t(first - packet_.packetIds);
 }
 
-void DacrtTraversal::nodePackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd,
+void DacrtTraversal::nodePackets(const Box& nodeCell, std::uint32_t packetBegin, std::uint32_t packetEnd,
                                  std::uint32_t triBegin, std::uint32_t triEnd, std::uint32_t depth,
                                  std::uint32_t stalls) {
     if (packetBegin >= packetEnd || triBegin >= triEnd) return;
+    // The packets' rays, finished ones included: what the rule weighs against the triangles.
+    std::uint64_t rays = 0;
+    for (std::uint32_t i = packetBegin; i < packetEnd; ++i) {
+        const RayPacket& p = packet_.packets[packet_.packetIds[i]];
+        rays += p.end - p.begin;
+    }
+    const Box box = shrunkBox(nodeCell, rays, triBegin, triEnd);
+    if (box.lo != nodeCell.lo || box.hi != nodeCell.hi) {
+        packetEnd = filterPackets(widenedBox(box, margin_), packetBegin, packetEnd);
+        if (packetBegin >= packetEnd) return;
+    }
     const bool split = splitNode(
         box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls, packetEnd - packetBegin < options_.packetFlush,
         false, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int, std::uint32_t) {
@@ -385,7 +428,7 @@ void DacrtTraversal::flushPackets(const Box& box, std::uint32_t packetBegin, std
     rayIds_ = packet_.flushRays;
     std::uint32_t terminated = 0;
     const std::uint32_t crossing = filterRays(widenedBox(box, margin_), 0, count);
-    node(box, terminated, crossing, triBegin, triEnd, depth, stalls);
+    node(box, terminated, crossing, triBegin, triEnd, depth, stalls, /*tightened=*/true);
     for (std::uint32_t k = 0; k < terminated; ++k) packet_.rayDone[rayIds_[k]] = 1;
     rayIds_ = regionRays;
 }

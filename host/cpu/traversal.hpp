@@ -113,6 +113,12 @@ inline bool endsAsLeaf(const Box& box, int axis, float split, bool fewItems, std
            stalls >= DACRT_MAX_STALLED_SPLITS || !(split > box.lo[axis] && split < box.hi[axis]);
 }
 
+// A node whose live rays number at least this many times its triangles traces inside the box
+// of its triangles' bounds (DacrtTraversal::tightenedBox) rather than its cell: measured on the
+// Bunny's, the room's and the Dragon's passes (docs/benchmarks.md, "Tight node boxes"), where
+// fewer rays than this saved less than the pass over the triangles' bounds cost.
+constexpr std::uint64_t kTightBoxRaysPerTriangle = 2;
+
 class DacrtTraversal {
 public:
     DacrtTraversal(const FrameGeometry& geometry, const DacrtOptions& options, const TraversalBuffers& buffers,
@@ -143,8 +149,17 @@ private:
                    FilterItems filterItems, Descend descend);
     bool sampledSplit(const Box& box, int& axis, std::uint32_t rayBegin, std::uint32_t rayEnd, std::uint32_t triBegin,
                       std::uint32_t triEnd, float& split);
-    void node(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
-              std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
+    // tightened: nodeCell already went through shrunkBox with at least these rays (a flushed
+    // packet node's box), so the node does not take the triangles' bounds again.
+    void node(const Box& nodeCell, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+              std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool tightened = false);
+    // Tight node boxes (docs/correctness.md): the cell shrunk to the box of the triangles'
+    // bounds widened by the margin, where `rays` outnumber them kTightBoxRaysPerTriangle to one
+    // and that box is smaller but not empty; else the cell. tightenedBox also moves the rays
+    // that miss the shrunk box (widened) behind the node's.
+    Box shrunkBox(const Box& cell, std::uint64_t rays, std::uint32_t triBegin, std::uint32_t triEnd);
+    Box tightenedBox(const Box& cell, std::uint32_t& terminated, std::uint32_t& rayEnd, std::uint32_t triBegin,
+                     std::uint32_t triEnd);
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
               std::uint32_t triEnd);
     std::uint32_t filterRays(const Box& cell, std::uint32_t begin, std::uint32_t end);
@@ -156,7 +171,7 @@ private:
     void tracePackets(const Box& box, std::uint32_t& terminated, std::uint32_t crossing, std::uint32_t triBegin,
                       std::uint32_t triEnd);
     std::uint32_t buildPackets(std::uint32_t begin, std::uint32_t end);
-    void nodePackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,
+    void nodePackets(const Box& nodeCell, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,
                      std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
     std::uint32_t filterPackets(const Box& cell, std::uint32_t begin, std::uint32_t end);
     void flushPackets(const Box& box, std::uint32_t packetBegin, std::uint32_t packetEnd, std::uint32_t triBegin,

@@ -39,6 +39,7 @@ TraceCounters countersOf(const TraceResult& result) {
     c.rayTriangleTests = result.counters.rayTriangleTests;
     c.rayTriangleTestsSkipped = result.counters.rayTriangleTestsSkipped;
     c.leaves = result.counters.leaves;
+    c.tightBoxes = result.counters.tightBoxes;
     c.raysCulled = result.counters.raysCulled;
     c.raysFinishedWithoutHit = result.counters.raysFinishedWithoutHit;
     c.raysFinishedStep1 = result.counters.finishedStep1;

@@ -269,6 +269,7 @@ TEST(Bench, PassesSuiteTimesEachPassAndDacrtMatchesCpuSeqExactly) {
                                             "cpu ray-grouping=slots", "cpu ray-grouping=octant",
                                             "cpu ray-grouping=octant-calls",
                                             "cpu pass-tracing=apart", "cpu pass-tracing=together",
+                                            "cpu tight-boxes=off",
                                             "embree dynamic", "embree dynamic stored rays",
                                             "embree refit",   "embree refit stored rays",
                                             "embree static",  "embree static stored rays"};

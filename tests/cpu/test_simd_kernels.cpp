@@ -258,6 +258,38 @@ TEST_F(EveryTarget, FacePartitionAnswersTheFullOverlapTestForAChildCellAndItsCom
     });
 }
 
+// The box of a node's triangles (DacrtTraversal::tightenedBox): the smallest lo and largest hi
+// of the bounds of any subset of ids, in any order, with counts that leave a vector's tail
+// and none at all (an empty box); the equal and signed-zero coordinates of
+// adversarialCoordinate included (a zero's sign may differ, which no comparison sees).
+TEST_F(EveryTarget, TriangleBoundsBoxIsTheScalarMinimumAndMaximum) {
+    forEachTarget([] {
+        Random rng(15);
+        for (int trial = 0; trial < 500; ++trial) {
+            std::vector<Bounds> bounds(150);
+            for (Bounds& b : bounds)
+                for (int a = 0; a < 3; ++a) {
+                    const float p = adversarialCoordinate(rng), q = adversarialCoordinate(rng);
+                    b.lo[a] = std::min(p, q);
+                    b.hi[a] = std::max(p, q);
+                }
+            const std::uint32_t count = std::uint32_t(rng.index(70));
+            const std::vector<std::uint32_t> ids = shuffledIds(rng, std::uint32_t(bounds.size()), count);
+            Box expected;
+            for (std::uint32_t id : ids) {
+                expected.lo = glm::min(expected.lo, bounds[id].lo);
+                expected.hi = glm::max(expected.hi, bounds[id].hi);
+            }
+            const Box got = simd::boundsOfTriangles(bounds.data(), ids.data(), count);
+            for (int a = 0; a < 3; ++a) {
+                ASSERT_EQ(got.lo[a], expected.lo[a]) << "trial " << trial << " axis " << a << " of " << count;
+                ASSERT_EQ(got.hi[a], expected.hi[a]) << "trial " << trial << " axis " << a << " of " << count;
+            }
+            ASSERT_EQ(got.empty(), count == 0) << "trial " << trial;
+        }
+    });
+}
+
 // The division's ray binning: slabs as the division makes them (equal widths, widened boxes),
 // rays starting inside, outside and on the slabs' faces, parallel to the axis or not, counts
 // that leave a vector's tail. Every region tested in lanes answers as the walk region by
