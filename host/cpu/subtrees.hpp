@@ -7,7 +7,8 @@
 // groups filtered nearly all 871k triangles at every level (docs/benchmarks.md, "Subtrees
 // side by side"). Here the top of the recursion is split by sequential DACRT's rules (the
 // longest axis at the spatial median, its leaf and stall rules, which count here every ray a
-// node is given, those a sibling would have ended included), each split's rays and triangles
+// node is given, those a sibling would have ended included; the cells unshrunk: the tight node
+// boxes start in the subtrees), each split's rays and triangles
 // filtered in chunks on the pool, until there are subtrees enough to share out; each subtree is
 // then a sequential DACRT on one worker, from its depth down.
 //

@@ -21,7 +21,7 @@ struct Counters {
     // triangle's bounds (simd::intersectBatchInGroups).
     std::uint64_t rayTriangleTestsSkipped = 0;
     std::uint64_t leaves = 0;
-    std::uint64_t tightBoxes = 0;  // nodes traced inside the box of their triangles (cpu: tightenedBox)
+    std::uint64_t tightBoxes = 0;  // nodes, of rays or of packets, shrunk to their triangles' box (shrunkBox)
     // A ray is finished once it has its final hit (or none): the parallel scheme finishes rays
     // early, without a further hit, when they cannot reach the next region.
     std::uint64_t raysFinishedWithoutHit = 0;

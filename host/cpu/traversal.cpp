@@ -328,10 +328,15 @@ Box DacrtTraversal::tightenedBox(const Box& cell, std::uint32_t& terminated, std
     return tight;
 }
 
-void DacrtTraversal::node(const Box& nodeCell, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
-                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool tightened) {
+void DacrtTraversal::node(const Box& cell, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                          std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
     if (terminated >= rayEnd || triBegin >= triEnd) return;
-    const Box box = tightened ? nodeCell : tightenedBox(nodeCell, terminated, rayEnd, triBegin, triEnd);
+    const Box box = tightenedBox(cell, terminated, rayEnd, triBegin, triEnd);
+    nodeInBox(box, terminated, rayEnd, triBegin, triEnd, depth, stalls);
+}
+
+void DacrtTraversal::nodeInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                               std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls) {
     if (terminated >= rayEnd) return;
     const bool split = splitNode(
         box, terminated, rayEnd, triBegin, triEnd, depth, stalls, rayEnd - terminated < options_.rayLimit,
@@ -388,7 +393,7 @@ void DacrtTraversal::nodePackets(const Box& nodeCell, std::uint32_t packetBegin,
     if (packetBegin >= packetEnd || triBegin >= triEnd) return;
     // The packets' rays, finished ones included: what the rule weighs against the triangles.
     std::uint64_t rays = 0;
-    for (std::uint32_t i = packetBegin; i < packetEnd; ++i) {
+    for (std::uint32_t i = packetBegin; options_.tightBoxes && i < packetEnd; ++i) {
         const RayPacket& p = packet_.packets[packet_.packetIds[i]];
         rays += p.end - p.begin;
     }
@@ -428,7 +433,8 @@ void DacrtTraversal::flushPackets(const Box& box, std::uint32_t packetBegin, std
     rayIds_ = packet_.flushRays;
     std::uint32_t terminated = 0;
     const std::uint32_t crossing = filterRays(widenedBox(box, margin_), 0, count);
-    node(box, terminated, crossing, triBegin, triEnd, depth, stalls, /*tightened=*/true);
+    // The packet node's box already went through shrunkBox, with at least these rays.
+    nodeInBox(box, terminated, crossing, triBegin, triEnd, depth, stalls);
     for (std::uint32_t k = 0; k < terminated; ++k) packet_.rayDone[rayIds_[k]] = 1;
     rayIds_ = regionRays;
 }

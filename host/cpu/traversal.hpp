@@ -114,9 +114,10 @@ inline bool endsAsLeaf(const Box& box, int axis, float split, bool fewItems, std
 }
 
 // A node whose live rays number at least this many times its triangles traces inside the box
-// of its triangles' bounds (DacrtTraversal::tightenedBox) rather than its cell: measured on the
-// Bunny's, the room's and the Dragon's passes (docs/benchmarks.md, "Tight node boxes"), where
-// fewer rays than this saved less than the pass over the triangles' bounds cost.
+// of its triangles' bounds (DacrtTraversal::shrunkBox) rather than its cell. Shrinking every
+// node made the Dragon's passes about 20% slower (its triangles outnumber its rays nearly
+// everywhere, and the bounds cost a pass over them); ratios of 0.5 to 4 measured alike on the
+// Bunny's, the room's and the Dragon's passes (docs/benchmarks.md, "Tight node boxes").
 constexpr std::uint64_t kTightBoxRaysPerTriangle = 2;
 
 class DacrtTraversal {
@@ -149,10 +150,12 @@ private:
                    FilterItems filterItems, Descend descend);
     bool sampledSplit(const Box& box, int& axis, std::uint32_t rayBegin, std::uint32_t rayEnd, std::uint32_t triBegin,
                       std::uint32_t triEnd, float& split);
-    // tightened: nodeCell already went through shrunkBox with at least these rays (a flushed
-    // packet node's box), so the node does not take the triangles' bounds again.
-    void node(const Box& nodeCell, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
-              std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls, bool tightened = false);
+    // A node of rays: its cell shrunk (tightenedBox), then nodeInBox, which splits the box or
+    // makes it a leaf (a flushed packet node's rays start there, their box already shrunk).
+    void node(const Box& cell, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+              std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
+    void nodeInBox(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
+                   std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
     // Tight node boxes (docs/correctness.md): the cell shrunk to the box of the triangles'
     // bounds widened by the margin, where `rays` outnumber them kTightBoxRaysPerTriangle to one
     // and that box is smaller but not empty; else the cell. tightenedBox also moves the rays
@@ -186,7 +189,8 @@ private:
     // differs from the parent's widened cell in one face, on axis (the high face when child is
     // the low one), and the SIMD path tests that face alone: never "no" where the full test
     // says "maybe", and the same answer wherever the node's triangles overlap the node's
-    // widened cell, which the roots' do (scene bounds; region binning) and so every child's.
+    // widened cell, which the roots' do (scene bounds; region binning), and so every child's
+    // and every shrunk box's (docs/correctness.md, "Tight node boxes").
     std::uint32_t filterTriangles(const Box& child, const Box& cell, std::uint32_t begin, std::uint32_t end, int axis,
                                   bool lowChild);
     // The second child's triangles, when the first child's subtree has left its own (those

@@ -344,9 +344,10 @@ TEST(ReferenceDacrt, TightBoxesKeepTheHitsOnTheirTrianglesBounds) {
     // Small boxes far apart in a large scene box (two specks at its corners), so that a node's
     // box shrinks to its triangles' bounds (DacrtTraversal::tightenedBox) by far. Rays aim at
     // the clusters' corners, edge midpoints and face centres, which lie on those bounds' faces,
-    // from all around; others travel inside the planes of the bounds' faces. A shrunk box whose
-    // rays are filtered without any margin, or one made from fewer triangles than the node's,
-    // loses some of these hits; the counters show that the boxes shrank and saved tests.
+    // from all around; others travel inside the planes of the bounds' faces. A shrunk box taken
+    // without either widening (the bounds' and the filter's), or made from fewer triangles than
+    // the node's, loses some of these hits; the counters show that the boxes shrank and saved
+    // tests.
     std::vector<Triangle> tris;
     append(tris, grid({-4, -4, -4}, {0.01f, 0, 0}, {0, 0.01f, 0}, 1, 1));
     append(tris, grid({4, 4, 4}, {-0.01f, 0, 0}, {0, 0, -0.01f}, 1, 1));
@@ -373,9 +374,10 @@ TEST(ReferenceDacrt, TightBoxesKeepTheHitsOnTheirTrianglesBounds) {
     for (const auto& [lo, hi] : clusters)
         for (int n = 0; n < 16; ++n) {
             const double a = 0.4 * double(n);
+            const float f = float(n) / 15.0f;
             rays.push_back(makeRay({lo.x - 1.0f, lo.y, lo.z + 0.01f * float(n)}, {1.0, 0.0, 0.1 * std::sin(a)}));  // in y = lo.y
-            rays.push_back(makeRay({hi.x, hi.y + 1.0f, lo.z}, {std::sin(a), -1.0, 0.0}));  // in x = hi.x's plane, then across
-            rays.push_back(makeRay({lo.x, hi.y, hi.z + 1.0f}, {0.0, 0.0, -1.0}));  // along an edge of the bounds
+            rays.push_back(makeRay({hi.x, hi.y + 1.0f, lo.z + (hi.z - lo.z) * f}, {0.0, -1.0, 0.1 * std::sin(a)}));  // in x = hi.x
+            rays.push_back(makeRay({lo.x + (hi.x - lo.x) * f, hi.y, hi.z + 1.0f}, {0.0, 0.0, -1.0}));  // down the face y = hi.y
         }
     // A camera's rays as well, whose packets shrink their nodes' boxes too.
     std::vector<Case> cases = {Case{tris, rays}, Case{tris, rays}, Case{tris, cameraRays({0.5, 0.3, 9.0}, 64, 64), 64}};
@@ -386,7 +388,11 @@ TEST(ReferenceDacrt, TightBoxesKeepTheHitsOnTheirTrianglesBounds) {
         const std::vector<Bounds> bounds = allTriangleBounds(c.triangles);
         FrameGeometry g = frameGeometry(c.triangles, bounds, c.rays, sceneBounds(c.triangles), c.imageWidth);
         g.query = c.query;
-        for (const DacrtOptions& on : {DacrtOptions{}, exactOptionSets()[3].second}) {
+        DacrtOptions scalar;
+        for (const auto& [name, options] : exactOptionSets())
+            if (name == "scalar, tiny leaves") scalar = options;
+        ASSERT_EQ(scalar.triangleFilter, TriangleFilter::Sat) << "the scalar path's option set was renamed";
+        for (const DacrtOptions& on : {DacrtOptions{}, scalar}) {
             DacrtOptions without = on;
             without.tightBoxes = false;
             const Counters tight = traceSequential(g, on).counters, loose = traceSequential(g, without).counters;
