@@ -40,7 +40,7 @@ std::string optionText(const BenchConfig& c) {
       << " threads=" << c.threads();
     if (d.splitCost != SplitCost::Limits) s << " split_cost=" << toString(d.splitCost);
     if (!d.packets) s << " packets=off";
-    if (!d.tightBoxes && !gpu) s << " tight_boxes=off";
+    if (!d.tightBoxes) s << " tight_boxes=off";
     if (d.packets && d.packetFlush != kPacketFlushDefault) s << " packet_flush=" << d.packetFlush;
     if (d.rayGrouping != DacrtOptions{}.rayGrouping) s << " ray_grouping=" << toString(d.rayGrouping);
     if (d.passTracing != DacrtOptions{}.passTracing) s << " pass_tracing=" << toString(d.passTracing);

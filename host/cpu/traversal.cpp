@@ -1,6 +1,7 @@
 #include "cpu/traversal.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <utility>
 
 #include "core/mapped_memory.hpp"
@@ -299,33 +300,28 @@ bool DacrtTraversal::sampledSplit(const Box& box, int& axis, std::uint32_t rayBe
 }
 
 // Only where the rays outnumber the triangles (kTightBoxRaysPerTriangle): the box costs a pass
-// over the triangles' bounds and saves tests of rays. The cell itself where the shrunk box would
-// be empty on an axis (triangles that only reach into the cell's margin).
-Box DacrtTraversal::shrunkBox(const Box& cell, std::uint64_t rays, std::uint32_t triBegin, std::uint32_t triEnd) {
-    if (!options_.tightBoxes || rays < kTightBoxRaysPerTriangle * std::uint64_t(triEnd - triBegin)) return cell;
-    Box bounds;
-    if (simd_) {
-        bounds = simd::boundsOfTriangles(triangleBounds_, triIds_ + triBegin, triEnd - triBegin);
-    } else {
-        for (std::uint32_t k = triBegin; k < triEnd; ++k) {
-            bounds.lo = glm::min(bounds.lo, triangleBounds_[triIds_[k]].lo);
-            bounds.hi = glm::max(bounds.hi, triangleBounds_[triIds_[k]].hi);
-        }
-    }
-    const Box reach = widenedBox(bounds, margin_);
+// over the triangles' bounds and saves tests of rays. None where the shrunk box would be the cell,
+// or empty on an axis (triangles that only reach into the cell's margin). The bounds' minimum and
+// maximum are exact, so the scalar path takes them from the same kernel.
+std::optional<Box> DacrtTraversal::shrunkBox(const Box& cell, std::uint64_t rays, std::uint32_t triBegin,
+                                             std::uint32_t triEnd) {
+    if (!options_.tightBoxes || rays < kTightBoxRaysPerTriangle * std::uint64_t(triEnd - triBegin)) return std::nullopt;
+    const Box reach =
+        widenedBox(simd::boundsOfTriangles(triangleBounds_, triIds_ + triBegin, triEnd - triBegin), margin_);
     Box tight;
     tight.lo = glm::max(cell.lo, reach.lo);
     tight.hi = glm::min(cell.hi, reach.hi);
-    if (tight.empty() || (tight.lo == cell.lo && tight.hi == cell.hi)) return cell;
+    if (tight.empty() || (tight.lo == cell.lo && tight.hi == cell.hi)) return std::nullopt;
     ++counters_.tightBoxes;
     return tight;
 }
 
 Box DacrtTraversal::tightenedBox(const Box& cell, std::uint32_t& terminated, std::uint32_t& rayEnd,
                                  std::uint32_t triBegin, std::uint32_t triEnd) {
-    const Box tight = shrunkBox(cell, rayEnd - terminated, triBegin, triEnd);
-    if (tight.lo != cell.lo || tight.hi != cell.hi) rayEnd = filterRays(widenedBox(tight, margin_), terminated, rayEnd);
-    return tight;
+    const std::optional<Box> tight = shrunkBox(cell, rayEnd - terminated, triBegin, triEnd);
+    if (!tight) return cell;
+    rayEnd = filterRays(widenedBox(*tight, margin_), terminated, rayEnd);
+    return *tight;
 }
 
 void DacrtTraversal::node(const Box& cell, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
@@ -397,11 +393,12 @@ void DacrtTraversal::nodePackets(const Box& nodeCell, std::uint32_t packetBegin,
         const RayPacket& p = packet_.packets[packet_.packetIds[i]];
         rays += p.end - p.begin;
     }
-    const Box box = shrunkBox(nodeCell, rays, triBegin, triEnd);
-    if (box.lo != nodeCell.lo || box.hi != nodeCell.hi) {
-        packetEnd = filterPackets(widenedBox(box, margin_), packetBegin, packetEnd);
+    const std::optional<Box> tight = shrunkBox(nodeCell, rays, triBegin, triEnd);
+    if (tight) {
+        packetEnd = filterPackets(widenedBox(*tight, margin_), packetBegin, packetEnd);
         if (packetBegin >= packetEnd) return;
     }
+    const Box& box = tight ? *tight : nodeCell;
     const bool split = splitNode(
         box, packetBegin, packetEnd, triBegin, triEnd, depth, stalls, packetEnd - packetBegin < options_.packetFlush,
         false, [&](const Box& cell, std::uint32_t begin, std::uint32_t end, int, int, std::uint32_t) {

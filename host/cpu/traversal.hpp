@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "cpu/predicates.hpp"
@@ -158,9 +159,9 @@ private:
                    std::uint32_t triEnd, std::uint32_t depth, std::uint32_t stalls);
     // Tight node boxes (docs/correctness.md): the cell shrunk to the box of the triangles'
     // bounds widened by the margin, where `rays` outnumber them kTightBoxRaysPerTriangle to one
-    // and that box is smaller but not empty; else the cell. tightenedBox also moves the rays
-    // that miss the shrunk box (widened) behind the node's.
-    Box shrunkBox(const Box& cell, std::uint64_t rays, std::uint32_t triBegin, std::uint32_t triEnd);
+    // and that box is smaller but not empty; else none. tightenedBox gives that box or the cell,
+    // and moves the rays that miss the shrunk box (widened) behind the node's.
+    std::optional<Box> shrunkBox(const Box& cell, std::uint64_t rays, std::uint32_t triBegin, std::uint32_t triEnd);
     Box tightenedBox(const Box& cell, std::uint32_t& terminated, std::uint32_t& rayEnd, std::uint32_t triBegin,
                      std::uint32_t triEnd);
     void leaf(const Box& box, std::uint32_t& terminated, std::uint32_t rayEnd, std::uint32_t triBegin,
