@@ -87,6 +87,10 @@ struct ItemContext {
     uint itemTerminated;
 };
 
+// The most rays a packet holds (8x8 pixels), for the leaf balance's and the tight boxes' bound
+// on a packet node's rays.
+const uint kPacketRays = 64u;
+
 const uint kStepContinue = 0u;
 const uint kStepOutOfBudget = 1u;
 const uint kStepTreeDone = 2u;
@@ -96,12 +100,14 @@ const uint kStepEnterChild = 3u;  // Slice::next becomes the node (enterChild)
 // moved (axis * 2, + 1 for the high child's lower face), for its one-face triangle filter;
 // kNoFace: the node's own box, whose triangles are the range as it is. Above the face,
 // kSiblingWaits marks a near child whose sibling waits on top of the stack for the end of the
-// triangles it filters (StackEntry::siblingTriEnd).
+// triangles it filters (StackEntry::siblingTriEnd), and kShrunk a node entered again in its
+// shrunk box (tightenBox).
 const uint kFaceShift = 8u;
 const uint kRuleMask = (1u << kFaceShift) - 1u;
 const uint kFaceMask = 7u;
 const uint kNoFace = 7u;
 const uint kSiblingWaits = 1u << 11u;
+const uint kShrunk = 1u << 12u;  // the node again, in its shrunk box (tightenBox)
 const uint kSiblingNotFiltered = 0xFFFFFFFFu;
 const uint kStallsShift = 16u;
 
@@ -278,6 +284,8 @@ uint flushPackets(ItemContext c, inout Slice s) {
     s.flushBase = s.stackSize;
     s.terminated = c.flushAt;
     s.next = nodeEntry(s.lo, s.hi, gathered, kKeepCrossing, kNoFace, s.triBegin, s.triEnd, s.depth, s.stalls);
+    // Its box is as tight as the packet node's: that node tried with at least these rays.
+    s.next.rayRule |= kShrunk;
     return kStepEnterChild;
 }
 
@@ -308,13 +316,42 @@ uint popFarChild(ItemContext c, inout Slice s) {
     return kStepEnterChild;
 }
 
+// Where the node's rays outnumber its triangles kTightBoxRays times (a packet node: its packets
+// counted as full ones), its box shrinks to its cell cut to its triangles' bounds widened by
+// the margin (the cpu backend's tight node boxes: docs/correctness.md, "Tight node boxes"), and
+// the node is entered again in the shrunk box: its rays (packets) filtered against it widened
+// once more, so that neither its leaves nor its children see rays that pass the triangles by,
+// its triangles kept as they are. Returns whether it shrank. The node keeps its cell where
+// nothing would shrink, or where the box would be empty on an axis (triangles that only reach
+// into the cell's margin).
+bool tightenBox(ItemContext c, inout Slice s) {
+    uint triCount = s.triEnd - s.triBegin, count = s.nodeRayEnd - s.terminated;
+    uint rayCount = s.packetLevel ? min(count, 0xFFFFFFFFu / kPacketRays) * kPacketRays : count;
+    if (kTightBoxRays == 0u || triCount == 0u || rayCount / max(kTightBoxRays, 1u) < triCount) return false;
+    // Under a loop budget the box is an option the slice may not afford (the same hits
+    // without it): the reduction and the second partition cost a partition each at most.
+    uint cost = partitionCost(triCount) + partitionCost(count) + kStepOverhead;
+    if (overBudget(s.spent, cost + c.retireCost)) return false;
+    s.spent += cost;
+    vec3 boundsLo, boundsHi;
+    triangleBoundsBox(s.triBegin, s.triEnd, boundsLo, boundsHi);
+    precise vec3 reachLo = boundsLo - c.margin, reachHi = boundsHi + c.margin;
+    vec3 lo = max(s.lo, reachLo), hi = min(s.hi, reachHi);
+    if (any(greaterThan(lo, hi)) || (all(equal(lo, s.lo)) && all(equal(hi, s.hi)))) return false;
+    if (c.lane == 0) atomicAdd(counters.tightBoxes, 1u);
+    s.next = nodeEntry(lo, hi, s.nodeRayEnd, s.packetLevel ? kKeepPacketCrossing : kKeepCrossing, kNoFace, s.triBegin,
+                       s.triEnd, s.depth, s.stalls);
+    s.next.rayRule |= kShrunk;
+    return true;
+}
+
 // The node the step chose (a split's near child, the far child popped, the root, a flush's
 // rays) becomes the current one: its rays (or packets) and triangles filtered from its
 // parent's. The traversal's one call of the filters, so that the kernel inlines each once
 // (llvmpipe's compile time grows with every copy). A rule known only at run time makes every
 // branch of keepRay run under a mask on llvmpipe: the common rules get calls of their own,
-// where they are constants.
-void enterChild(ItemContext c, inout Slice s) {
+// where they are constants. Returns whether the node shrank, to be entered again (tightenBox).
+bool enterChild(ItemContext c, inout Slice s) {
     StackEntry e = s.next;
     uint rule = e.rayRule & kRuleMask, face = (e.rayRule >> kFaceShift) & kFaceMask;
     vec3 lo = e.lo - c.margin, hi = e.hi + c.margin;
@@ -342,6 +379,7 @@ void enterChild(ItemContext c, inout Slice s) {
     uint stalls = e.depthAndStalls >> kStallsShift;
     s.stalls = ownBox ? stalls
                       : (s.nodeRayEnd == e.rayEnd && s.triBegin == e.triBegin && s.triEnd == e.triEnd ? stalls + 1u : 0u);
+    return hasRays && (e.rayRule & kShrunk) == 0u && tightenBox(c, s);
 }
 
 // A leaf tests every one of its rays against every one of its triangles, a split only
@@ -355,9 +393,6 @@ bool leafCostsMoreThanSplits(uint rayCount, uint triCount) {
     return kLeafOverSplit != 0u &&
            leafTestCost(rayCount, triCount) > kLeafOverSplit * (partitionCost(rayCount) + partitionCost(triCount) + kStepOverhead);
 }
-
-// The most rays a packet holds (8x8 pixels), for the leaf balance's bound on a packet node's rays.
-const uint kPacketRays = 64u;
 
 // A packet node splits as a ray node does, or goes on ray by ray where it has fewer than
 // kPacketFlush packets, or where its rays would be a leaf at once, however many they are.
@@ -494,7 +529,7 @@ void runWorkItem(inout ItemContext c) {
     }
 
     while (outcome == kStepContinue || outcome == kStepEnterChild) {
-        if (outcome == kStepEnterChild) enterChild(c, s);
+        if (outcome == kStepEnterChild && enterChild(c, s)) continue;  // s.next: the node in its shrunk box
         outcome = stepTraversal(c, s);
     }
     if (outcome == kStepOutOfBudget)

@@ -33,6 +33,9 @@ layout(constant_id = DACRT_SPEC_LEAF_BALANCE) const uint kLeafBalance = 0;
 // Nonzero: primary rays travel the top of the tree as packets of 8x8 pixels (shaders/
 // ray_packets.glsl), and a node with fewer than this many packets goes on ray by ray. 0: off.
 layout(constant_id = DACRT_SPEC_PACKET_FLUSH) const uint kPacketFlush = 0;
+// Nonzero: a node whose rays number at least this many times its triangles traces in its cell
+// cut to its triangles' bounds, widened by the margin (dacrt.comp, tightenBox). 0: off.
+layout(constant_id = DACRT_SPEC_TIGHT_BOX_RAYS) const uint kTightBoxRays = 2;
 
 #ifdef DACRT_ADDRESSED
 // Arrays larger than one binding may be (maxStorageBufferRange) are reached by device address,
@@ -124,6 +127,7 @@ uint gPacketCount;
 const uint kWorkgroupSize = gl_WorkGroupSize.x;
 
 shared uint sSubgroupTotals[kWorkgroupSize];
+shared uint sBoxKeys[6];                     // triangleBoundsBox: orderedKey minima, then maxima
 shared bool sReady;                           // this work item may run now
 // The DACRT stack of the running slice (saved to `stacks` between slices): a split pushes one
 // waiting child, or two where rays are classified per split (kOrderPerRay).

@@ -318,6 +318,60 @@ uint partitionTrianglesAtFace(uint begin, uint end, vec3 lo, vec3 hi, int axis, 
     return kept;
 }
 
+// A float's bits as a uint whose unsigned order is the float's order (negatives reversed), so
+// that shared uint atomics take a float minimum or maximum across subgroups.
+uint orderedKey(float x) {
+    uint bits = floatBitsToUint(x);
+    return (bits & 0x80000000u) != 0u ? ~bits : bits | 0x80000000u;
+}
+
+float orderedFloat(uint key) {
+    return uintBitsToFloat((key & 0x80000000u) != 0u ? key & 0x7FFFFFFFu : ~key);
+}
+
+// The box of the bounds of triangles triIds[begin, end): their exact minimum and maximum (a
+// minimum or a maximum rounds nothing, so the order of the reduction changes no bit but
+// the sign of a zero). Subgroup reductions, then one shared atomic per subgroup and axis.
+void triangleBoundsBox(uint begin, uint end, out vec3 lo, out vec3 hi) {
+    uint start = stageClock();
+    vec3 myLo = vec3(kNoHitT), myHi = vec3(-kNoHitT);
+    for (uint base = begin; base < end; base += kPartitionChunk) {
+        uint first = base + gl_LocalInvocationIndex * kIdsPerInvocation;
+        [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
+            if (first + e >= end) continue;
+            uint id = TRI_IDS(first + e);
+            myLo = min(myLo, TRIANGLE_BOUNDS(id).lo);
+            myHi = max(myHi, TRIANGLE_BOUNDS(id).hi);
+        }
+    }
+    lo = subgroupMin(myLo);
+    hi = subgroupMax(myHi);
+    if (!(kLockstepSubgroups || gl_NumSubgroups == 1)) {
+        if (gl_LocalInvocationIndex == 0) {
+            [[unroll]] for (int a = 0; a < 3; ++a) {
+                sBoxKeys[a] = 0xFFFFFFFFu;
+                sBoxKeys[3 + a] = 0u;
+            }
+        }
+        memoryBarrierShared();
+        barrier();
+        if (subgroupElect()) {
+            [[unroll]] for (int a = 0; a < 3; ++a) {
+                atomicMin(sBoxKeys[a], orderedKey(lo[a]));
+                atomicMax(sBoxKeys[3 + a], orderedKey(hi[a]));
+            }
+        }
+        memoryBarrierShared();
+        barrier();
+        [[unroll]] for (int a = 0; a < 3; ++a) {
+            lo[a] = orderedFloat(sBoxKeys[a]);
+            hi[a] = orderedFloat(sBoxKeys[3 + a]);
+        }
+        barrier();  // sBoxKeys is reused by the next call
+    }
+    addStageTicks(DACRT_STAGE_TRIANGLE_PARTITIONS, start);
+}
+
 // Invocations that share one ray in a leaf with rayCount rays: a power of two, so that one
 // ray's lanes are a run of one subgroup that a butterfly of shuffles reduces.
 uint leafLanesPerRay(uint rayCount) {

@@ -231,6 +231,7 @@ struct GpuCounters {
     uint stackSlotsTaken;  // work items that saved a stack (more than DacrtPush::stackSlots: the frame fails)
     uint raysCulled;       // secondary.comp: rays made that miss the division's widened box (no region)
     uint packetBoxTests;   // packets tested against a cell (each stands for its rays)
+    uint tightBoxes;       // nodes whose box shrank to their triangles' bounds (kTightBoxRays)
     // The kernel's stage clocks (the DACRT_STAGE_CLOCKS build, --stage-clocks): clock ticks
     // each stage took over the frame's work items, as 64-bit sums of (low, high) words.
     uint stageTicks[2 * DACRT_STAGE_COUNT];
@@ -311,7 +312,8 @@ struct WorkgroupTestPush {
 #define DACRT_SPEC_LEAF_BALANCE 10     // 0, or the leaf balance (kLeafBalance, shaders/leaf_rule.glsl)
 #define DACRT_SPEC_PACKET_FLUSH 11     // 0, or packets: a node with fewer goes on ray by ray (kPacketFlush)
 #define DACRT_SPEC_SHARED_SEGMENT 12   // 1: any-hit rays that all have tmin rayTmin and tmax rayTmax (DacrtPush)
-#define DACRT_SPEC_COUNT 13
+#define DACRT_SPEC_TIGHT_BOX_RAYS 13    // 0, or rays per triangle from which a node shrinks its box (kTightBoxRays)
+#define DACRT_SPEC_COUNT 14
 
 #ifdef __cplusplus
 static_assert(sizeof(WorkItem) == 32);
@@ -347,7 +349,8 @@ static_assert(offsetof(DacrtPush, rayScratchHalf) == 24 && offsetof(DacrtPush, t
 static_assert(offsetof(GpuCounters, raysRetired) == 20);
 static_assert(offsetof(GpuCounters, terminatedStep1) == 48 && offsetof(GpuCounters, stackSlotsTaken) == 52);
 static_assert(offsetof(GpuCounters, raysCulled) == 56 && offsetof(GpuCounters, packetBoxTests) == 60);
-static_assert(offsetof(GpuCounters, stageTicks) == 64 && sizeof(GpuCounters) == 64 + 8 * DACRT_STAGE_COUNT);
+static_assert(offsetof(GpuCounters, tightBoxes) == 64);
+static_assert(offsetof(GpuCounters, stageTicks) == 68 && sizeof(GpuCounters) == 68 + 8 * DACRT_STAGE_COUNT);
 static_assert(offsetof(GpuCounters, itemsFinished) == 32 && offsetof(GpuCounters, tooLarge) == 44);
 static_assert(offsetof(GpuCounters, testResult) == 24 && offsetof(GpuCounters, loopLimitHits) == 28);
 static_assert(sizeof(WorkgroupTestPush) == 64 && offsetof(WorkgroupTestPush, mode) == 12);

@@ -154,8 +154,8 @@ std::vector<BenchConfig> sweepConfigs(Backend b, unsigned hardwareThreads, unsig
             c.options.trace.dacrt.splitCost = SplitCost::RaySampling;
             c.options.trace.dacrt.packets = false;
         });
-        variant("tight-boxes=off", [](BenchConfig& c) { c.options.trace.dacrt.tightBoxes = false; });
     }
+    variant("tight-boxes=off", [](BenchConfig& c) { c.options.trace.dacrt.tightBoxes = false; });
     const DacrtOptions defaults = base.options.trace.dacrt.resolvedFor(b);
     variant("packets=off", [](BenchConfig& c) { c.options.trace.dacrt.packets = false; });
     for (std::uint32_t f : {4u, 64u, 256u})
@@ -230,7 +230,6 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
         return out;
     }
     out.push_back(baseConfig(b, hardwareThreads));
-    if (b != Backend::Cpu) return out;
     auto variant = [&](const std::string& name, auto&& set) {
         BenchConfig c = out.front();
         c.name = name;
@@ -238,6 +237,11 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
         set(c.options.trace.dacrt);
         out.push_back(c);
     };
+    // The nodes' own boxes, without the box of their triangles (docs/benchmarks.md, "Tight node
+    // boxes"; the kernel's: docs/gpu.md).
+    const auto cellsOnly = [](DacrtOptions& d) { d.tightBoxes = false; };
+    if (b == Backend::Gpu) variant("tight-boxes=off", cellsOnly);
+    if (b != Backend::Cpu) return out;
     // The secondary rays' order (docs/benchmarks.md, "Rays grouped by octant").
     for (RayGrouping grouping : {RayGrouping::Slots, RayGrouping::Octant, RayGrouping::OctantCalls})
         variant("ray-grouping=" + toString(grouping), [grouping](DacrtOptions& d) { d.rayGrouping = grouping; });
@@ -245,8 +249,7 @@ std::vector<BenchConfig> passesConfigs(Backend b, unsigned hardwareThreads) {
     // passes traced together").
     for (PassTracing tracing : {PassTracing::Apart, PassTracing::Together})
         variant("pass-tracing=" + toString(tracing), [tracing](DacrtOptions& d) { d.passTracing = tracing; });
-    // The nodes' own boxes, without the box of their triangles (docs/benchmarks.md, "Tight node boxes").
-    variant("tight-boxes=off", [](DacrtOptions& d) { d.tightBoxes = false; });
+    variant("tight-boxes=off", cellsOnly);
     return out;
 }
 

@@ -50,7 +50,7 @@ constexpr std::array<BackendOption, 23> kBackendOptions{{
     {"--packets", kDacrt, "filter primary rays 8x8 pixels at a time high in the recursion, one by one below: on or off",
      "cpu: with the default tests only; gpu: not on a device with a loop limiter, such as lavapipe before Mesa 25",
      !kAdvanced, kDacrtOption, [](const RequestedOptions& r) { return r.trace.dacrt.packets != DacrtOptions{}.packets; }},
-    {"--tight-boxes", kCpuDacrt,
+    {"--tight-boxes", kDacrt,
      "a node whose live rays number at least twice its triangles traces inside the box of its triangles' bounds "
      "rather than its whole cell: on or off",
      "", !kAdvanced, kDacrtOption,

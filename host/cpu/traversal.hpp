@@ -118,7 +118,9 @@ inline bool endsAsLeaf(const Box& box, int axis, float split, bool fewItems, std
 // of its triangles' bounds (DacrtTraversal::shrunkBox) rather than its cell. Shrinking every
 // node made the Dragon's passes about 20% slower (its triangles outnumber its rays nearly
 // everywhere, and the bounds cost a pass over them); ratios of 0.5 to 4 measured alike on the
-// Bunny's, the room's and the Dragon's passes (docs/benchmarks.md, "Tight node boxes").
+// Bunny's, the room's and the Dragon's passes (docs/benchmarks.md, "Tight node boxes"). The
+// gpu kernel takes the same ratio (kTightBoxRays; 1 and 2 alike on lavapipe, 4 slower:
+// docs/gpu.md, "Tight node boxes in the kernel").
 constexpr std::uint64_t kTightBoxRaysPerTriangle = 2;
 
 class DacrtTraversal {

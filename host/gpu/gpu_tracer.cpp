@@ -10,6 +10,7 @@
 #include "core/timing.hpp"
 #include "cpu/backend_options.hpp"
 #include "cpu/scene_division.hpp"
+#include "cpu/traversal.hpp"
 #include "gpu/binding_set.hpp"
 #include "gpu/device_defaults.hpp"
 #include "gpu/dispatch_recorder.hpp"
@@ -510,6 +511,7 @@ void GpuTracer::compileKernel(Frame& frame, const KernelRays& rays) const {
         .chunkBytes = frame.set->kernelChunkBytes(),
         .stageClocks = tuning_.stageClocks,
         .sharedSegment = rays.sharedSegment,
+        .tightBoxRays = options_.dacrt.tightBoxes ? std::uint32_t(kTightBoxRaysPerTriangle) : 0u,
     });
     frame.result.gpu->rayLimit = leafRule.rayLimit;
     frame.result.gpu->triLimit = leafRule.triLimit;
@@ -592,6 +594,7 @@ void GpuTracer::readBack(Frame& frame) const {
     result.counters.raysCulled += counters.raysCulled;  // a secondary pass's (the division counted a frame's)
     result.counters.rayBoxTests = counters.rayBoxTests;
     result.counters.packetBoxTests = counters.packetBoxTests;
+    result.counters.tightBoxes = counters.tightBoxes;
     result.counters.rayTriangleTests = counters.rayTriangleTests;
     result.counters.leaves = counters.leaves;
     result.counters.raysFinishedWithoutHit = counters.raysRetired;

@@ -23,6 +23,7 @@ std::vector<std::uint32_t> KernelSpecialization::values() const {
     v[DACRT_SPEC_LEAF_BALANCE] = leafBalance;
     v[DACRT_SPEC_PACKET_FLUSH] = packetFlush;
     v[DACRT_SPEC_SHARED_SEGMENT] = sharedSegment ? 1u : 0u;
+    v[DACRT_SPEC_TIGHT_BOX_RAYS] = tightBoxRays;
     return v;
 }
 

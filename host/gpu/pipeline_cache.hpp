@@ -32,6 +32,7 @@ struct KernelSpecialization {
     // The kernel with its stage clocks (DACRT_STAGE_CLOCKS, GpuTuning::stageClocks).
     bool stageClocks = false;
     bool sharedSegment = false;  // kSharedSegmentSpec: any-hit rays with one tmin and tmax
+    std::uint32_t tightBoxRays = 0;  // kTightBoxRays: 0, or kTightBoxRaysPerTriangle (DacrtOptions::tightBoxes)
     std::vector<std::uint32_t> values() const;  // in constant_id order
 };
 

@@ -78,8 +78,9 @@ struct DacrtOptions {
     // the recursion, one by one below; the SIMD path of rays that share their start only.
     bool packets = true;
     std::uint32_t packetFlush = 0;  // a node with fewer packets goes on ray by ray; 0: the default
-    // Tight node boxes (docs/cpu-reference.md): on the cpu backends, a node whose rays number
-    // at least twice its triangles traces inside the box of their bounds rather than its whole cell.
+    // Tight node boxes (docs/cpu-reference.md, docs/gpu.md): on the DACRT backends, a node whose
+    // rays number at least twice its triangles traces inside the box of their bounds rather than
+    // its whole cell.
     bool tightBoxes = true;
     // Secondary passes on the cpu backends: batches by default (the room's lit frame 0.74x of
     // slots, the Bunny's and the Dragon's passes one batch: docs/benchmarks.md).

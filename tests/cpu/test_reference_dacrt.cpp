@@ -12,6 +12,7 @@
 #include "cpu/reference_dacrt.hpp"
 #include "cpu/traversal.hpp"
 #include "support/frames.hpp"
+#include "support/tight_box_scene.hpp"
 
 using namespace dacrt;
 using namespace dacrt::test;
@@ -341,46 +342,15 @@ TEST(ReferenceDacrt, SegmentsEndingBeforeOnAndAfterTheirHits) {
 }
 
 TEST(ReferenceDacrt, TightBoxesKeepTheHitsOnTheirTrianglesBounds) {
-    // Small boxes far apart in a large scene box (two specks at its corners), so that a node's
-    // box shrinks to its triangles' bounds (DacrtTraversal::tightenedBox) by far. Rays aim at
-    // the clusters' corners, edge midpoints and face centres, which lie on those bounds' faces,
-    // from all around; others travel inside the planes of the bounds' faces. A shrunk box taken
-    // without either widening (the bounds' and the filter's), or made from fewer triangles than
-    // the node's, loses some of these hits; the counters show that the boxes shrank and saved
-    // tests.
+    // Clusters far apart, rays at and along their bounds' faces (support/tight_box_scene.hpp),
+    // closest and any hit, and a camera's rays; the counters show that the boxes shrank
+    // (DacrtTraversal::tightenedBox) and saved tests.
+    const TightBoxScene scene = tightBoxScene();
     std::vector<Triangle> tris;
-    append(tris, grid({-4, -4, -4}, {0.01f, 0, 0}, {0, 0.01f, 0}, 1, 1));
-    append(tris, grid({4, 4, 4}, {-0.01f, 0, 0}, {0, 0, -0.01f}, 1, 1));
-    const std::vector<std::pair<glm::vec3, glm::vec3>> clusters = {
-        {{-3.0f, -2.5f, -1.0f}, {-2.5f, -2.0f, -0.75f}}, {{1.0f, 2.0f, 3.0f}, {1.25f, 2.5f, 3.25f}},
-        {{2.5f, -3.0f, 0.5f}, {3.0f, -2.875f, 1.0f}},   {{-0.5f, 0.25f, -3.5f}, {0.0f, 0.75f, -3.0f}}};
-    std::vector<glm::vec3> targets;
-    for (const auto& [lo, hi] : clusters) {
-        append(tris, box(lo, hi));
-        append(tris, doubleSided(grid(lo, {hi.x - lo.x, 0, 0}, {0, hi.y - lo.y, 0}, 2, 2)));  // on its low z face
-        for (int i = 0; i <= 2; ++i)
-            for (int j = 0; j <= 2; ++j)
-                for (int k = 0; k <= 2; ++k)
-                    if (i != 1 || j != 1 || k != 1)  // corners, edge midpoints and face centres
-                        targets.push_back(lo + (hi - lo) * glm::vec3(float(i), float(j), float(k)) * 0.5f);
-    }
-    std::vector<Ray> rays;
-    Random random(41);
-    for (const glm::vec3& target : targets)
-        for (int n = 0; n < 12; ++n) {
-            const glm::vec3 from = target + 3.0f * glm::vec3(random.onSphere());
-            rays.push_back(makeRay(from, glm::dvec3(target) - glm::dvec3(from)));
-        }
-    for (const auto& [lo, hi] : clusters)
-        for (int n = 0; n < 16; ++n) {
-            const double a = 0.4 * double(n);
-            const float f = float(n) / 15.0f;
-            rays.push_back(makeRay({lo.x - 1.0f, lo.y, lo.z + 0.01f * float(n)}, {1.0, 0.0, 0.1 * std::sin(a)}));  // in y = lo.y
-            rays.push_back(makeRay({hi.x, hi.y + 1.0f, lo.z + (hi.z - lo.z) * f}, {0.0, -1.0, 0.1 * std::sin(a)}));  // in x = hi.x
-            rays.push_back(makeRay({lo.x + (hi.x - lo.x) * f, hi.y, hi.z + 1.0f}, {0.0, 0.0, -1.0}));  // down the face y = hi.y
-        }
+    for (const Mesh& m : scene.meshes) append(tris, m);
+    const std::vector<Ray>& rays = scene.rays;
     // A camera's rays as well, whose packets shrink their nodes' boxes too.
-    std::vector<Case> cases = {Case{tris, rays}, Case{tris, rays}, Case{tris, cameraRays({0.5, 0.3, 9.0}, 64, 64), 64}};
+    std::vector<Case> cases = {Case{tris, rays}, Case{tris, rays}, Case{tris, cameraRays(scene.cameraEye, 64, 64), 64}};
     cases[1].query = HitQuery::Any;
     for (const Case& c : cases) {
         SCOPED_TRACE(c.imageWidth ? "camera" : c.query == HitQuery::Any ? "any hit" : "closest");

@@ -11,6 +11,7 @@
 #include "gpu/gpu_tracer.hpp"
 #include "core/procedural.hpp"
 #include "support/frames.hpp"
+#include "support/tight_box_scene.hpp"
 
 using namespace dacrt;
 using namespace dacrt::test;
@@ -289,6 +290,52 @@ TEST(GpuImages, EveryPacketFlushGivesTheSameHits) {
     EXPECT_EQ(r.counters.packetBoxTests, 0u);
     EXPECT_EQ(r.gpu->packets, 0u);
     EXPECT_GT(r.counters.rayBoxTests, 0u);
+}
+
+TEST(GpuImages, TightBoxesGiveTheSameHitsAndSaveTests) {
+    // The kernel's tight node boxes (tightenBox, shaders/dacrt.comp) on the cpu backends' scene
+    // for them (support/tight_box_scene.hpp): rays of their own origins at and along the
+    // clusters' bounds' faces, closest and any hit, and a camera's rays (packets where the device
+    // allows them), on one and three regions, with the boxes and without. cpu-seq's hits bit for
+    // bit (any hit: the visibility), boxes shrunk and fewer ray/triangle tests with them.
+    DACRT_REQUIRE_GPU(context);
+    const TightBoxScene scene = tightBoxScene();
+    const Scene s = sceneFromMeshes(scene.meshes);
+    const std::vector<Bounds> bounds = allTriangleBounds(s.triangles);
+    for (HitQuery query : {HitQuery::Closest, HitQuery::Any}) {
+        SCOPED_TRACE(query == HitQuery::Any ? "any hit" : "closest hit");
+        FrameGeometry g = frameGeometry(s.triangles, bounds, scene.rays, sceneBounds(s.triangles));
+        g.query = query;
+        const TraceResult reference = traceFrame(g, Backend::CpuSeq);
+        // Workgroups of several subgroups too, whose bounds meet through shared memory.
+        for (const GpuTuning& tuning : {GpuTuning{}, GpuTuning{.workgroupSize = 32}})
+            for (unsigned regions : {1u, 3u}) {
+                SCOPED_TRACE(std::to_string(regions) + " regions, workgroup " + std::to_string(tuning.workgroupSize));
+                std::map<bool, Counters> counters;  // by tight boxes on
+                for (bool tight : {true, false}) {
+                    TraceOptions o = gpuOptions(regions);
+                    o.dacrt.tightBoxes = tight;
+                    ThreadPool pool(2);
+                    const TraceResult r = GpuTracer(*context, pool, o, tuning).trace(g);
+                    EXPECT_TRUE(query == HitQuery::Closest ? identicalHits(reference.hits, r.hits)
+                                                           : identicalVisibility(reference.hits, r.hits))
+                        << "tight boxes " << tight;
+                    counters[tight] = r.counters;
+                }
+                EXPECT_GT(counters[true].tightBoxes, 0u);
+                EXPECT_EQ(counters[false].tightBoxes, 0u);
+                EXPECT_LT(counters[true].rayTriangleTests, counters[false].rayTriangleTests);
+            }
+    }
+    CameraOptions view;
+    view.eye = scene.cameraEye;
+    view.target = glm::dvec3(0.0);
+    const Frame frame(sceneFromMeshes(scene.meshes), 64, 64, view);
+    for (bool tight : {true, false}) {
+        SCOPED_TRACE(tight ? "camera, tight boxes" : "camera, cells");
+        expectGpuMatchesCpu(*context, frame, {1, 3}, {}, DacrtOptions{.tightBoxes = tight});
+    }
+    EXPECT_TRUE(noValidationErrors(*context));
 }
 
 TEST(GpuImages, CameraInsideTheSceneAndOnSplitPlanes) {
