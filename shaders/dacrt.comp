@@ -126,6 +126,10 @@ StackEntry nodeEntry(vec3 lo, vec3 hi, uint rayEnd, uint rule, uint face, uint t
     e.triEnd = triEnd;
     e.depthAndStalls = depth | (stalls << kStallsShift);
     e.siblingTriEnd = kSiblingNotFiltered;
+    e.siblingRayEnd = kSiblingNotFiltered;
+    e.pad0 = 0u;
+    e.pad1 = 0u;
+    e.pad2 = 0u;
     e.rayRule = rule | (face << kFaceShift);
     return e;
 }
@@ -358,8 +362,13 @@ bool enterChild(ItemContext c, inout Slice s) {
     s.lo = e.lo;
     s.hi = e.hi;
     s.packetLevel = rule == kKeepPacketCrossing;
-    s.nodeRayEnd = rule == kKeepCrossing        ? partitionRays(s.terminated, e.rayEnd, kKeepCrossing, lo, hi)
-                   : rule == kKeepPacketCrossing ? partitionPackets(s.terminated, e.rayEnd, lo, hi)
+    // A second child takes the rays (packets) its sibling dropped untested: they crossed the
+    // parent's widened box but not the sibling's, and the two children's widened boxes cover
+    // the parent's (docs/correctness.md, "The second child's rays"; a ray given to a cell it
+    // does not cross changes no hit). Its sibling's subtree traced only the rays it kept.
+    uint certainFrom = e.siblingRayEnd != kSiblingNotFiltered ? e.siblingRayEnd : e.rayEnd;
+    s.nodeRayEnd = rule == kKeepCrossing        ? partitionRaysFrom(s.terminated, e.rayEnd, certainFrom, kKeepCrossing, lo, hi)
+                   : rule == kKeepPacketCrossing ? partitionPackets(s.terminated, e.rayEnd, certainFrom, lo, hi)
                                                  : partitionRays(s.terminated, e.rayEnd, rule, lo, hi);
     bool ownBox = face == kNoFace;
     bool hasRays = s.nodeRayEnd > s.terminated;
@@ -373,8 +382,10 @@ bool enterChild(ItemContext c, inout Slice s) {
                                        : e.triBegin;
     s.triBegin = afterSibling ? filtered : e.triBegin;
     s.triEnd = ownBox ? e.triEnd : (afterSibling ? e.triEnd : filtered);
-    if ((e.rayRule & kSiblingWaits) != 0u && c.lane == 0)
+    if ((e.rayRule & kSiblingWaits) != 0u && c.lane == 0) {
         sStack[s.stackSize - 1u].siblingTriEnd = hasRays ? s.triEnd : kSiblingNotFiltered;
+        sStack[s.stackSize - 1u].siblingRayEnd = s.nodeRayEnd;
+    }
     s.depth = e.depthAndStalls & ((1u << kStallsShift) - 1u);
     uint stalls = e.depthAndStalls >> kStallsShift;
     s.stalls = ownBox ? stalls

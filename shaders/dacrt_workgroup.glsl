@@ -183,16 +183,41 @@ bool keepId(uint id, uint rule, vec3 lo, vec3 hi, int axis) {
     return keepRay(id, rule, lo, hi);
 }
 
+// The ids [from, end) of the ray (or triangle) id buffer moved down to `to` (<= from), in order:
+// each chunk is read whole before any of its slots is written, and no later chunk reads a slot
+// an earlier one wrote (every write lands below the reads so far).
+void moveIdsDown(bool triangleIds, uint from, uint end, uint to) {
+    if (to == from) return;  // uniform: nothing moves
+    uint lane = gl_LocalInvocationIndex;
+    for (uint base = from; base < end; base += kPartitionChunk) {
+        uint first = base + lane * kIdsPerInvocation;
+        uint ids[kIdsPerInvocation];
+        [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e)
+            ids[e] = first + e < end ? (triangleIds ? TRI_IDS(first + e) : RAY_IDS(first + e)) : 0u;
+        workgroupSync();
+        [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
+            if (first + e >= end) continue;
+            uint slot = to + (first + e - from);
+            if (triangleIds) TRI_IDS(slot) = ids[e];
+            else RAY_IDS(slot) = ids[e];
+        }
+    }
+    workgroupSync();
+}
+
 // Stable partition of rayIds[begin, end) (or triIds, for kKeepOverlapping; the packet ids in the
 // ray id buffer, for kKeepPacketCrossing): the ids `rule` keeps first, in their order, then the
 // others in theirs. Kept ids move down in place (never
 // onto an unread id); dropped ids wait in the buffer's scratch half and are copied back
-// behind them. Returns the end of the kept ids.
-uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi, int axis) {
+// behind them. The ids from certainFrom on (end: none) are kept untested, behind those tested
+// and kept. Returns the end of the kept ids.
+uint partitionIds(uint begin, uint end, uint certainFrom, uint rule, vec3 lo, vec3 hi, int axis) {
     bool triangleIds = rule == kKeepOverlapping || rule == kKeepBelowFace || rule == kKeepAboveFace;
     uint scratch = (triangleIds ? gTriScratchHalf : (rule == kKeepPacketCrossing ? gPacketCount : gRayScratchHalf)) + begin;
     uint kept = 0, dropped = 0;
     uint lane = gl_LocalInvocationIndex;
+    uint tested = end;
+    end = certainFrom;
     for (uint base = begin; base < end; base += kPartitionChunk) {
         uint first = base + lane * kIdsPerInvocation;
         uint ids[kIdsPerInvocation];
@@ -223,6 +248,8 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi, int axis) {
         dropped += min(kPartitionChunk, end - base) - total;
     }
     workgroupSync();
+    moveIdsDown(triangleIds, certainFrom, tested, begin + kept);
+    kept += tested - certainFrom;
     uint keptEnd = begin + kept;
     for (uint base = 0; base < dropped; base += kPartitionChunk) {
         [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
@@ -239,17 +266,23 @@ uint partitionIds(uint begin, uint end, uint rule, vec3 lo, vec3 hi, int axis) {
     return keptEnd;
 }
 
-uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
+// The rays [begin, end) that `rule` keeps first; those from certainFrom on kept untested.
+uint partitionRaysFrom(uint begin, uint end, uint certainFrom, uint rule, vec3 lo, vec3 hi) {
     uint start = stageClock();
-    uint kept = partitionIds(begin, end, rule, lo, hi, 0);
+    uint kept = partitionIds(begin, end, certainFrom, rule, lo, hi, 0);
     addStageTicks(DACRT_STAGE_RAY_PARTITIONS, start);
     return kept;
 }
 
-// The packet ids [begin, end) that may cross the cell first (a packet level's ray partition).
-uint partitionPackets(uint begin, uint end, vec3 lo, vec3 hi) {
+uint partitionRays(uint begin, uint end, uint rule, vec3 lo, vec3 hi) {
+    return partitionRaysFrom(begin, end, end, rule, lo, hi);
+}
+
+// The packet ids [begin, end) that may cross the cell first (a packet level's ray partition);
+// those from certainFrom on kept untested.
+uint partitionPackets(uint begin, uint end, uint certainFrom, vec3 lo, vec3 hi) {
     uint start = stageClock();
-    uint kept = partitionIds(begin, end, kKeepPacketCrossing, lo, hi, 0);
+    uint kept = partitionIds(begin, end, certainFrom, kKeepPacketCrossing, lo, hi, 0);
     addStageTicks(DACRT_STAGE_RAY_PARTITIONS, start);
     return kept;
 }
@@ -300,7 +333,7 @@ void markRaysDone(uint begin, uint end) {
 
 uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
     uint start = stageClock();
-    uint kept = partitionIds(begin, end, kKeepOverlapping, lo, hi, 0);
+    uint kept = partitionIds(begin, end, end, kKeepOverlapping, lo, hi, 0);
     addStageTicks(DACRT_STAGE_TRIANGLE_PARTITIONS, start);
     return kept;
 }
@@ -312,8 +345,8 @@ uint partitionTriangles(uint begin, uint end, vec3 lo, vec3 hi) {
 uint partitionTrianglesAtFace(uint begin, uint end, vec3 lo, vec3 hi, int axis, bool highChild, bool beyond) {
     uint start = stageClock();
     int face = axis | (beyond ? kBeyondFace : 0);
-    uint kept = highChild ? partitionIds(begin, end, kKeepAboveFace, lo, hi, face)
-                          : partitionIds(begin, end, kKeepBelowFace, lo, hi, face);
+    uint kept = highChild ? partitionIds(begin, end, end, kKeepAboveFace, lo, hi, face)
+                          : partitionIds(begin, end, end, kKeepBelowFace, lo, hi, face);
     addStageTicks(DACRT_STAGE_TRIANGLE_PARTITIONS, start);
     return kept;
 }

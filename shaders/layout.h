@@ -133,6 +133,12 @@ struct StackEntry {   // a child waiting, with its parent's ranges
     // the range being its own already; kSiblingNotFiltered otherwise.
     uint siblingTriEnd;
     uint rayRule;     // which of the parent's live rays visit it (kKeepCrossing*), its face, kSiblingWaits
+    // Likewise for its rays (or packets): where the sibling's filter put those it kept. The
+    // parent's rays behind them, which the sibling dropped, visit this child untested.
+    uint siblingRayEnd;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 // Which child of a split each ray meets first (FrameGeometry::order).
@@ -323,8 +329,9 @@ static_assert(sizeof(TraversalState) == 64 && offsetof(TraversalState, phase) ==
 static_assert(offsetof(TraversalState, stalls) == 48 && offsetof(TraversalState, leafNext) == 52);
 static_assert(offsetof(TraversalState, cost) == 56 && offsetof(TraversalState, stackSlot) == 60);
 static_assert(offsetof(TraversalState, nodeRayEnd) == 28 && offsetof(TraversalState, stackSize) == 44);
-static_assert(sizeof(StackEntry) == 48 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depthAndStalls) == 36);
+static_assert(sizeof(StackEntry) == 64 && offsetof(StackEntry, rayEnd) == 12 && offsetof(StackEntry, depthAndStalls) == 36);
 static_assert(offsetof(StackEntry, siblingTriEnd) == 40 && offsetof(StackEntry, rayRule) == 44);
+static_assert(offsetof(StackEntry, siblingRayEnd) == 48);
 static_assert(sizeof(DacrtPush) == 68 && offsetof(DacrtPush, loopProbe) == 32 && offsetof(DacrtPush, rayTmax) == 64);
 static_assert(offsetof(DacrtPush, packetRaysAt) == 48 && offsetof(DacrtPush, doneFlagsAt) == 52);
 static_assert(offsetof(DacrtPush, packetIdsAt) == 56 && offsetof(DacrtPush, packetCount) == 60);
