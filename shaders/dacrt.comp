@@ -366,7 +366,8 @@ bool enterChild(ItemContext c, inout Slice s) {
     // parent's widened box but not the sibling's, and the two children's widened boxes cover
     // the parent's (docs/correctness.md, "The second child's rays"; a ray given to a cell it
     // does not cross changes no hit). Its sibling's subtree traced only the rays it kept.
-    uint certainFrom = e.siblingRayEnd != kSiblingNotFiltered ? e.siblingRayEnd : e.rayEnd;
+    // (Clamped to the range, so that a broken invariant would cost tests, never ray ids.)
+    uint certainFrom = e.siblingRayEnd != kSiblingNotFiltered ? clamp(e.siblingRayEnd, s.terminated, e.rayEnd) : e.rayEnd;
     s.nodeRayEnd = rule == kKeepCrossing        ? partitionRaysFrom(s.terminated, e.rayEnd, certainFrom, kKeepCrossing, lo, hi)
                    : rule == kKeepPacketCrossing ? partitionPackets(s.terminated, e.rayEnd, certainFrom, lo, hi)
                                                  : partitionRays(s.terminated, e.rayEnd, rule, lo, hi);

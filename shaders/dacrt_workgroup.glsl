@@ -187,7 +187,7 @@ bool keepId(uint id, uint rule, vec3 lo, vec3 hi, int axis) {
 // each chunk is read whole before any of its slots is written, and no later chunk reads a slot
 // an earlier one wrote (every write lands below the reads so far).
 void moveIdsDown(bool triangleIds, uint from, uint end, uint to) {
-    if (to == from) return;  // uniform: nothing moves
+    if (to == from || from == end) return;  // uniform: nothing moves
     uint lane = gl_LocalInvocationIndex;
     for (uint base = from; base < end; base += kPartitionChunk) {
         uint first = base + lane * kIdsPerInvocation;

@@ -55,7 +55,7 @@ struct TraceCounters {
     std::uint64_t rayTriangleTests = 0;         // a leaf's rays times its triangles, summed over leaves
     std::uint64_t rayTriangleTestsSkipped = 0;  // cpu: of those, pairs a leaf's ray groups ruled out unrun
     std::uint64_t leaves = 0;
-    std::uint64_t tightBoxes = 0;       // cpu: nodes traced inside the box of their triangles' bounds
+    std::uint64_t tightBoxes = 0;       // DACRT backends: nodes traced inside the box of their triangles' bounds
     std::uint64_t raysCulled = 0;        // missed the scene's bounds
     std::uint64_t raysFinishedWithoutHit = 0;  // cpu: finished early, unable to reach a further region
     std::uint64_t raysFinishedStep1 = 0;       // in their own region's Step 1 (cpu-seq: every ray)

@@ -308,7 +308,8 @@ TEST(GpuImages, TightBoxesGiveTheSameHitsAndSaveTests) {
         g.query = query;
         const TraceResult reference = traceFrame(g, Backend::CpuSeq);
         // Workgroups of several subgroups too, whose bounds meet through shared memory.
-        for (const GpuTuning& tuning : {GpuTuning{}, GpuTuning{.workgroupSize = 32}})
+        const std::uint32_t severalSubgroups = 4 * context->info().subgroupSize;
+        for (const GpuTuning& tuning : {GpuTuning{}, GpuTuning{.workgroupSize = severalSubgroups}})
             for (unsigned regions : {1u, 3u}) {
                 SCOPED_TRACE(std::to_string(regions) + " regions, workgroup " + std::to_string(tuning.workgroupSize));
                 std::map<bool, Counters> counters;  // by tight boxes on
@@ -331,10 +332,18 @@ TEST(GpuImages, TightBoxesGiveTheSameHitsAndSaveTests) {
     view.eye = scene.cameraEye;
     view.target = glm::dvec3(0.0);
     const Frame frame(sceneFromMeshes(scene.meshes), 64, 64, view);
+    std::map<bool, Counters> counters;  // by tight boxes on
     for (bool tight : {true, false}) {
         SCOPED_TRACE(tight ? "camera, tight boxes" : "camera, cells");
         expectGpuMatchesCpu(*context, frame, {1, 3}, {}, DacrtOptions{.tightBoxes = tight});
+        TraceOptions o = gpuOptions(1);
+        o.dacrt.tightBoxes = tight;
+        ThreadPool pool(2);
+        counters[tight] = GpuTracer(*context, pool, o, {}).trace(frame.geometry).counters;
     }
+    EXPECT_GT(counters[true].tightBoxes, 0u) << "camera";
+    EXPECT_EQ(counters[false].tightBoxes, 0u) << "camera";
+    EXPECT_LT(counters[true].rayTriangleTests, counters[false].rayTriangleTests) << "camera";
     EXPECT_TRUE(noValidationErrors(*context));
 }
 
