@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -623,7 +624,18 @@ TEST(Cli, AnOrthographicCameraRendersAlikeOnEveryBackend) {
     EXPECT_GT(hits, 200u);
     EXPECT_LT(hits, 576u);  // the quad fills 2/3 of the 3-unit-high view: (16/24)^2 of the pixels
     for (const auto& [backend, aov] : aovs) {
-        EXPECT_EQ(aov.depth, brute.depth) << backend;
+        if (backend != "embree") {
+            EXPECT_EQ(aov.depth, brute.depth) << backend;
+        } else {  // Embree's own t: its AVX2 kernels round it a few ulps off, its AVX-512 ones did not
+            ASSERT_EQ(aov.depth.size(), brute.depth.size());
+            for (std::size_t k = 0; k < brute.depth.size(); ++k) {
+                EXPECT_EQ(std::isfinite(aov.depth[k]), std::isfinite(brute.depth[k])) << "embree, pixel " << k;
+                if (std::isfinite(brute.depth[k])) {
+                    EXPECT_NEAR(aov.depth[k], brute.depth[k], 4.0f * std::numeric_limits<float>::epsilon() * brute.depth[k])
+                        << "embree, pixel " << k;
+                }
+            }
+        }
         // The quad's diagonal runs through the diagonal pixels' centres: a tie between its two
         // triangles, which brute force and DACRT give to the smaller id and Embree to either.
         if (backend != "embree") {

@@ -98,6 +98,16 @@ TEST(ApiRays, RefusesBadRaysNamingTheRay) {
     expectInputError([&] { RayBatch::fromCamera(scene, {.fovDegrees = 200.0}, 8, 8); }, "field of view");
 }
 
+// Embree computes t its own way: its AVX2 kernels round it a few ulps off the exact value where
+// its AVX-512 ones did not. The DACRT backends and brute force give it bit for bit.
+static void expectT(Backend b, float t, float expected) {
+    if (b == Backend::Embree) {
+        EXPECT_NEAR(t, expected, 4.0f * std::numeric_limits<float>::epsilon() * std::fabs(expected)) << "embree";
+    } else {
+        EXPECT_EQ(t, expected) << int(b);
+    }
+}
+
 // AsGiven: t in units of the caller's direction (a segment to a point ends at 1), and a ray
 // made canonical already (makeRay's) traced bit for bit as made.
 TEST(ApiRays, DirectionsAsGivenMeasureTInTheirUnits) {
@@ -110,10 +120,10 @@ TEST(ApiRays, DirectionsAsGivenMeasureTInTheirUnits) {
     for (Backend b : {Backend::Brute, Backend::CpuSeq, Backend::Cpu, Backend::Embree}) {
         Tracer tracer(onBackend(b, 2));
         const TraceOutput out = tracer.trace(scene, given);
-        EXPECT_EQ(out.hits[0].t, 0.25f) << int(b);
+        expectT(b, out.hits[0].t, 0.25f);
         EXPECT_FALSE(out.hits[1].hit()) << int(b);  // the segment ends at z = -0.5
         EXPECT_FALSE(out.hits[2].hit()) << int(b);
-        EXPECT_EQ(tracer.trace(scene, unit).hits[0].t, 1.0f) << int(b);
+        expectT(b, tracer.trace(scene, unit).hits[0].t, 1.0f);
         EXPECT_TRUE(tracer.occluded(scene, given).hits[0].hit()) << int(b);
     }
 
@@ -150,7 +160,7 @@ TEST(ApiScene, DroppedTrianglesKeepTheCallersNumbering) {
         ASSERT_EQ(out.hits.size(), 3u);
         EXPECT_EQ(out.hits[0].primitive, 0u);
         EXPECT_EQ(out.hits[1].primitive, 2u);
-        EXPECT_EQ(out.hits[1].t, 3.0f);
+        expectT(b, out.hits[1].t, 3.0f);
         EXPECT_FALSE(out.hits[2].hit());
         EXPECT_EQ(tracer.occluded(scene, rays).hits[1].hit(), true);
     }

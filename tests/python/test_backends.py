@@ -79,11 +79,17 @@ def test_hits_report_the_callers_numbering_and_a_miss_as_open3d_does(tracer):
     for backend in DACRT_BACKENDS[:3] + ["embree"]:
         got = tracer(backend).cast_rays(scene, rays)
         assert got["primitive_ids"].tolist() == [0, 2, dacrt.INVALID_ID], backend
-        assert got["t_hit"].tolist() == [0.5, 3.0, np.inf], backend  # units of the direction as given
+        # Units of the direction as given; Embree's own arithmetic may round t a few ulps off
+        # (its AVX2 kernels do here, where its AVX-512 ones did not), DACRT's never.
+        if backend == "embree":
+            np.testing.assert_allclose(got["t_hit"], [0.5, 3.0, np.inf], rtol=4 * 2.0**-23, err_msg=backend)
+        else:
+            assert got["t_hit"].tolist() == [0.5, 3.0, np.inf], backend
         assert got["primitive_normals"].tolist() == [[0, 0, 1], [0, 0, 1], [0, 0, 0]], backend
         assert got["primitive_uvs"][2].tolist() == [0, 0]
         np.testing.assert_allclose(got["primitive_uvs"][0], [0.25, 0.25])
-        assert tracer(backend).cast_rays(scene, rays, normalize=True)["t_hit"][0] == 1.0
+        unit_t = tracer(backend).cast_rays(scene, rays, normalize=True)["t_hit"][0]
+        assert unit_t == 1.0 or (backend == "embree" and abs(unit_t - 1.0) <= 4 * 2.0**-23), backend
     # Single-sided: the back face lets the ray through.
     single = dacrt.Scene(vertices[:3], np.array([[0, 1, 2]], np.uint32), double_sided=False)
     below = np.array([[0.25, 0.25, -5, 0, 0, 1], [0.25, 0.25, 5, 0, 0, -1]], np.float32)
