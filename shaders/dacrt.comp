@@ -91,6 +91,11 @@ struct ItemContext {
 // on a packet node's rays.
 const uint kPacketRays = 64u;
 
+// The rays `packets` packets stand for at most, without overflow.
+uint raysOfPackets(uint packets) {
+    return min(packets, 0xFFFFFFFFu / kPacketRays) * kPacketRays;
+}
+
 const uint kStepContinue = 0u;
 const uint kStepOutOfBudget = 1u;
 const uint kStepTreeDone = 2u;
@@ -330,7 +335,7 @@ uint popFarChild(ItemContext c, inout Slice s) {
 // into the cell's margin).
 bool tightenBox(ItemContext c, inout Slice s) {
     uint triCount = s.triEnd - s.triBegin, count = s.nodeRayEnd - s.terminated;
-    uint rayCount = s.packetLevel ? min(count, 0xFFFFFFFFu / kPacketRays) * kPacketRays : count;
+    uint rayCount = s.packetLevel ? raysOfPackets(count) : count;
     if (kTightBoxRays == 0u || triCount == 0u || rayCount / max(kTightBoxRays, 1u) < triCount) return false;
     // Under a loop budget the box is an option the slice may not afford (the same hits
     // without it): the reduction and the second partition cost a partition each at most.
@@ -413,7 +418,7 @@ uint stepPacketNode(ItemContext c, inout Slice s, int axis, float split) {
     bool canSplit = s.depth < kMaxDepth && split > s.lo[axis] && split < s.hi[axis] &&
                     s.stalls < DACRT_MAX_STALLED_SPLITS;
     bool flush = packetCount < kPacketFlush || triCount < kTriLimit || !canSplit ||
-                 leafUnderBalance(min(packetCount, 0xFFFFFFFFu / kPacketRays) * kPacketRays, triCount, kLeafBalance);
+                 leafUnderBalance(raysOfPackets(packetCount), triCount, kLeafBalance);
     return flush ? flushPackets(c, s) : splitNode(c, s, axis, split, packetCount, triCount);
 }
 
