@@ -205,6 +205,28 @@ void moveIdsDown(bool triangleIds, uint from, uint end, uint to) {
     workgroupSync();
 }
 
+// Which ids of an invocation's run (ids[e] at first + e, those at end and past it out of range)
+// `rule` keeps: bit e for ids[e]. Each copy of keepId, inlined at every call site, costs
+// llvmpipe compile time: unrolled over the run, the four copies made Mesa 25.0.7 compile the
+// kernel 1.5x as long (docs/gpu.md, "The kernel's compile time"). Under a loop budget they stay
+// unrolled: llvmpipe's loop limiter would count the loop's iterations, which partitionCost
+// leaves out.
+uint keptOfRun(uint ids[kIdsPerInvocation], uint first, uint end, uint rule, vec3 lo, vec3 hi, int axis) {
+    uint keeps = 0u;
+    if (kLoopBudget != 0u) {
+        [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e)
+            if (first + e < end && keepId(ids[e], rule, lo, hi, axis)) keeps |= 1u << e;
+        return keeps;
+    }
+    [[dont_unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
+        uint id = ids[0];
+        [[unroll]] for (uint k = 1; k < kIdsPerInvocation; ++k)
+            if (e == k) id = ids[k];  // constant indices: the run stays in registers
+        if (first + e < end && keepId(id, rule, lo, hi, axis)) keeps |= 1u << e;
+    }
+    return keeps;
+}
+
 // Stable partition of rayIds[begin, end) (or triIds, for kKeepOverlapping; the packet ids in the
 // ray id buffer, for kKeepPacketCrossing): the ids `rule` keeps first, in their order, then the
 // others in theirs. Kept ids move down in place (never
@@ -221,15 +243,12 @@ uint partitionIds(uint begin, uint end, uint certainFrom, uint rule, vec3 lo, ve
     for (uint base = begin; base < end; base += kPartitionChunk) {
         uint first = base + lane * kIdsPerInvocation;
         uint ids[kIdsPerInvocation];
-        bool keeps[kIdsPerInvocation];
-        uint myKept = 0;
         [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             uint index = first + e;
-            bool inRange = index < end;
-            ids[e] = inRange ? (triangleIds ? TRI_IDS(index) : RAY_IDS(index)) : 0u;
-            keeps[e] = inRange && keepId(ids[e], rule, lo, hi, axis);
-            myKept += keeps[e] ? 1u : 0u;
+            ids[e] = index < end ? (triangleIds ? TRI_IDS(index) : RAY_IDS(index)) : 0u;
         }
+        uint keeps = keptOfRun(ids, first, end, rule, lo, hi, axis);
+        uint myKept = bitCount(keeps);
         uint total;
         uint keptBefore = workgroupExclusiveSum(myKept, total);
         // Kept ids move down in place: every id of the chunk must be read before any of the
@@ -240,7 +259,7 @@ uint partitionIds(uint begin, uint end, uint certainFrom, uint rule, vec3 lo, ve
         uint k = begin + kept + keptBefore, d = scratch + dropped + droppedBefore;
         [[unroll]] for (uint e = 0; e < kIdsPerInvocation; ++e) {
             if (first + e >= end) continue;
-            uint slot = keeps[e] ? k++ : d++;
+            uint slot = (keeps & (1u << e)) != 0u ? k++ : d++;
             if (triangleIds) TRI_IDS(slot) = ids[e];
             else RAY_IDS(slot) = ids[e];
         }
