@@ -10,8 +10,10 @@
 #include "cpu/traversal.hpp"
 #include "gpu/binding_set.hpp"
 #include "gpu/compute_pipeline.hpp"
+#include "gpu/device_defaults.hpp"
 #include "gpu/dispatch_recorder.hpp"
 #include "gpu/embedded_shaders.hpp"
+#include "gpu/pipeline_cache.hpp"
 
 using namespace dacrt;
 
@@ -58,8 +60,15 @@ int main(int argc, char** argv) {
     upload(DACRT_BINDING_TRI_IDS, triIds);
     const std::uint32_t subgroup = context.info().subgroupSize;
     for (std::uint32_t workgroup : {subgroup, 4 * subgroup}) {
-        gpu::ComputePipeline pipeline(context, gpu::workgroupTestSpirv(),
-                                     DACRT_BINDING_COUNT, sizeof(WorkgroupTestPush), {workgroup, 16, 16, 48}, "bench");
+        // The kernel's loop budget on this device: under one a partition's run of tests is
+        // unrolled (keptOfRun), as the kernel runs it there.
+        const gpu::KernelSpecialization specialization{.workgroupSize = workgroup,
+                                                       .rayLimit = 16,
+                                                       .triLimit = 16,
+                                                       .maxDepth = 48,
+                                                       .loopBudget = gpu::loopBudgetOf(context.info())};
+        gpu::ComputePipeline pipeline(context, gpu::workgroupTestSpirv(), DACRT_BINDING_COUNT, sizeof(WorkgroupTestPush),
+                                      specialization.values(), "bench");
         set.bindTo(pipeline);
         // Each block runs twice and the second run is reported: the first also pays for the
         // first touch of the scratch memory and the driver's lazy set-up.
