@@ -16,6 +16,7 @@
 #include "library/backend_dispatcher.hpp"
 #include "peers/embree_memory.hpp"
 #include "support/api_support.hpp"
+#include "support/embree_t.hpp"
 #include "support/fixtures.hpp"
 
 namespace dacrt {
@@ -98,11 +99,10 @@ TEST(ApiRays, RefusesBadRaysNamingTheRay) {
     expectInputError([&] { RayBatch::fromCamera(scene, {.fovDegrees = 200.0}, 8, 8); }, "field of view");
 }
 
-// Embree computes t its own way: its AVX2 kernels round it a few ulps off the exact value where
-// its AVX-512 ones did not. The DACRT backends and brute force give it bit for bit.
+// Embree's t within its rounding (support/embree_t.hpp), every other backend's bit for bit.
 static void expectT(Backend b, float t, float expected) {
     if (b == Backend::Embree) {
-        EXPECT_NEAR(t, expected, 4.0f * std::numeric_limits<float>::epsilon() * std::fabs(expected)) << "embree";
+        EXPECT_NEAR(t, expected, test::embreeTTolerance(expected)) << "embree";
     } else {
         EXPECT_EQ(t, expected) << int(b);
     }
