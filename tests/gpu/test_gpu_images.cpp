@@ -307,13 +307,17 @@ TEST(GpuImages, TightBoxesGiveTheSameHitsAndSaveTests) {
         FrameGeometry g = frameGeometry(s.triangles, bounds, scene.rays, sceneBounds(s.triangles));
         g.query = query;
         const TraceResult reference = traceFrame(g, Backend::CpuSeq);
-        // Workgroups of several subgroups too, whose bounds meet through shared memory.
+        // Workgroups of several subgroups too, whose bounds meet through shared memory: with the
+        // boxes only, as that meeting is what they test (without the boxes they would add two
+        // kernel variants, over a minute of compile on Mesa 25.0.7 with a clean shader cache).
         const std::uint32_t severalSubgroups = 4 * context->info().subgroupSize;
         for (const GpuTuning& tuning : {GpuTuning{}, GpuTuning{.workgroupSize = severalSubgroups}})
             for (unsigned regions : {1u, 3u}) {
                 SCOPED_TRACE(std::to_string(regions) + " regions, workgroup " + std::to_string(tuning.workgroupSize));
+                const bool severalSubgroupsWorkgroup = tuning.workgroupSize != 0;
                 std::map<bool, Counters> counters;  // by tight boxes on
                 for (bool tight : {true, false}) {
+                    if (!tight && severalSubgroupsWorkgroup) continue;
                     TraceOptions o = gpuOptions(regions);
                     o.dacrt.tightBoxes = tight;
                     ThreadPool pool(2);
@@ -324,6 +328,7 @@ TEST(GpuImages, TightBoxesGiveTheSameHitsAndSaveTests) {
                     counters[tight] = r.counters;
                 }
                 EXPECT_GT(counters[true].tightBoxes, 0u);
+                if (severalSubgroupsWorkgroup) continue;
                 EXPECT_EQ(counters[false].tightBoxes, 0u);
                 EXPECT_LT(counters[true].rayTriangleTests, counters[false].rayTriangleTests);
             }
