@@ -448,13 +448,84 @@ HWY_INLINE bool watertightInLanes(const VF (&a)[3], const VF (&b)[3], const VF (
     return !hn::AllFalse(df, live);
 }
 
+// What the back-face skip of intersectRay reads of a batch: each triangle's n = (v1 - v0) x
+// (v2 - v0) in lanes, a bias per lane added to n's side (0 for a single-sided triangle; NaN for
+// a double-sided one, which is then never skipped; +infinity for the lanes past the count, so
+// that they never hold a vector's test), and the box of the batch's vertices (the padded lanes
+// repeat the first triangle, so they widen nothing). None of it where no triangle is
+// single-sided.
+struct BatchFaces {
+    alignas(64) float normal[3][kLeafBatch];
+    alignas(64) float bias[kLeafBatch];
+    glm::vec3 lo{}, hi{};
+    bool anyCulled = false;
+};
+
+HWY_INLINE void facesOf(const LeafTriangles& batch, BatchFaces& faces) {
+    const DF df;
+    const DU du;
+    const std::size_t n = hn::Lanes(df);
+    auto culled = hn::Zero(du);
+    for (std::size_t j = 0; j < batch.count; j += n) culled = hn::Or(culled, hn::Load(du, &batch.cullBackFace[j]));
+    faces.anyCulled = !hn::AllTrue(du, culled == hn::Zero(du));
+    if (!faces.anyCulled) return;
+    VF lo[3], hi[3];
+    const VF infinity = hn::Set(df, std::numeric_limits<float>::infinity());
+    const VF notANumber = hn::Set(df, std::numeric_limits<float>::quiet_NaN());
+    for (int c = 0; c < 3; ++c) {
+        lo[c] = infinity;
+        hi[c] = hn::Neg(infinity);
+    }
+    for (std::size_t j = 0; j < batch.count; j += n) {
+        VF v[3][3];
+        for (int k = 0; k < 3; ++k)
+            for (int c = 0; c < 3; ++c) v[k][c] = hn::Load(df, &batch.vertex[k][c][j]);
+        VF e1[3], e2[3];
+        for (int c = 0; c < 3; ++c) {
+            e1[c] = hn::Sub(v[1][c], v[0][c]);
+            e2[c] = hn::Sub(v[2][c], v[0][c]);
+            lo[c] = hn::Min(lo[c], hn::Min(v[0][c], hn::Min(v[1][c], v[2][c])));
+            hi[c] = hn::Max(hi[c], hn::Max(v[0][c], hn::Max(v[1][c], v[2][c])));
+        }
+        for (int c = 0; c < 3; ++c) {
+            const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            hn::Store(hn::Sub(hn::Mul(e1[c1], e2[c2]), hn::Mul(e1[c2], e2[c1])), df, &faces.normal[c][j]);
+        }
+        const MF single = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
+        const MF live = hn::FirstN(df, batch.count - j);
+        hn::Store(hn::IfThenElse(live, hn::IfThenElse(single, hn::Zero(df), notANumber), infinity), df, &faces.bias[j]);
+    }
+    for (int c = 0; c < 3; ++c) {
+        faces.lo[c] = hn::GetLane(hn::MinOfLanes(df, lo[c]));
+        faces.hi[c] = hn::GetLane(hn::MaxOfLanes(df, hi[c]));
+    }
+}
+
+// The back-face skip's margin for a ray from origin over faces' box (docs/correctness.md,
+// "Back faces skipped in a leaf"): 2^-12 R^2 + 2^-120, R the largest coordinate of a vertex
+// less the origin; infinite (nothing skipped) past R = 2^40, where the bound's products could
+// overflow.
+HWY_INLINE float backFaceMargin(const BatchFaces& faces, const glm::vec3& origin) {
+    float reach = 0.0f;
+    for (int c = 0; c < 3; ++c)
+        reach = std::max(reach, std::max(std::abs(faces.lo[c] - origin[c]), std::abs(faces.hi[c] - origin[c])));
+    if (!(reach <= 0x1p40f)) return std::numeric_limits<float>::infinity();
+    return reach * reach * 0x1p-12f + 0x1p-120f;
+}
+
 // shared::intersectWatertight for one ray and hn::Lanes triangles at a time; the tie rule then
 // runs per hit lane in scalar code. The ray's axes are template arguments, so that a[kx] and
 // the like name registers: indexed by a run-time axis, the vertex vectors went through the
 // stack on every batch of triangles. An any-hit ray (kAnyHit) that has a hit is done: it
 // tests nothing more, and it takes the first hit lane of the first vector that has one.
+//
+// A vector whose single-sided triangles all show the ray their backs, by more than the rounding
+// of the test's determinant can hide, is skipped before the test (docs/correctness.md, "Back
+// faces skipped in a leaf"): its determinants are all negative, so the face rule rejects every
+// lane. The leaves of occlusion and shadow rays, which leave a surface outwards, are mostly such
+// vectors. faces: the batch's (facesOf).
 template <int kx, int ky, int kz, bool kAnyHit>
-HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch) {
+HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch, const BatchFaces& faces) {
     if constexpr (kAnyHit)
         if (best.prim != kMissPrim) return best;
     const DF df;
@@ -466,7 +537,32 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
     const VF sx = hn::Set(df, ray.shear.x), sy = hn::Set(df, ray.shear.y), sz = hn::Set(df, ray.shear.z);
     const VF origin[3] = {hn::Set(df, ray.origin.x), hn::Set(df, ray.origin.y), hn::Set(df, ray.origin.z)};
     const VF tmin = hn::Set(df, ray.tmin);
+    // A bit per vector that some lane of holds the test (every vector where no triangle is
+    // single-sided). A ray that every vector shows its back is done here, with no branch per
+    // vector. The sheared frame's determinant is -sigma n . w, w the vector with the shear's x
+    // and y on axes kx and ky and 1 on kz, sigma the sign of the permutation (kx, ky, kz): so
+    // the face rule rejects where sigma n . w is positive, and `toward` is sigma w.
+    std::uint64_t tested = ~std::uint64_t(0);
+    if (faces.anyCulled) {
+        const VF margin = hn::Set(df, backFaceMargin(faces, ray.origin));
+        const float sigma = ky == (kx + 1) % 3 ? 1.0f : -1.0f;
+        VF toward[3];
+        toward[kx] = hn::Set(df, sigma * ray.shear.x);
+        toward[ky] = hn::Set(df, sigma * ray.shear.y);
+        toward[kz] = hn::Set(df, sigma);
+        tested = 0;
+        for (std::size_t j = 0; j < batch.count; j += n) {
+            const VF side = hn::Add(hn::Add(hn::Add(hn::Mul(hn::Load(df, &faces.normal[0][j]), toward[0]),
+                                                    hn::Mul(hn::Load(df, &faces.normal[1][j]), toward[1])),
+                                            hn::Mul(hn::Load(df, &faces.normal[2][j]), toward[2])),
+                                    hn::Load(df, &faces.bias[j]));
+            tested |= std::uint64_t(!hn::AllTrue(df, side > margin)) << (j / n);
+        }
+        if (tested == 0) return best;
+    }
     for (std::size_t j = 0; j < batch.count; j += n) {
+        if ((tested >> (j / n) & 1) == 0) continue;
+        const MF cull = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
         VF a[3], b[3], c[3];
         for (int k = 0; k < 3; ++k) {
             a[k] = hn::Sub(hn::Load(df, &batch.vertex[0][k][j]), origin[k]);
@@ -475,7 +571,6 @@ HWY_INLINE Hit intersectRay(const Ray& ray, Hit best, const LeafTriangles& batch
         }
         const VF pa[3] = {a[kx], a[ky], a[kz]}, pb[3] = {b[kx], b[ky], b[kz]}, pc[3] = {c[kx], c[ky], c[kz]};
         auto slackOf = [&] { return projectionSlackOf(a, b, c); };
-        const MF cull = hn::RebindMask(df, hn::Load(du, &batch.cullBackFace[j]) != hn::Zero(du));
         MF m = hn::FirstN(df, batch.count - j);
         VF t, ev, ew, det;
         if (!watertightInLanes(pa, pb, pc, sx, sy, sz, cull, tmin, slackOf, m, t, ev, ew, det)) continue;
@@ -505,6 +600,8 @@ HWY_INLINE void intersectRays(const Ray* rays, Hit* hits, const std::uint32_t* r
                               const LeafTriangles& batch) {
     // A few rays ahead asked for: a leaf's rays are scattered over the pass's arrays.
     constexpr std::uint32_t kRaysAhead = 4;
+    BatchFaces faces;
+    facesOf(batch, faces);
     for (std::uint32_t r = 0; r < rayCount; ++r) {
         const std::uint32_t rayId = rayIds[r];
         if (r + kRaysAhead < rayCount) {
@@ -514,12 +611,12 @@ HWY_INLINE void intersectRays(const Ray* rays, Hit* hits, const std::uint32_t* r
         const Ray& ray = rays[rayId];
         const Hit best = hits[rayId];
         switch (ray.axes) {
-            case packedAxes(1, 2, 0): hits[rayId] = intersectRay<1, 2, 0, kAnyHit>(ray, best, batch); break;
-            case packedAxes(2, 1, 0): hits[rayId] = intersectRay<2, 1, 0, kAnyHit>(ray, best, batch); break;
-            case packedAxes(2, 0, 1): hits[rayId] = intersectRay<2, 0, 1, kAnyHit>(ray, best, batch); break;
-            case packedAxes(0, 2, 1): hits[rayId] = intersectRay<0, 2, 1, kAnyHit>(ray, best, batch); break;
-            case packedAxes(0, 1, 2): hits[rayId] = intersectRay<0, 1, 2, kAnyHit>(ray, best, batch); break;
-            case packedAxes(1, 0, 2): hits[rayId] = intersectRay<1, 0, 2, kAnyHit>(ray, best, batch); break;
+            case packedAxes(1, 2, 0): hits[rayId] = intersectRay<1, 2, 0, kAnyHit>(ray, best, batch, faces); break;
+            case packedAxes(2, 1, 0): hits[rayId] = intersectRay<2, 1, 0, kAnyHit>(ray, best, batch, faces); break;
+            case packedAxes(2, 0, 1): hits[rayId] = intersectRay<2, 0, 1, kAnyHit>(ray, best, batch, faces); break;
+            case packedAxes(0, 2, 1): hits[rayId] = intersectRay<0, 2, 1, kAnyHit>(ray, best, batch, faces); break;
+            case packedAxes(0, 1, 2): hits[rayId] = intersectRay<0, 1, 2, kAnyHit>(ray, best, batch, faces); break;
+            case packedAxes(1, 0, 2): hits[rayId] = intersectRay<1, 0, 2, kAnyHit>(ray, best, batch, faces); break;
             default: HWY_ABORT("ray axes %u: makeRay and segmentRay make only six", ray.axes);
         }
     }
