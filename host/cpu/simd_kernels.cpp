@@ -597,11 +597,9 @@ constexpr std::uint32_t packedAxes(int kx, int ky, int kz) { return std::uint32_
 
 template <bool kAnyHit>
 HWY_INLINE void intersectRays(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
-                              const LeafTriangles& batch) {
+                              const LeafTriangles& batch, const BatchFaces& faces) {
     // A few rays ahead asked for: a leaf's rays are scattered over the pass's arrays.
     constexpr std::uint32_t kRaysAhead = 4;
-    BatchFaces faces;
-    facesOf(batch, faces);
     for (std::uint32_t r = 0; r < rayCount; ++r) {
         const std::uint32_t rayId = rayIds[r];
         if (r + kRaysAhead < rayCount) {
@@ -624,10 +622,12 @@ HWY_INLINE void intersectRays(const Ray* rays, Hit* hits, const std::uint32_t* r
 
 void IntersectBatch(const Ray* rays, Hit* hits, const std::uint32_t* rayIds, std::uint32_t rayCount,
                     const LeafTriangles& batch, bool anyHit) {
+    BatchFaces faces;
+    facesOf(batch, faces);
     if (anyHit)
-        intersectRays<true>(rays, hits, rayIds, rayCount, batch);
+        intersectRays<true>(rays, hits, rayIds, rayCount, batch, faces);
     else
-        intersectRays<false>(rays, hits, rayIds, rayCount, batch);
+        intersectRays<false>(rays, hits, rayIds, rayCount, batch, faces);
 }
 
 // The batch's triangle bounds, widened, lanes at a time: min and max of exact vertices, then
@@ -973,6 +973,14 @@ HWY_INLINE std::uint64_t intersectSegmentGroups(const Ray* rays, Hit* hits, cons
     WidenedBounds bounds;
     bool haveBounds = false;
     LeafTriangles narrowed;
+    // The whole batch's faces once for every group that tests it; a narrowed batch's its own.
+    BatchFaces batchFaces, narrowedFaces;
+    bool haveBatchFaces = false;
+    auto wholeBatch = [&]() -> const BatchFaces& {
+        if (!haveBatchFaces) facesOf(batch, batchFaces);
+        haveBatchFaces = true;
+        return batchFaces;
+    };
     std::uint64_t skipped = 0, vectorsSaved = 0;
     std::uint32_t g = 0;
     for (; g < rayCount; g += kLeafGroupRays) {
@@ -982,7 +990,7 @@ HWY_INLINE std::uint64_t intersectSegmentGroups(const Ray* rays, Hit* hits, cons
         boxOfSegments(rays, hits, rayIds + g, groupRays, lo, hi);
         if (lo.x <= cell.lo.x && lo.y <= cell.lo.y && lo.z <= cell.lo.z && hi.x >= cell.hi.x &&
             hi.y >= cell.hi.y && hi.z >= cell.hi.z) {
-            intersectRays<kAnyHit>(rays, hits, rayIds + g, groupRays, batch);
+            intersectRays<kAnyHit>(rays, hits, rayIds + g, groupRays, batch, wholeBatch());
             continue;
         }
         if (!haveBounds) {
@@ -993,9 +1001,14 @@ HWY_INLINE std::uint64_t intersectSegmentGroups(const Ray* rays, Hit* hits, cons
         skipped += std::uint64_t(groupRays) * (batch.count - kept.count);
         vectorsSaved += std::uint64_t(groupRays) * (vectors(batch.count) - vectors(kept.count));
         if (kept.count == 0) continue;
-        intersectRays<kAnyHit>(rays, hits, rayIds + g, groupRays, kept);
+        if (&kept == &batch) {
+            intersectRays<kAnyHit>(rays, hits, rayIds + g, groupRays, batch, wholeBatch());
+            continue;
+        }
+        facesOf(kept, narrowedFaces);
+        intersectRays<kAnyHit>(rays, hits, rayIds + g, groupRays, kept, narrowedFaces);
     }
-    if (g < rayCount) intersectRays<kAnyHit>(rays, hits, rayIds + g, rayCount - g, batch);
+    if (g < rayCount) intersectRays<kAnyHit>(rays, hits, rayIds + g, rayCount - g, batch, wholeBatch());
     return skipped;
 }
 
